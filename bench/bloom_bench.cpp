@@ -1,0 +1,104 @@
+// Bloom benchmarks: GPU time from timestamp queries as manual time (STYLE rule 11), bytes/s over
+// the bytes-moved floor, and the error against the float64 reference as a counter.
+//
+// Each iteration records kFramesPerIteration blooms back to back in one command buffer with a
+// timestamp between them and reports their median; Google Benchmark then aggregates iterations
+// (run with --benchmark_repetitions=N --benchmark_report_aggregates_only for medians).
+#include <glint/bloom.h>
+
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <memory>
+#include <random>
+
+#include "bench_support.h"
+#include "core/half.h"
+#include "core/transfer.h"
+#include "reference/bloom_reference.h"
+
+namespace glint::bench {
+namespace {
+
+constexpr int kFramesPerIteration = 16;
+
+const char* filter_name(BloomFilter f) {
+  switch (f) {
+    case BloomFilter::cod13: return "cod13";
+    case BloomFilter::dual: return "dual";
+    case BloomFilter::gauss9: return "gauss9";
+  }
+  return "?";
+}
+
+void BM_Bloom(benchmark::State& state) {
+  const auto width = static_cast<uint32_t>(state.range(0));
+  const auto height = static_cast<uint32_t>(state.range(1));
+  const auto filter = static_cast<BloomFilter>(state.range(2));
+  const auto precision = static_cast<Precision>(state.range(3));
+  const Context& ctx = context();
+  const VkFormat format = VK_FORMAT_R16G16B16A16_SFLOAT;
+
+  const CpuImage input = random_hdr(width, height, 1234);
+  detail::OwnedImage in(ctx, {width, height}, format, detail::kToolImageUsage);
+  detail::OwnedImage out(ctx, {width, height}, format, detail::kToolImageUsage);
+  detail::upload(ctx, in.state, input);
+  BloomConfig config;
+  config.filter = filter;
+  config.precision = precision;
+  Bloom bloom(ctx, config);
+  bloom.prepare({width, height});
+  Profiler profiler(ctx, kFramesPerIteration + 1);
+
+  // Error against the float64 reference (not timed); skipped above 1080p to keep runs short.
+  double error = -1.0;
+  if (uint64_t(width) * height <= 1920ull * 1080ull) {
+    ctx.run_once([&](VkCommandBuffer cmd) { bloom.record(cmd, in.state, out.state); });
+    CpuImage stored = input;
+    for (float& v : stored.rgba) v = detail::round_to_half(v);
+    error = reference::relative_l2(detail::download(ctx, out.state), reference::bloom(stored, config));
+  }
+
+  std::vector<double> frame_ms;
+  for (auto _ : state) {
+    ctx.run_once([&](VkCommandBuffer cmd) {
+      profiler.reset(cmd);
+      profiler.mark(cmd, "start");
+      for (int i = 0; i < kFramesPerIteration; ++i) {
+        bloom.record(cmd, in.state, out.state);
+        profiler.mark(cmd, "frame");
+      }
+    });
+    std::vector<double> ms;
+    for (const auto& s : profiler.results()) ms.push_back(s.ms);
+    const double median = median_of(ms);
+    frame_ms.push_back(median);
+    state.SetIterationTime(median * 1e-3);
+  }
+  const double bytes = static_cast<double>(bloom.min_bytes_moved(format, format));
+  state.counters["floor_bytes"] = bytes;
+  state.counters["bytes_per_second"] = benchmark::Counter(bytes, benchmark::Counter::kIsIterationInvariantRate);
+  state.counters["median_us"] = median_of(frame_ms) * 1e3;
+  state.counters["rel_l2_vs_f64"] = error;
+  state.counters["levels"] = bloom.levels();
+  state.SetLabel(std::string(filter_name(filter)) + (precision == Precision::fp16 ? "/fp16" : "/fp32") + " on " +
+                 ctx.info().name);
+}
+
+void bloom_args(benchmark::internal::Benchmark* b) {
+  for (auto size : {std::pair{640, 480}, std::pair{1920, 1080}, std::pair{3840, 2160}}) {
+    for (int filter = 0; filter < 3; ++filter) {
+      b->Args({size.first, size.second, filter, 0});
+    }
+    b->Args({size.first, size.second, 0, 1});  // cod13 with fp32 intermediates
+  }
+  b->ArgNames({"w", "h", "filter", "fp32"});
+  b->UseManualTime();
+  b->Unit(benchmark::kMicrosecond);
+}
+
+BENCHMARK(BM_Bloom)->Apply(bloom_args);
+
+}  // namespace
+}  // namespace glint::bench

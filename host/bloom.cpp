@@ -1,0 +1,379 @@
+// Bloom driver: validates, owns the pyramid and pipelines, records the passes of docs/BLOOM.md.
+#include <glint/bloom.h>
+
+#include <cmath>
+#include <cstddef>
+#include <map>
+#include <utility>
+
+#include "bloom_params.h"
+#include "core/barriers.h"
+#include "core/check.h"
+#include "core/context_state.h"
+#include "core/pipeline.h"
+#include "core/resources.h"
+
+namespace glint {
+
+using detail::check_range;
+using detail::concat;
+
+// The GLSL push-constant block must match byte for byte (STYLE rule 2).
+static_assert(sizeof(BloomPush) == 48, "BloomPush layout changed: update kernels/common/bloom_params.h users");
+static_assert(offsetof(BloomPush, threshold) == 16);
+static_assert(offsetof(BloomPush, composite_scale) == 32);
+static_assert(offsetof(BloomPush, flags) == 36);
+static_assert(static_cast<uint32_t>(BloomFilter::cod13) == GLINT_BLOOM_COD13);
+static_assert(static_cast<uint32_t>(BloomFilter::dual) == GLINT_BLOOM_DUAL);
+static_assert(static_cast<uint32_t>(BloomFilter::gauss9) == GLINT_BLOOM_GAUSS9);
+
+void BloomConfig::validate() const {
+  check_range("BloomConfig::threshold", threshold, 0.0, 65504.0);
+  check_range("BloomConfig::soft_knee", soft_knee, 0.0, 1.0);
+  check_range("BloomConfig::intensity", intensity, 0.0, 100.0);
+  check_range("BloomConfig::iterations", iterations, 1, 8);
+  check_range("BloomConfig::radius", radius, 0.25, 4.0);
+  check_range("BloomConfig::max_brightness", max_brightness, 1e-3, 8000.0);
+  const auto f = static_cast<uint32_t>(filter);
+  if (f > GLINT_BLOOM_GAUSS9) {
+    throw Error(ErrorCode::invalid_argument, concat("BloomConfig::filter = ", f, " is not a BloomFilter: accepted cod13, dual, gauss9"));
+  }
+  const auto p = static_cast<uint32_t>(precision);
+  if (p > 1) throw Error(ErrorCode::invalid_argument, concat("BloomConfig::precision = ", p, " is not a Precision: accepted fp16, fp32"));
+}
+
+std::vector<LevelSize> bloom_mip_chain(VkExtent2D input, uint32_t iterations) {
+  std::vector<LevelSize> chain;
+  LevelSize level{std::max(1u, input.width / 2), std::max(1u, input.height / 2)};
+  chain.push_back(level);  // level 0 always exists, even when it is under 2 pixels
+  while (chain.size() < iterations) {
+    LevelSize next{std::max(1u, level.width / 2), std::max(1u, level.height / 2)};
+    if (next.width < 2 || next.height < 2) break;
+    chain.push_back(next);
+    level = next;
+  }
+  return chain;
+}
+
+namespace {
+
+const char* format_variant(VkFormat f) {
+  return f == VK_FORMAT_R32G32B32A32_SFLOAT ? "rgba32f" : "rgba16f";
+}
+
+bool is_float_rgba(VkFormat f) {
+  return f == VK_FORMAT_R16G16B16A16_SFLOAT || f == VK_FORMAT_R32G32B32A32_SFLOAT;
+}
+
+constexpr VkPipelineStageFlags2 kCompute = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
+constexpr VkAccessFlags2 kSampled = VK_ACCESS_2_SHADER_SAMPLED_READ_BIT;
+constexpr VkAccessFlags2 kStorageWrite = VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT;
+constexpr VkAccessFlags2 kStorageRead = VK_ACCESS_2_SHADER_STORAGE_READ_BIT;
+
+}  // namespace
+
+struct Bloom::Impl {
+  const Context* context;
+  BloomConfig config;
+  detail::Workgroup2D workgroup;
+
+  // Pipelines for the current shape (filter, precision); composite and copy per output format.
+  detail::ComputePipeline prefilter_down, down, blur, up;
+  detail::ComputePipeline composite[2], copy[2];  // [0] rgba16f, [1] rgba32f
+
+  // Pyramid for the current extent.
+  VkExtent2D extent{0, 0};
+  std::vector<LevelSize> chain;
+  bool was_clamped = false;
+  std::vector<detail::OwnedImage> levels;
+  std::vector<detail::OwnedImage> temps;  // gauss9 horizontal pass, one per level
+  detail::DescriptorArena internal_sets;
+  std::vector<VkDescriptorSet> down_sets, blur_h_sets, blur_v_sets, up_sets;
+
+  // Descriptor sets that name caller images, made once per (input view, output view).
+  struct CallerSets {
+    VkDescriptorSet prefilter = VK_NULL_HANDLE;
+    VkDescriptorSet composite = VK_NULL_HANDLE;
+    VkDescriptorSet copy = VK_NULL_HANDLE;
+  };
+  std::map<std::pair<VkImageView, VkImageView>, CallerSets> caller_sets;
+  std::vector<detail::DescriptorArena> caller_arenas;
+  uint32_t caller_sets_left = 0;
+
+  VkFormat level_format() const {
+    return config.precision == Precision::fp32 ? VK_FORMAT_R32G32B32A32_SFLOAT : VK_FORMAT_R16G16B16A16_SFLOAT;
+  }
+
+  detail::PipelineDesc desc(const std::string& kernel, std::vector<VkDescriptorType> bindings) const {
+    detail::PipelineDesc d;
+    d.kernel_id = kernel;
+    d.bindings = std::move(bindings);
+    d.push_constant_bytes = sizeof(BloomPush);
+    d.workgroup = workgroup;
+    d.specialization = {static_cast<uint32_t>(config.filter)};
+    return d;
+  }
+
+  void make_pipelines() {
+    const std::string lv = format_variant(level_format());
+    const auto S = VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE;
+    const auto W = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
+    prefilter_down = detail::ComputePipeline(*context, desc("bloom_prefilter_down_" + lv, {S, W}));
+    down = detail::ComputePipeline(*context, desc("bloom_down_" + lv, {S, W}));
+    blur = config.filter == BloomFilter::gauss9 ? detail::ComputePipeline(*context, desc("bloom_blur_" + lv, {S, W}))
+                                                : detail::ComputePipeline();
+    up = detail::ComputePipeline(*context, desc("bloom_up_" + lv, {S, W}));
+    const char* out_variants[2] = {"rgba16f", "rgba32f"};
+    for (int i = 0; i < 2; ++i) {
+      composite[i] = detail::ComputePipeline(*context, desc(std::string("bloom_composite_") + out_variants[i], {S, S, W}));
+      copy[i] = detail::ComputePipeline(*context, desc(std::string("image_copy_") + out_variants[i], {S, W}));
+    }
+  }
+
+  void release_pyramid() {
+    caller_sets.clear();
+    caller_arenas.clear();
+    caller_sets_left = 0;
+    down_sets.clear();
+    blur_h_sets.clear();
+    blur_v_sets.clear();
+    up_sets.clear();
+    internal_sets.reset();
+    levels.clear();
+    temps.clear();
+    extent = {0, 0};
+  }
+
+  void make_pyramid(VkExtent2D size) {
+    release_pyramid();
+    chain = bloom_mip_chain(size, config.iterations);
+    was_clamped = chain.size() < config.iterations;
+    const VkImageUsageFlags usage = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT;
+    const bool gauss = config.filter == BloomFilter::gauss9;
+    for (const LevelSize& l : chain) {
+      levels.emplace_back(*context, VkExtent2D{l.width, l.height}, level_format(), usage);
+      if (gauss) temps.emplace_back(*context, VkExtent2D{l.width, l.height}, level_format(), usage);
+    }
+    const uint32_t n = static_cast<uint32_t>(chain.size());
+    internal_sets = detail::DescriptorArena(*context, 4 * n + 1);
+    const VkImageLayout G = VK_IMAGE_LAYOUT_GENERAL;  // pyramid images stay in GENERAL
+    for (uint32_t k = 1; k < n; ++k) {
+      down_sets.push_back(internal_sets.make_set(down, {{levels[k - 1].state.view, G}, {levels[k].state.view, G}}));
+    }
+    for (uint32_t k = 0; gauss && k < n; ++k) {
+      blur_h_sets.push_back(internal_sets.make_set(blur, {{levels[k].state.view, G}, {temps[k].state.view, G}}));
+      blur_v_sets.push_back(internal_sets.make_set(blur, {{temps[k].state.view, G}, {levels[k].state.view, G}}));
+    }
+    for (uint32_t k = 0; k + 1 < n; ++k) {
+      up_sets.push_back(internal_sets.make_set(up, {{levels[k + 1].state.view, G}, {levels[k].state.view, G}}));
+    }
+    extent = size;
+  }
+
+  const CallerSets& sets_for(const Image& in, const Image& out) {
+    auto key = std::make_pair(in.view, out.view);
+    auto it = caller_sets.find(key);
+    if (it != caller_sets.end()) return it->second;
+    if (caller_sets_left < 3) {
+      caller_arenas.emplace_back(*context, 24);
+      caller_sets_left = 24;
+    }
+    caller_sets_left -= 3;
+    auto& arena = caller_arenas.back();
+    const bool in_place = in.image == out.image;
+    const VkImageLayout in_layout = in_place ? VK_IMAGE_LAYOUT_GENERAL : VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+    const VkImageLayout G = VK_IMAGE_LAYOUT_GENERAL;
+    const int o = out.format == VK_FORMAT_R32G32B32A32_SFLOAT ? 1 : 0;
+    CallerSets s;
+    s.prefilter = arena.make_set(prefilter_down, {{in.view, in_layout}, {levels[0].state.view, G}});
+    s.composite = arena.make_set(composite[o], {{in.view, in_layout}, {levels[0].state.view, G}, {out.view, G}});
+    s.copy = arena.make_set(copy[o], {{in.view, in_layout}, {out.view, G}});
+    return caller_sets.emplace(key, s).first->second;
+  }
+
+  BloomPush push(LevelSize src, LevelSize dst, uint32_t flags = 0) const {
+    BloomPush p{};
+    p.src_width = static_cast<int32_t>(src.width);
+    p.src_height = static_cast<int32_t>(src.height);
+    p.dst_width = static_cast<int32_t>(dst.width);
+    p.dst_height = static_cast<int32_t>(dst.height);
+    p.threshold = config.threshold;
+    p.knee = config.threshold * config.soft_knee;
+    p.max_brightness = config.max_brightness;
+    p.radius = config.radius;
+    p.composite_scale = config.intensity / static_cast<float>(chain.size());
+    p.flags = flags;
+    return p;
+  }
+
+  void check_images(const Image& in, const Image& out) const {
+    const uint32_t max_dim = context->info().max_image_dimension_2d;
+    auto check_one = [&](const Image& img, const char* role, VkImageUsageFlags need, const char* need_name) {
+      if (!img.image || !img.view) {
+        throw Error(ErrorCode::invalid_argument, concat("Bloom::record: ", role, " image and view must be non-null"));
+      }
+      if (!is_float_rgba(img.format)) {
+        throw Error(ErrorCode::unsupported_format,
+                    concat("Bloom::record: ", role, " format is ", detail::format_name(img.format),
+                           "; accepted VK_FORMAT_R16G16B16A16_SFLOAT or VK_FORMAT_R32G32B32A32_SFLOAT"));
+      }
+      if (img.extent.width == 0 || img.extent.height == 0 || img.extent.width > max_dim || img.extent.height > max_dim) {
+        throw Error(ErrorCode::unsupported_size, concat("Bloom::record: ", role, " extent ", img.extent.width, "x",
+                                                        img.extent.height, " is out of range: accepted 1 to ", max_dim,
+                                                        " on each side"));
+      }
+      if ((img.usage & need) != need) {
+        throw Error(ErrorCode::missing_usage, concat("Bloom::record: ", role, " image lacks ", need_name, " usage"));
+      }
+    };
+    const bool in_place = in.image == out.image;
+    check_one(in, "input", VK_IMAGE_USAGE_SAMPLED_BIT, "VK_IMAGE_USAGE_SAMPLED_BIT");
+    check_one(out, "output", VK_IMAGE_USAGE_STORAGE_BIT, "VK_IMAGE_USAGE_STORAGE_BIT");
+    if (in.extent.width != out.extent.width || in.extent.height != out.extent.height) {
+      throw Error(ErrorCode::invalid_argument, concat("Bloom::record: output extent ", out.extent.width, "x",
+                                                      out.extent.height, " differs from input extent ",
+                                                      in.extent.width, "x", in.extent.height));
+    }
+    if (in_place && in.format != out.format) {
+      throw Error(ErrorCode::invalid_argument, "Bloom::record: in-place input and output must have the same format");
+    }
+  }
+
+  void record(VkCommandBuffer cmd, Image& input, Image& output, Profiler* profiler);
+};
+
+void Bloom::Impl::record(VkCommandBuffer cmd, Image& input, Image& output, Profiler* profiler) {
+  check_images(input, output);
+  const bool in_place = input.image == output.image;
+  if (config.intensity == 0.0f) {
+    // Nothing to add: the output is the input. In place that is no work at all.
+    if (in_place) return;
+    if (input.extent.width != extent.width || input.extent.height != extent.height) make_pyramid(input.extent);
+    const CallerSets& s = sets_for(input, output);
+    detail::Barriers b;
+    b.use(input, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, kSampled);
+    b.use(output, VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, kStorageWrite);
+    b.flush(cmd);
+    const LevelSize full{input.extent.width, input.extent.height};
+    copy[output.format == VK_FORMAT_R32G32B32A32_SFLOAT].dispatch(cmd, s.copy, push(full, full), full.width, full.height);
+    if (profiler) profiler->mark(cmd, "bloom copy (intensity 0)");
+    return;
+  }
+  if (input.extent.width != extent.width || input.extent.height != extent.height) make_pyramid(input.extent);
+  const CallerSets& sets = sets_for(input, output);
+
+  // In place, one state tracks the one image; it is copied back to `input` at the end.
+  Image& scene = in_place ? output : input;
+  const VkImageLayout scene_layout = in_place ? VK_IMAGE_LAYOUT_GENERAL : VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+  const uint32_t n = static_cast<uint32_t>(chain.size());
+  const LevelSize full{input.extent.width, input.extent.height};
+  const VkImageLayout G = VK_IMAGE_LAYOUT_GENERAL;
+  const bool gauss = config.filter == BloomFilter::gauss9;
+  detail::Barriers b;
+
+  auto blur_level = [&](uint32_t k) {
+    b.use(levels[k].state, G, kCompute, kSampled);
+    b.use(temps[k].state, G, kCompute, kStorageWrite);
+    b.flush(cmd);
+    blur.dispatch(cmd, blur_h_sets[k], push(chain[k], chain[k]), chain[k].width, chain[k].height);
+    b.use(temps[k].state, G, kCompute, kSampled);
+    b.use(levels[k].state, G, kCompute, kStorageWrite);
+    b.flush(cmd);
+    blur.dispatch(cmd, blur_v_sets[k], push(chain[k], chain[k], GLINT_BLOOM_FLAG_VERTICAL), chain[k].width,
+                  chain[k].height);
+  };
+
+  // 1. Bright-pass fused into the first downsample.
+  b.use(scene, scene_layout, kCompute, kSampled);
+  b.use(levels[0].state, G, kCompute, kStorageWrite);
+  b.flush(cmd);
+  prefilter_down.dispatch(cmd, sets.prefilter, push(full, chain[0], config.firefly_guard ? GLINT_BLOOM_FLAG_KARIS : 0u),
+                          chain[0].width, chain[0].height);
+  if (gauss) blur_level(0);
+  if (profiler) profiler->mark(cmd, "bloom bright-pass + down 0");
+
+  // 2. Progressive downsample.
+  for (uint32_t k = 1; k < n; ++k) {
+    b.use(levels[k - 1].state, G, kCompute, kSampled);
+    b.use(levels[k].state, G, kCompute, kStorageWrite);
+    b.flush(cmd);
+    down.dispatch(cmd, down_sets[k - 1], push(chain[k - 1], chain[k]), chain[k].width, chain[k].height);
+    if (gauss) blur_level(k);
+  }
+  if (profiler && n > 1) profiler->mark(cmd, "bloom downsample");
+
+  // 3. Upsample with accumulation by gather, smallest level first.
+  for (uint32_t k = n - 1; k-- > 0;) {
+    b.use(levels[k + 1].state, G, kCompute, kSampled);
+    b.use(levels[k].state, G, kCompute, kStorageRead | kStorageWrite);
+    b.flush(cmd);
+    up.dispatch(cmd, up_sets[k], push(chain[k + 1], chain[k]), chain[k].width, chain[k].height);
+  }
+  if (profiler && n > 1) profiler->mark(cmd, "bloom upsample");
+
+  // 4. Last upsample fused with the composite.
+  b.use(levels[0].state, G, kCompute, kSampled);
+  b.use(scene, scene_layout, kCompute, kSampled);
+  b.use(output, G, kCompute, in_place ? (kSampled | kStorageWrite) : kStorageWrite);
+  b.flush(cmd);
+  composite[output.format == VK_FORMAT_R32G32B32A32_SFLOAT].dispatch(cmd, sets.composite, push(chain[0], full),
+                                                                      full.width, full.height);
+  if (profiler) profiler->mark(cmd, "bloom composite");
+  if (in_place) input = output;
+}
+
+Bloom::Bloom(const Context& context, const BloomConfig& config) : impl_(std::make_unique<Impl>()) {
+  config.validate();
+  impl_->context = &context;
+  impl_->config = config;
+  impl_->workgroup = detail::choose_workgroup_2d(context.info());
+  impl_->make_pipelines();
+}
+
+Bloom::Bloom(Bloom&&) noexcept = default;
+Bloom& Bloom::operator=(Bloom&&) noexcept = default;
+Bloom::~Bloom() = default;
+
+void Bloom::set_config(const BloomConfig& config) {
+  config.validate();
+  const BloomConfig old = impl_->config;
+  impl_->config = config;
+  const bool shape_changed = old.iterations != config.iterations || old.filter != config.filter ||
+                             old.precision != config.precision;
+  if (!shape_changed) return;
+  const VkExtent2D size = impl_->extent;
+  impl_->release_pyramid();
+  if (old.filter != config.filter || old.precision != config.precision) impl_->make_pipelines();
+  if (size.width) impl_->make_pyramid(size);
+}
+
+const BloomConfig& Bloom::config() const { return impl_->config; }
+
+void Bloom::prepare(VkExtent2D extent) {
+  const uint32_t max_dim = impl_->context->info().max_image_dimension_2d;
+  if (extent.width == 0 || extent.height == 0 || extent.width > max_dim || extent.height > max_dim) {
+    throw Error(ErrorCode::unsupported_size, concat("Bloom::prepare: extent ", extent.width, "x", extent.height,
+                                                    " is out of range: accepted 1 to ", max_dim, " on each side"));
+  }
+  if (extent.width != impl_->extent.width || extent.height != impl_->extent.height) impl_->make_pyramid(extent);
+}
+
+void Bloom::record(VkCommandBuffer cmd, Image& input, Image& output, Profiler* profiler) {
+  impl_->record(cmd, input, output, profiler);
+}
+
+uint32_t Bloom::levels() const { return static_cast<uint32_t>(impl_->chain.size()); }
+bool Bloom::clamped() const { return impl_->was_clamped; }
+std::vector<LevelSize> Bloom::level_sizes() const { return impl_->chain; }
+
+uint64_t Bloom::min_bytes_moved(VkFormat input_format, VkFormat output_format) const {
+  const uint64_t pixels = uint64_t(impl_->extent.width) * impl_->extent.height;
+  const uint64_t in_bytes = input_format == VK_FORMAT_R32G32B32A32_SFLOAT ? 16 : 8;
+  const uint64_t out_bytes = output_format == VK_FORMAT_R32G32B32A32_SFLOAT ? 16 : 8;
+  const uint64_t level_bytes = impl_->config.precision == Precision::fp32 ? 16 : 8;
+  uint64_t total = pixels * (in_bytes + out_bytes);
+  for (const LevelSize& l : impl_->chain) total += 2 * uint64_t(l.width) * l.height * level_bytes;
+  return total;
+}
+
+}  // namespace glint

@@ -1,0 +1,51 @@
+#include "core/barriers.h"
+
+namespace glint::detail {
+
+void Barriers::use(Image& image, VkImageLayout layout, VkPipelineStageFlags2 stage, VkAccessFlags2 access) {
+  const bool was_write = (image.access & kWriteAccess) != 0;
+  const bool is_write = (access & kWriteAccess) != 0;
+  if (!was_write && !is_write && image.layout == layout && image.layout != VK_IMAGE_LAYOUT_UNDEFINED) {
+    image.stage |= stage;
+    image.access |= access;
+    return;
+  }
+  VkImageMemoryBarrier2 b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
+  b.srcStageMask = image.stage;
+  b.srcAccessMask = image.access & kWriteAccess;  // only writes need to be made available
+  b.dstStageMask = stage;
+  b.dstAccessMask = access;
+  b.oldLayout = image.layout;
+  b.newLayout = layout;
+  b.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+  b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+  b.image = image.image;
+  b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+  // The same image twice in one batch (in-place use) merges into one barrier.
+  for (auto& p : pending_) {
+    if (p.image == image.image) {
+      p.dstStageMask |= stage;
+      p.dstAccessMask |= access;
+      p.newLayout = layout;
+      image.layout = layout;
+      image.stage = p.dstStageMask;
+      image.access = p.dstAccessMask;
+      return;
+    }
+  }
+  pending_.push_back(b);
+  image.layout = layout;
+  image.stage = stage;
+  image.access = access;
+}
+
+void Barriers::flush(VkCommandBuffer cmd) {
+  if (pending_.empty()) return;
+  VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+  dep.imageMemoryBarrierCount = static_cast<uint32_t>(pending_.size());
+  dep.pImageMemoryBarriers = pending_.data();
+  vkCmdPipelineBarrier2(cmd, &dep);
+  pending_.clear();
+}
+
+}  // namespace glint::detail

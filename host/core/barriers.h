@@ -1,0 +1,28 @@
+// The one place that writes barriers. Each image carries its last use (glint::Image's layout,
+// stage, access); use() queues the transition to the next use and flush() records them together.
+#pragma once
+
+#include <glint/glint.h>
+
+#include <vector>
+
+namespace glint::detail {
+
+class Barriers {
+ public:
+  /// Declares that `image` is next used with (layout, stage, access). Read-after-read in the same
+  /// layout needs no barrier and only widens the tracked use; anything else queues one.
+  void use(Image& image, VkImageLayout layout, VkPipelineStageFlags2 stage, VkAccessFlags2 access);
+  /// Records every queued barrier in one vkCmdPipelineBarrier2 (nothing if none are queued).
+  void flush(VkCommandBuffer cmd);
+
+ private:
+  std::vector<VkImageMemoryBarrier2> pending_;
+};
+
+inline constexpr VkAccessFlags2 kWriteAccess =
+    VK_ACCESS_2_SHADER_WRITE_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT | VK_ACCESS_2_TRANSFER_WRITE_BIT |
+    VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT |
+    VK_ACCESS_2_HOST_WRITE_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT;
+
+}  // namespace glint::detail

@@ -1,0 +1,474 @@
+// Context: standalone (own instance and device) or adopted (the engine's), device selection,
+// validation messages, run_once for tools, and the timestamp profiler.
+#include "core/check.h"
+#include "core/context_state.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+
+namespace glint {
+namespace detail {
+
+const char* vk_result_name(VkResult r) {
+  switch (r) {
+    case VK_SUCCESS: return "VK_SUCCESS";
+    case VK_ERROR_OUT_OF_HOST_MEMORY: return "VK_ERROR_OUT_OF_HOST_MEMORY";
+    case VK_ERROR_OUT_OF_DEVICE_MEMORY: return "VK_ERROR_OUT_OF_DEVICE_MEMORY";
+    case VK_ERROR_INITIALIZATION_FAILED: return "VK_ERROR_INITIALIZATION_FAILED";
+    case VK_ERROR_DEVICE_LOST: return "VK_ERROR_DEVICE_LOST";
+    case VK_ERROR_LAYER_NOT_PRESENT: return "VK_ERROR_LAYER_NOT_PRESENT";
+    case VK_ERROR_EXTENSION_NOT_PRESENT: return "VK_ERROR_EXTENSION_NOT_PRESENT";
+    case VK_ERROR_FEATURE_NOT_PRESENT: return "VK_ERROR_FEATURE_NOT_PRESENT";
+    case VK_ERROR_INCOMPATIBLE_DRIVER: return "VK_ERROR_INCOMPATIBLE_DRIVER";
+    case VK_ERROR_FORMAT_NOT_SUPPORTED: return "VK_ERROR_FORMAT_NOT_SUPPORTED";
+    case VK_ERROR_OUT_OF_POOL_MEMORY: return "VK_ERROR_OUT_OF_POOL_MEMORY";
+    default: return "VkResult error";
+  }
+}
+
+const char* format_name(VkFormat f) {
+  switch (f) {
+    case VK_FORMAT_R16G16B16A16_SFLOAT: return "VK_FORMAT_R16G16B16A16_SFLOAT";
+    case VK_FORMAT_R32G32B32A32_SFLOAT: return "VK_FORMAT_R32G32B32A32_SFLOAT";
+    case VK_FORMAT_R8G8B8A8_UNORM: return "VK_FORMAT_R8G8B8A8_UNORM";
+    case VK_FORMAT_D32_SFLOAT: return "VK_FORMAT_D32_SFLOAT";
+    case VK_FORMAT_R32_SFLOAT: return "VK_FORMAT_R32_SFLOAT";
+    case VK_FORMAT_UNDEFINED: return "VK_FORMAT_UNDEFINED";
+    default: return "an unsupported VkFormat";
+  }
+}
+
+uint32_t ContextState::memory_type(uint32_t type_bits, VkMemoryPropertyFlags flags) const {
+  for (uint32_t i = 0; i < memory.memoryTypeCount; ++i) {
+    if ((type_bits & (1u << i)) && (memory.memoryTypes[i].propertyFlags & flags) == flags) return i;
+  }
+  throw Error(ErrorCode::vulkan_failure, concat("no memory type with flags 0x", std::hex, flags));
+}
+
+namespace {
+
+VKAPI_ATTR VkBool32 VKAPI_CALL on_validation_message(
+    VkDebugUtilsMessageSeverityFlagBitsEXT severity, VkDebugUtilsMessageTypeFlagsEXT,
+    const VkDebugUtilsMessengerCallbackDataEXT* data, void* user) {
+  auto* state = static_cast<ContextState*>(user);
+  if (severity < VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT) return VK_FALSE;
+  std::string text = data && data->pMessage ? data->pMessage : "(no message)";
+  {
+    std::lock_guard<std::mutex> lock(state->log_mutex);
+    state->validation_log.push_back(text);
+  }
+  state->validation_count++;
+  std::fprintf(stderr, "glint: validation: %s\n", text.c_str());
+  return VK_FALSE;
+}
+
+bool env_flag(const char* name) {
+  const char* v = std::getenv(name);
+  return v && std::strcmp(v, "0") != 0 && *v != '\0';
+}
+
+bool layer_available(const char* name) {
+  uint32_t n = 0;
+  vkEnumerateInstanceLayerProperties(&n, nullptr);
+  std::vector<VkLayerProperties> layers(n);
+  vkEnumerateInstanceLayerProperties(&n, layers.data());
+  for (const auto& l : layers) {
+    if (std::strcmp(l.layerName, name) == 0) return true;
+  }
+  return false;
+}
+
+std::string lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
+  return s;
+}
+
+VkInstance make_instance(bool validation, ContextState* state, VkDebugUtilsMessengerEXT* messenger) {
+  VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
+  app.pApplicationName = "glint";
+  app.pEngineName = "glint";
+  app.apiVersion = VK_API_VERSION_1_3;
+
+  std::vector<const char*> layers;
+  std::vector<const char*> extensions;
+  const char* kValidation = "VK_LAYER_KHRONOS_validation";
+  if (validation) {
+    if (!layer_available(kValidation)) {
+      throw Error(ErrorCode::no_device,
+                  "validation requested (GLINT_VALIDATION=1 or ContextOptions::validation) but "
+                  "VK_LAYER_KHRONOS_validation is not installed (Debian: vulkan-validationlayers)");
+    }
+    layers.push_back(kValidation);
+    extensions.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
+  }
+  // Synchronization validation on; best practices off (it warns about choices, not errors).
+  VkValidationFeatureEnableEXT enables[] = {VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT};
+  VkValidationFeaturesEXT features{VK_STRUCTURE_TYPE_VALIDATION_FEATURES_EXT};
+  features.enabledValidationFeatureCount = 1;
+  features.pEnabledValidationFeatures = enables;
+
+  VkDebugUtilsMessengerCreateInfoEXT messenger_info{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
+  messenger_info.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT |
+                                   VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
+  messenger_info.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT |
+                               VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
+                               VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
+  messenger_info.pfnUserCallback = on_validation_message;
+  messenger_info.pUserData = state;
+  if (validation) features.pNext = &messenger_info;
+
+  VkInstanceCreateInfo info{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
+  info.pNext = validation ? &features : nullptr;
+  info.pApplicationInfo = &app;
+  info.enabledLayerCount = static_cast<uint32_t>(layers.size());
+  info.ppEnabledLayerNames = layers.data();
+  info.enabledExtensionCount = static_cast<uint32_t>(extensions.size());
+  info.ppEnabledExtensionNames = extensions.data();
+  VkInstance instance = VK_NULL_HANDLE;
+  vk_check(vkCreateInstance(&info, nullptr, &instance), "vkCreateInstance");
+  if (validation && messenger) {
+    auto create = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
+        vkGetInstanceProcAddr(instance, "vkCreateDebugUtilsMessengerEXT"));
+    if (create) vk_check(create(instance, &messenger_info, nullptr, messenger), "vkCreateDebugUtilsMessengerEXT");
+  }
+  return instance;
+}
+
+std::vector<VkPhysicalDevice> physical_devices(VkInstance instance) {
+  uint32_t n = 0;
+  vk_check(vkEnumeratePhysicalDevices(instance, &n, nullptr), "vkEnumeratePhysicalDevices");
+  std::vector<VkPhysicalDevice> devices(n);
+  vk_check(vkEnumeratePhysicalDevices(instance, &n, devices.data()), "vkEnumeratePhysicalDevices");
+  return devices;
+}
+
+int type_rank(VkPhysicalDeviceType t) {
+  switch (t) {
+    case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU: return 0;
+    case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU: return 1;
+    case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU: return 2;
+    case VK_PHYSICAL_DEVICE_TYPE_CPU: return 3;
+    default: return 4;
+  }
+}
+
+VkPhysicalDevice choose_device(VkInstance instance, std::string wanted) {
+  auto devices = physical_devices(instance);
+  if (devices.empty()) throw Error(ErrorCode::no_device, "no Vulkan device found (Debian: mesa-vulkan-drivers gives lavapipe)");
+  if (wanted.empty()) {
+    if (const char* env = std::getenv("GLINT_DEVICE")) wanted = env;
+  }
+  std::vector<VkPhysicalDeviceProperties> props(devices.size());
+  for (size_t i = 0; i < devices.size(); ++i) vkGetPhysicalDeviceProperties(devices[i], &props[i]);
+  if (!wanted.empty()) {
+    bool numeric = std::all_of(wanted.begin(), wanted.end(), [](unsigned char c) { return std::isdigit(c); });
+    if (numeric) {
+      unsigned long idx = std::strtoul(wanted.c_str(), nullptr, 10);
+      if (idx >= devices.size()) {
+        throw Error(ErrorCode::no_device, concat("device index ", wanted, " is out of range: accepted 0 to ", devices.size() - 1));
+      }
+      return devices[idx];
+    }
+    for (size_t i = 0; i < devices.size(); ++i) {
+      if (lower(props[i].deviceName).find(lower(wanted)) != std::string::npos) return devices[i];
+    }
+    std::string names;
+    for (auto& p : props) names += concat(names.empty() ? "" : ", ", "'", p.deviceName, "'");
+    throw Error(ErrorCode::no_device, concat("no Vulkan device matches '", wanted, "'; devices: ", names));
+  }
+  size_t best = 0;
+  for (size_t i = 1; i < devices.size(); ++i) {
+    if (type_rank(props[i].deviceType) < type_rank(props[best].deviceType)) best = i;
+  }
+  return devices[best];
+}
+
+uint32_t compute_queue_family(VkPhysicalDevice pd) {
+  uint32_t n = 0;
+  vkGetPhysicalDeviceQueueFamilyProperties(pd, &n, nullptr);
+  std::vector<VkQueueFamilyProperties> families(n);
+  vkGetPhysicalDeviceQueueFamilyProperties(pd, &n, families.data());
+  // Prefer graphics+compute: effects that draw (flares) need graphics; bloom needs compute.
+  for (uint32_t i = 0; i < n; ++i) {
+    if ((families[i].queueFlags & VK_QUEUE_GRAPHICS_BIT) && (families[i].queueFlags & VK_QUEUE_COMPUTE_BIT)) return i;
+  }
+  for (uint32_t i = 0; i < n; ++i) {
+    if (families[i].queueFlags & VK_QUEUE_COMPUTE_BIT) return i;
+  }
+  throw Error(ErrorCode::no_device, "the device has no queue family with compute");
+}
+
+void fill_info(ContextState& s) {
+  VkPhysicalDeviceSubgroupProperties subgroup{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES};
+  VkPhysicalDeviceProperties2 props{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
+  props.pNext = &subgroup;
+  vkGetPhysicalDeviceProperties2(s.physical_device, &props);
+  const auto& p = props.properties;
+  s.info.name = p.deviceName;
+  s.info.type = p.deviceType;
+  s.info.subgroup_size = subgroup.subgroupSize;
+  s.info.max_shared_memory_bytes = p.limits.maxComputeSharedMemorySize;
+  s.info.max_workgroup_invocations = p.limits.maxComputeWorkGroupInvocations;
+  s.info.max_image_dimension_2d = p.limits.maxImageDimension2D;
+  s.info.timestamp_period_ns = p.limits.timestampPeriod;
+  uint32_t n = 0;
+  vkGetPhysicalDeviceQueueFamilyProperties(s.physical_device, &n, nullptr);
+  std::vector<VkQueueFamilyProperties> families(n);
+  vkGetPhysicalDeviceQueueFamilyProperties(s.physical_device, &n, families.data());
+  s.info.timestamps_supported = s.queue_family < n && families[s.queue_family].timestampValidBits > 0;
+  vkGetPhysicalDeviceMemoryProperties(s.physical_device, &s.memory);
+}
+
+}  // namespace
+}  // namespace detail
+
+using detail::concat;
+using detail::vk_check;
+
+Context::Context(std::unique_ptr<detail::ContextState> state) : state_(std::move(state)) {}
+Context::Context(Context&&) noexcept = default;
+Context& Context::operator=(Context&&) noexcept = default;
+
+Context::~Context() {
+  if (!state_) return;
+  auto& s = *state_;
+  s.cache.clear();  // helper objects first: they hold handles of the device
+  if (s.adopted) return;
+  if (s.device) {
+    vkDeviceWaitIdle(s.device);
+    if (s.fence) vkDestroyFence(s.device, s.fence, nullptr);
+    if (s.command_pool) vkDestroyCommandPool(s.device, s.command_pool, nullptr);
+    vkDestroyDevice(s.device, nullptr);
+  }
+  if (s.messenger) {
+    auto destroy = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
+        vkGetInstanceProcAddr(s.instance, "vkDestroyDebugUtilsMessengerEXT"));
+    if (destroy) destroy(s.instance, s.messenger, nullptr);
+  }
+  if (s.instance) vkDestroyInstance(s.instance, nullptr);
+}
+
+Context Context::create(const ContextOptions& options) {
+  auto state = std::make_unique<detail::ContextState>();
+  auto& s = *state;
+  // The context is returned only when complete; a throw below must not leak what was made.
+  struct Guard {
+    detail::ContextState* s;
+    bool done = false;
+    ~Guard() {
+      if (done) return;
+      if (s->device) vkDestroyDevice(s->device, nullptr);
+      if (s->messenger) {
+        auto destroy = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
+            vkGetInstanceProcAddr(s->instance, "vkDestroyDebugUtilsMessengerEXT"));
+        if (destroy) destroy(s->instance, s->messenger, nullptr);
+      }
+      if (s->instance) vkDestroyInstance(s->instance, nullptr);
+    }
+  } guard{&s};
+
+  const bool validation = options.validation || detail::env_flag("GLINT_VALIDATION");
+  s.instance = detail::make_instance(validation, &s, &s.messenger);
+  s.physical_device = detail::choose_device(s.instance, options.device);
+  s.queue_family = detail::compute_queue_family(s.physical_device);
+
+  VkPhysicalDeviceProperties props;
+  vkGetPhysicalDeviceProperties(s.physical_device, &props);
+  if (props.apiVersion < VK_API_VERSION_1_3) {
+    throw Error(ErrorCode::no_device, concat("device '", props.deviceName, "' supports Vulkan ",
+                                             VK_API_VERSION_MAJOR(props.apiVersion), ".",
+                                             VK_API_VERSION_MINOR(props.apiVersion), "; glint needs 1.3"));
+  }
+
+  VkPhysicalDeviceVulkan13Features f13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
+  VkPhysicalDeviceVulkan12Features f12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
+  f12.pNext = &f13;
+  VkPhysicalDeviceFeatures2 supported{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
+  supported.pNext = &f12;
+  vkGetPhysicalDeviceFeatures2(s.physical_device, &supported);
+  if (!f13.synchronization2) throw Error(ErrorCode::no_device, "device lacks synchronization2");
+
+  VkPhysicalDeviceVulkan13Features e13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
+  e13.synchronization2 = VK_TRUE;
+  e13.dynamicRendering = f13.dynamicRendering;
+  e13.subgroupSizeControl = f13.subgroupSizeControl;
+  e13.computeFullSubgroups = f13.computeFullSubgroups;
+  e13.maintenance4 = f13.maintenance4;
+  VkPhysicalDeviceVulkan12Features e12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
+  e12.pNext = &e13;
+  e12.hostQueryReset = f12.hostQueryReset;
+  e12.timelineSemaphore = f12.timelineSemaphore;
+  e12.shaderFloat16 = f12.shaderFloat16;
+  VkPhysicalDeviceFeatures2 enabled{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
+  enabled.pNext = &e12;
+  enabled.features.shaderStorageImageWriteWithoutFormat = supported.features.shaderStorageImageWriteWithoutFormat;
+  enabled.features.samplerAnisotropy = supported.features.samplerAnisotropy;
+
+  float priority = 1.0f;
+  VkDeviceQueueCreateInfo queue{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
+  queue.queueFamilyIndex = s.queue_family;
+  queue.queueCount = 1;
+  queue.pQueuePriorities = &priority;
+  VkDeviceCreateInfo info{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
+  info.pNext = &enabled;
+  info.queueCreateInfoCount = 1;
+  info.pQueueCreateInfos = &queue;
+  vk_check(vkCreateDevice(s.physical_device, &info, nullptr, &s.device), "vkCreateDevice");
+  vkGetDeviceQueue(s.device, s.queue_family, 0, &s.queue);
+
+  VkCommandPoolCreateInfo pool{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+  pool.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
+  pool.queueFamilyIndex = s.queue_family;
+  vk_check(vkCreateCommandPool(s.device, &pool, nullptr, &s.command_pool), "vkCreateCommandPool");
+  VkFenceCreateInfo fence{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+  vk_check(vkCreateFence(s.device, &fence, nullptr, &s.fence), "vkCreateFence");
+  detail::fill_info(s);
+  guard.done = true;
+  return Context(std::move(state));
+}
+
+Context Context::adopt(const AdoptInfo& a) {
+  if (!a.instance || !a.physical_device || !a.device) {
+    throw Error(ErrorCode::invalid_argument,
+                concat("AdoptInfo: instance, physical_device and device must all be non-null (got ",
+                       a.instance ? "instance" : "null instance", ", ",
+                       a.physical_device ? "physical_device" : "null physical_device", ", ",
+                       a.device ? "device" : "null device", ")"));
+  }
+  uint32_t n = 0;
+  vkGetPhysicalDeviceQueueFamilyProperties(a.physical_device, &n, nullptr);
+  std::vector<VkQueueFamilyProperties> families(n);
+  vkGetPhysicalDeviceQueueFamilyProperties(a.physical_device, &n, families.data());
+  if (a.queue_family_index >= n) {
+    throw Error(ErrorCode::invalid_argument, concat("AdoptInfo::queue_family_index = ", a.queue_family_index,
+                                                    " is out of range: accepted 0 to ", n - 1));
+  }
+  if (!(families[a.queue_family_index].queueFlags & VK_QUEUE_COMPUTE_BIT)) {
+    throw Error(ErrorCode::invalid_argument, concat("AdoptInfo::queue_family_index = ", a.queue_family_index,
+                                                    " has no compute capability"));
+  }
+  auto state = std::make_unique<detail::ContextState>();
+  state->instance = a.instance;
+  state->physical_device = a.physical_device;
+  state->device = a.device;
+  state->queue_family = a.queue_family_index;
+  state->adopted = true;
+  detail::fill_info(*state);
+  return Context(std::move(state));
+}
+
+VkInstance Context::instance() const { return state_->instance; }
+VkPhysicalDevice Context::physical_device() const { return state_->physical_device; }
+VkDevice Context::device() const { return state_->device; }
+uint32_t Context::queue_family_index() const { return state_->queue_family; }
+const DeviceInfo& Context::info() const { return state_->info; }
+bool Context::is_adopted() const { return state_->adopted; }
+uint32_t Context::validation_messages() const { return state_->validation_count.load(); }
+std::vector<std::string> Context::validation_log() const {
+  std::lock_guard<std::mutex> lock(state_->log_mutex);
+  return state_->validation_log;
+}
+uint64_t Context::objects_created() const { return state_->objects_created.load(); }
+
+void Context::run_once(const std::function<void(VkCommandBuffer)>& record) const {
+  auto& s = *state_;
+  if (s.adopted) {
+    throw Error(ErrorCode::invalid_argument, "run_once() is for standalone contexts; an adopted context never submits");
+  }
+  VkCommandBufferAllocateInfo alloc{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+  alloc.commandPool = s.command_pool;
+  alloc.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+  alloc.commandBufferCount = 1;
+  VkCommandBuffer cmd = VK_NULL_HANDLE;
+  vk_check(vkAllocateCommandBuffers(s.device, &alloc, &cmd), "vkAllocateCommandBuffers");
+  struct Free {
+    const detail::ContextState& s;
+    VkCommandBuffer cmd;
+    ~Free() { vkFreeCommandBuffers(s.device, s.command_pool, 1, &cmd); }
+  } free_cmd{s, cmd};
+  VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+  begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+  vk_check(vkBeginCommandBuffer(cmd, &begin), "vkBeginCommandBuffer");
+  record(cmd);
+  vk_check(vkEndCommandBuffer(cmd), "vkEndCommandBuffer");
+  VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+  submit.commandBufferCount = 1;
+  submit.pCommandBuffers = &cmd;
+  vk_check(vkResetFences(s.device, 1, &s.fence), "vkResetFences");
+  vk_check(vkQueueSubmit(s.queue, 1, &submit, s.fence), "vkQueueSubmit");
+  vk_check(vkWaitForFences(s.device, 1, &s.fence, VK_TRUE, UINT64_MAX), "vkWaitForFences");
+}
+
+std::vector<DeviceDescription> list_devices() {
+  VkInstance instance = detail::make_instance(false, nullptr, nullptr);
+  std::vector<DeviceDescription> out;
+  try {
+    auto devices = detail::physical_devices(instance);
+    for (uint32_t i = 0; i < devices.size(); ++i) {
+      VkPhysicalDeviceProperties p;
+      vkGetPhysicalDeviceProperties(devices[i], &p);
+      out.push_back({i, p.deviceName, p.deviceType, p.apiVersion});
+    }
+  } catch (...) {
+    vkDestroyInstance(instance, nullptr);
+    throw;
+  }
+  vkDestroyInstance(instance, nullptr);
+  return out;
+}
+
+// ---- Profiler ---------------------------------------------------------------------------------
+
+Profiler::Profiler(const Context& context, uint32_t capacity) : context_(&context), capacity_(capacity) {
+  detail::check_range("Profiler capacity", capacity, 1, 4096);
+  if (!context.info().timestamps_supported) return;
+  VkQueryPoolCreateInfo info{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
+  info.queryType = VK_QUERY_TYPE_TIMESTAMP;
+  info.queryCount = capacity;
+  vk_check(vkCreateQueryPool(context.device(), &info, nullptr, &pool_), "vkCreateQueryPool");
+  context.state().count_object();
+}
+
+Profiler::~Profiler() {
+  if (pool_) vkDestroyQueryPool(context_->device(), pool_, nullptr);
+}
+
+void Profiler::reset(VkCommandBuffer cmd) {
+  labels_.clear();
+  if (pool_) vkCmdResetQueryPool(cmd, pool_, 0, capacity_);
+}
+
+void Profiler::mark(VkCommandBuffer cmd, const std::string& label) {
+  if (!pool_) return;
+  if (labels_.size() >= capacity_) {
+    throw Error(ErrorCode::invalid_argument, concat("Profiler: more than ", capacity_, " marks in one frame"));
+  }
+  vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, pool_, static_cast<uint32_t>(labels_.size()));
+  labels_.push_back(label);
+}
+
+std::vector<Profiler::Stage> Profiler::results() const {
+  std::vector<Stage> out;
+  if (!pool_ || labels_.size() < 2) return out;
+  std::vector<uint64_t> ticks(labels_.size());
+  vk_check(vkGetQueryPoolResults(context_->device(), pool_, 0, static_cast<uint32_t>(ticks.size()),
+                                 ticks.size() * sizeof(uint64_t), ticks.data(), sizeof(uint64_t),
+                                 VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),
+           "vkGetQueryPoolResults");
+  const double ns = context_->info().timestamp_period_ns;
+  for (size_t i = 1; i < ticks.size(); ++i) {
+    out.push_back({labels_[i], static_cast<double>(ticks[i] - ticks[i - 1]) * ns * 1e-6});
+  }
+  return out;
+}
+
+double Profiler::total_ms() const {
+  double total = 0.0;
+  for (const auto& s : results()) total += s.ms;
+  return total;
+}
+
+}  // namespace glint

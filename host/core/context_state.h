@@ -1,0 +1,53 @@
+// What a Context holds. Internal: effects and tools include it, users never need to.
+#pragma once
+
+#include <glint/glint.h>
+
+#include <atomic>
+#include <functional>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+namespace glint::detail {
+
+struct ContextState {
+  VkInstance instance = VK_NULL_HANDLE;
+  VkPhysicalDevice physical_device = VK_NULL_HANDLE;
+  VkDevice device = VK_NULL_HANDLE;
+  uint32_t queue_family = 0;
+  VkQueue queue = VK_NULL_HANDLE;  // standalone only
+  bool adopted = false;
+  DeviceInfo info;
+  VkPhysicalDeviceMemoryProperties memory{};
+
+  // Standalone helpers for run_once().
+  VkCommandPool command_pool = VK_NULL_HANDLE;
+  VkFence fence = VK_NULL_HANDLE;
+
+  VkDebugUtilsMessengerEXT messenger = VK_NULL_HANDLE;
+  mutable std::mutex log_mutex;
+  std::vector<std::string> validation_log;
+  std::atomic<uint32_t> validation_count{0};
+  std::atomic<uint64_t> objects_created{0};
+
+  /// Index of a memory type allowed by `type_bits` with all `flags`; throws if none.
+  uint32_t memory_type(uint32_t type_bits, VkMemoryPropertyFlags flags) const;
+  void count_object(uint64_t n = 1) { objects_created += n; }
+
+  /// Objects owned by the context for helpers without an owner of their own (the demo scene's
+  /// pipeline): made on first use, destroyed with the context, before the device.
+  template <typename T>
+  T& cached(const std::string& key, const std::function<std::shared_ptr<T>()>& make) {
+    std::lock_guard<std::mutex> lock(cache_mutex);
+    auto& slot = cache[key];
+    if (!slot) slot = make();
+    return *static_cast<T*>(slot.get());
+  }
+  std::mutex cache_mutex;
+  std::map<std::string, std::shared_ptr<void>> cache;
+};
+
+}  // namespace glint::detail

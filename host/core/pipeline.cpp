@@ -1,0 +1,174 @@
+#include "core/pipeline.h"
+
+#include "core/context_state.h"
+#include "core/kernel_table.h"
+
+#include <utility>
+
+namespace glint::detail {
+
+Workgroup2D choose_workgroup_2d(const DeviceInfo& info) {
+  // CPU devices (lavapipe) run a workgroup per thread with 8-wide SIMD: 8x8 keeps groups small
+  // enough to spread over cores. GPUs with 32/64-wide subgroups get 16x16 when allowed.
+  if (info.type != VK_PHYSICAL_DEVICE_TYPE_CPU && info.max_workgroup_invocations >= 256 && info.subgroup_size >= 32) {
+    return {16, 16};
+  }
+  return {8, 8};
+}
+
+ComputePipeline::ComputePipeline(const Context& context, const PipelineDesc& desc) {
+  device_ = context.device();
+  id_ = desc.kernel_id;
+  push_bytes_ = desc.push_constant_bytes;
+  workgroup_ = desc.workgroup;
+  bindings_ = desc.bindings;
+  auto& s = context.state();
+  const KernelBinary* bin = find_kernel(desc.kernel_id.c_str());
+  if (!bin) throw Error(ErrorCode::vulkan_failure, concat("kernel '", desc.kernel_id, "' is not embedded in this build"));
+
+  VkShaderModule module = VK_NULL_HANDLE;
+  try {
+    std::vector<VkDescriptorSetLayoutBinding> b(desc.bindings.size());
+    for (uint32_t i = 0; i < b.size(); ++i) {
+      b[i] = {i, desc.bindings[i], 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
+    }
+    VkDescriptorSetLayoutCreateInfo sl{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
+    sl.bindingCount = static_cast<uint32_t>(b.size());
+    sl.pBindings = b.data();
+    vk_check(vkCreateDescriptorSetLayout(device_, &sl, nullptr, &set_layout_), "vkCreateDescriptorSetLayout");
+    s.count_object();
+
+    VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, desc.push_constant_bytes};
+    VkPipelineLayoutCreateInfo pl{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+    pl.setLayoutCount = 1;
+    pl.pSetLayouts = &set_layout_;
+    pl.pushConstantRangeCount = desc.push_constant_bytes ? 1 : 0;
+    pl.pPushConstantRanges = &range;
+    vk_check(vkCreatePipelineLayout(device_, &pl, nullptr, &layout_), "vkCreatePipelineLayout");
+    s.count_object();
+
+    VkShaderModuleCreateInfo sm{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
+    sm.codeSize = bin->size_bytes;
+    sm.pCode = bin->code;
+    vk_check(vkCreateShaderModule(device_, &sm, nullptr, &module), "vkCreateShaderModule");
+
+    std::vector<uint32_t> values = {desc.workgroup.x, desc.workgroup.y};
+    values.insert(values.end(), desc.specialization.begin(), desc.specialization.end());
+    std::vector<VkSpecializationMapEntry> entries(values.size());
+    for (uint32_t i = 0; i < values.size(); ++i) entries[i] = {i, i * 4u, 4u};
+    VkSpecializationInfo spec{static_cast<uint32_t>(entries.size()), entries.data(), values.size() * 4, values.data()};
+
+    VkComputePipelineCreateInfo cp{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
+    cp.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
+    cp.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+    cp.stage.module = module;
+    cp.stage.pName = "main";
+    cp.stage.pSpecializationInfo = &spec;
+    cp.layout = layout_;
+    vk_check(vkCreateComputePipelines(device_, VK_NULL_HANDLE, 1, &cp, nullptr, &pipeline_), "vkCreateComputePipelines");
+    s.count_object();
+    vkDestroyShaderModule(device_, module, nullptr);
+  } catch (...) {
+    if (module) vkDestroyShaderModule(device_, module, nullptr);
+    reset();
+    throw;
+  }
+}
+
+ComputePipeline& ComputePipeline::operator=(ComputePipeline&& o) noexcept {
+  if (this != &o) {
+    reset();
+    device_ = std::exchange(o.device_, VK_NULL_HANDLE);
+    id_ = std::move(o.id_);
+    set_layout_ = std::exchange(o.set_layout_, VK_NULL_HANDLE);
+    layout_ = std::exchange(o.layout_, VK_NULL_HANDLE);
+    pipeline_ = std::exchange(o.pipeline_, VK_NULL_HANDLE);
+    push_bytes_ = o.push_bytes_;
+    workgroup_ = o.workgroup_;
+    bindings_ = std::move(o.bindings_);
+  }
+  return *this;
+}
+
+void ComputePipeline::reset() {
+  if (device_) {
+    if (pipeline_) vkDestroyPipeline(device_, pipeline_, nullptr);
+    if (layout_) vkDestroyPipelineLayout(device_, layout_, nullptr);
+    if (set_layout_) vkDestroyDescriptorSetLayout(device_, set_layout_, nullptr);
+  }
+  device_ = VK_NULL_HANDLE;
+  pipeline_ = VK_NULL_HANDLE;
+  layout_ = VK_NULL_HANDLE;
+  set_layout_ = VK_NULL_HANDLE;
+}
+
+void ComputePipeline::dispatch_raw(VkCommandBuffer cmd, VkDescriptorSet set, const void* push, uint32_t bytes,
+                                   uint32_t width, uint32_t height) const {
+  if (bytes != push_bytes_) {
+    throw Error(ErrorCode::invalid_argument,
+                concat("kernel ", id_, ": push constants are ", bytes, " bytes, pipeline expects ", push_bytes_));
+  }
+  vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_);
+  vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, layout_, 0, 1, &set, 0, nullptr);
+  if (bytes) vkCmdPushConstants(cmd, layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, bytes, push);
+  vkCmdDispatch(cmd, (width + workgroup_.x - 1) / workgroup_.x, (height + workgroup_.y - 1) / workgroup_.y, 1);
+}
+
+DescriptorArena::DescriptorArena(const Context& context, uint32_t max_sets) : context_(&context) {
+  VkDescriptorPoolSize sizes[] = {
+      {VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, max_sets * 4},
+      {VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, max_sets * 4},
+      {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, max_sets * 4},
+      {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, max_sets * 4},
+  };
+  VkDescriptorPoolCreateInfo info{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+  info.maxSets = max_sets;
+  info.poolSizeCount = 4;
+  info.pPoolSizes = sizes;
+  vk_check(vkCreateDescriptorPool(context.device(), &info, nullptr, &pool_), "vkCreateDescriptorPool");
+  context.state().count_object();
+}
+
+DescriptorArena& DescriptorArena::operator=(DescriptorArena&& o) noexcept {
+  if (this != &o) {
+    reset();
+    context_ = std::exchange(o.context_, nullptr);
+    pool_ = std::exchange(o.pool_, VK_NULL_HANDLE);
+  }
+  return *this;
+}
+
+void DescriptorArena::reset() {
+  if (context_ && pool_) vkDestroyDescriptorPool(context_->device(), pool_, nullptr);
+  pool_ = VK_NULL_HANDLE;
+}
+
+VkDescriptorSet DescriptorArena::make_set(const ComputePipeline& pipeline, const std::vector<ImageBinding>& images) {
+  VkDescriptorSetLayout layout = pipeline.set_layout();
+  VkDescriptorSetAllocateInfo alloc{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
+  alloc.descriptorPool = pool_;
+  alloc.descriptorSetCount = 1;
+  alloc.pSetLayouts = &layout;
+  VkDescriptorSet set = VK_NULL_HANDLE;
+  vk_check(vkAllocateDescriptorSets(context_->device(), &alloc, &set), "vkAllocateDescriptorSets");
+  context_->state().count_object();
+  const auto& types = pipeline.bindings();
+  if (images.size() != types.size()) {
+    throw Error(ErrorCode::invalid_argument, concat("descriptor set: ", images.size(), " images for ", types.size(), " bindings"));
+  }
+  std::vector<VkDescriptorImageInfo> infos(images.size());
+  std::vector<VkWriteDescriptorSet> writes(images.size());
+  for (uint32_t i = 0; i < images.size(); ++i) {
+    infos[i] = {VK_NULL_HANDLE, images[i].view, images[i].layout};
+    writes[i] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+    writes[i].dstSet = set;
+    writes[i].dstBinding = i;
+    writes[i].descriptorCount = 1;
+    writes[i].descriptorType = types[i];
+    writes[i].pImageInfo = &infos[i];
+  }
+  vkUpdateDescriptorSets(context_->device(), static_cast<uint32_t>(writes.size()), writes.data(), 0, nullptr);
+  return set;
+}
+
+}  // namespace glint::detail

@@ -1,0 +1,86 @@
+// Compute pipelines made from embedded kernels, and the descriptor sets that feed them.
+#pragma once
+
+#include <glint/glint.h>
+
+#include <string>
+#include <vector>
+
+#include "core/check.h"
+
+namespace glint::detail {
+
+/// Workgroup shape for 2D image kernels, chosen from the device's limits (STYLE rule 3).
+struct Workgroup2D {
+  uint32_t x = 8;
+  uint32_t y = 8;
+};
+Workgroup2D choose_workgroup_2d(const DeviceInfo& info);
+
+struct PipelineDesc {
+  std::string kernel_id;                        //!< e.g. "bloom_down_rgba16f"
+  std::vector<VkDescriptorType> bindings;       //!< binding i has type bindings[i]
+  uint32_t push_constant_bytes = 0;
+  Workgroup2D workgroup;                        //!< constant_id 0 and 1 (local_size_x_id/y_id)
+  std::vector<uint32_t> specialization;         //!< constant_id 2, 3, ...
+};
+
+class ComputePipeline {
+ public:
+  ComputePipeline() = default;
+  ComputePipeline(const Context& context, const PipelineDesc& desc);
+  ComputePipeline(ComputePipeline&& o) noexcept { *this = std::move(o); }
+  ComputePipeline& operator=(ComputePipeline&& o) noexcept;
+  ComputePipeline(const ComputePipeline&) = delete;
+  ComputePipeline& operator=(const ComputePipeline&) = delete;
+  ~ComputePipeline() { reset(); }
+  void reset();
+
+  VkDescriptorSetLayout set_layout() const { return set_layout_; }
+  const std::vector<VkDescriptorType>& bindings() const { return bindings_; }
+
+  /// Binds the pipeline and `set`, pushes `push` and dispatches enough groups to cover
+  /// width x height invocations. The push-constant size is checked on every dispatch.
+  template <typename Push>
+  void dispatch(VkCommandBuffer cmd, VkDescriptorSet set, const Push& push, uint32_t width, uint32_t height) const {
+    dispatch_raw(cmd, set, &push, sizeof(Push), width, height);
+  }
+
+ private:
+  void dispatch_raw(VkCommandBuffer cmd, VkDescriptorSet set, const void* push, uint32_t bytes,
+                    uint32_t width, uint32_t height) const;
+  VkDevice device_ = VK_NULL_HANDLE;
+  std::string id_;
+  VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
+  VkPipelineLayout layout_ = VK_NULL_HANDLE;
+  VkPipeline pipeline_ = VK_NULL_HANDLE;
+  uint32_t push_bytes_ = 0;
+  Workgroup2D workgroup_;
+  std::vector<VkDescriptorType> bindings_;
+};
+
+/// A descriptor pool and the sets allocated from it, owned by one effect.
+class DescriptorArena {
+ public:
+  DescriptorArena() = default;
+  DescriptorArena(const Context& context, uint32_t max_sets);
+  DescriptorArena(DescriptorArena&& o) noexcept { *this = std::move(o); }
+  DescriptorArena& operator=(DescriptorArena&& o) noexcept;
+  DescriptorArena(const DescriptorArena&) = delete;
+  DescriptorArena& operator=(const DescriptorArena&) = delete;
+  ~DescriptorArena() { reset(); }
+  void reset();
+
+  struct ImageBinding {
+    VkImageView view;
+    VkImageLayout layout;
+  };
+  /// Allocates a set for `pipeline` and writes one image per binding, in binding order.
+  VkDescriptorSet make_set(const ComputePipeline& pipeline, const std::vector<ImageBinding>& images);
+
+ private:
+  const Context* context_ = nullptr;
+  VkDescriptorPool pool_ = VK_NULL_HANDLE;
+};
+
+}  // namespace glint::detail

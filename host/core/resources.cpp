@@ -1,0 +1,150 @@
+#include "core/resources.h"
+
+#include "core/check.h"
+#include "core/context_state.h"
+
+#include <utility>
+
+namespace glint::detail {
+
+uint32_t texel_bytes(VkFormat format) {
+  switch (format) {
+    case VK_FORMAT_R16G16B16A16_SFLOAT: return 8;
+    case VK_FORMAT_R32G32B32A32_SFLOAT: return 16;
+    case VK_FORMAT_R8G8B8A8_UNORM: return 4;
+    case VK_FORMAT_R32_SFLOAT:
+    case VK_FORMAT_D32_SFLOAT:
+    case VK_FORMAT_R32_UINT: return 4;
+    case VK_FORMAT_R16_SFLOAT: return 2;
+    default: throw Error(ErrorCode::unsupported_format, concat("texel size of ", format_name(format), " is unknown"));
+  }
+}
+
+OwnedImage::OwnedImage(const Context& context, VkExtent2D extent, VkFormat format, VkImageUsageFlags usage) {
+  device_ = context.device();
+  auto& s = context.state();
+  VkImageCreateInfo info{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
+  info.imageType = VK_IMAGE_TYPE_2D;
+  info.format = format;
+  info.extent = {extent.width, extent.height, 1};
+  info.mipLevels = 1;
+  info.arrayLayers = 1;
+  info.samples = VK_SAMPLE_COUNT_1_BIT;
+  info.tiling = VK_IMAGE_TILING_OPTIMAL;
+  info.usage = usage;
+  info.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+  vk_check(vkCreateImage(device_, &info, nullptr, &state.image), "vkCreateImage");
+  s.count_object();
+  state.format = format;
+  state.extent = extent;
+  state.usage = usage;
+  try {
+    VkMemoryRequirements req;
+    vkGetImageMemoryRequirements(device_, state.image, &req);
+    VkMemoryAllocateInfo alloc{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+    alloc.allocationSize = req.size;
+    alloc.memoryTypeIndex = s.memory_type(req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+    vk_check(vkAllocateMemory(device_, &alloc, nullptr, &memory_), "vkAllocateMemory (image)");
+    s.count_object();
+    vk_check(vkBindImageMemory(device_, state.image, memory_, 0), "vkBindImageMemory");
+    VkImageViewCreateInfo view{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
+    view.image = state.image;
+    view.viewType = VK_IMAGE_VIEW_TYPE_2D;
+    view.format = format;
+    const bool depth = format == VK_FORMAT_D32_SFLOAT;
+    view.subresourceRange = {static_cast<VkImageAspectFlags>(depth ? VK_IMAGE_ASPECT_DEPTH_BIT : VK_IMAGE_ASPECT_COLOR_BIT), 0, 1, 0, 1};
+    vk_check(vkCreateImageView(device_, &view, nullptr, &state.view), "vkCreateImageView");
+    s.count_object();
+  } catch (...) {
+    reset();
+    throw;
+  }
+}
+
+OwnedImage& OwnedImage::operator=(OwnedImage&& other) noexcept {
+  if (this != &other) {
+    reset();
+    device_ = std::exchange(other.device_, VK_NULL_HANDLE);
+    memory_ = std::exchange(other.memory_, VK_NULL_HANDLE);
+    state = std::exchange(other.state, Image{});
+  }
+  return *this;
+}
+
+void OwnedImage::reset() {
+  if (device_) {
+    if (state.view) vkDestroyImageView(device_, state.view, nullptr);
+    if (state.image) vkDestroyImage(device_, state.image, nullptr);
+    if (memory_) vkFreeMemory(device_, memory_, nullptr);
+  }
+  device_ = VK_NULL_HANDLE;
+  memory_ = VK_NULL_HANDLE;
+  state = Image{};
+}
+
+OwnedBuffer::OwnedBuffer(const Context& context, VkDeviceSize size, VkBufferUsageFlags usage, bool host_visible) {
+  device_ = context.device();
+  size_ = size;
+  auto& s = context.state();
+  VkBufferCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+  info.size = size;
+  info.usage = usage;
+  info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+  vk_check(vkCreateBuffer(device_, &info, nullptr, &buffer_), "vkCreateBuffer");
+  s.count_object();
+  try {
+    VkMemoryRequirements req;
+    vkGetBufferMemoryRequirements(device_, buffer_, &req);
+    VkMemoryAllocateInfo alloc{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+    alloc.allocationSize = req.size;
+    VkMemoryPropertyFlags flags = host_visible ? VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT : VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT;
+    alloc.memoryTypeIndex = s.memory_type(req.memoryTypeBits, flags);
+    coherent_ = (s.memory.memoryTypes[alloc.memoryTypeIndex].propertyFlags & VK_MEMORY_PROPERTY_HOST_COHERENT_BIT) != 0;
+    vk_check(vkAllocateMemory(device_, &alloc, nullptr, &memory_), "vkAllocateMemory (buffer)");
+    s.count_object();
+    vk_check(vkBindBufferMemory(device_, buffer_, memory_, 0), "vkBindBufferMemory");
+    if (host_visible) vk_check(vkMapMemory(device_, memory_, 0, VK_WHOLE_SIZE, 0, &mapped_), "vkMapMemory");
+  } catch (...) {
+    reset();
+    throw;
+  }
+}
+
+OwnedBuffer& OwnedBuffer::operator=(OwnedBuffer&& other) noexcept {
+  if (this != &other) {
+    reset();
+    device_ = std::exchange(other.device_, VK_NULL_HANDLE);
+    buffer_ = std::exchange(other.buffer_, VK_NULL_HANDLE);
+    memory_ = std::exchange(other.memory_, VK_NULL_HANDLE);
+    size_ = std::exchange(other.size_, 0);
+    mapped_ = std::exchange(other.mapped_, nullptr);
+    coherent_ = other.coherent_;
+  }
+  return *this;
+}
+
+void OwnedBuffer::reset() {
+  if (device_) {
+    if (buffer_) vkDestroyBuffer(device_, buffer_, nullptr);
+    if (memory_) vkFreeMemory(device_, memory_, nullptr);  // unmaps implicitly
+  }
+  device_ = VK_NULL_HANDLE;
+  buffer_ = VK_NULL_HANDLE;
+  memory_ = VK_NULL_HANDLE;
+  mapped_ = nullptr;
+  size_ = 0;
+}
+
+void OwnedBuffer::flush() const {
+  if (coherent_ || !mapped_) return;
+  VkMappedMemoryRange r{VK_STRUCTURE_TYPE_MAPPED_MEMORY_RANGE, nullptr, memory_, 0, VK_WHOLE_SIZE};
+  vk_check(vkFlushMappedMemoryRanges(device_, 1, &r), "vkFlushMappedMemoryRanges");
+}
+
+void OwnedBuffer::invalidate() const {
+  if (coherent_ || !mapped_) return;
+  VkMappedMemoryRange r{VK_STRUCTURE_TYPE_MAPPED_MEMORY_RANGE, nullptr, memory_, 0, VK_WHOLE_SIZE};
+  vk_check(vkInvalidateMappedMemoryRanges(device_, 1, &r), "vkInvalidateMappedMemoryRanges");
+}
+
+}  // namespace glint::detail

@@ -1,0 +1,66 @@
+// Images and buffers that glint owns (pyramid levels, staging), with their memory. Move-only.
+#pragma once
+
+#include <glint/glint.h>
+
+#include <cstddef>
+
+namespace glint::detail {
+
+/// A 2D single-mip image with its memory and a view; `state` tracks its last use for barriers.
+class OwnedImage {
+ public:
+  OwnedImage() = default;
+  OwnedImage(const Context& context, VkExtent2D extent, VkFormat format, VkImageUsageFlags usage);
+  OwnedImage(OwnedImage&& other) noexcept { *this = std::move(other); }
+  OwnedImage& operator=(OwnedImage&& other) noexcept;
+  OwnedImage(const OwnedImage&) = delete;
+  OwnedImage& operator=(const OwnedImage&) = delete;
+  ~OwnedImage() { reset(); }
+
+  void reset();
+  explicit operator bool() const { return state.image != VK_NULL_HANDLE; }
+  /// The image as effects see it; the state fields are shared with this object by reference.
+  Image& image() { return state; }
+  const Image& image() const { return state; }
+
+  Image state;
+
+ private:
+  VkDevice device_ = VK_NULL_HANDLE;
+  VkDeviceMemory memory_ = VK_NULL_HANDLE;
+};
+
+/// A buffer with its memory, optionally host-visible and mapped.
+class OwnedBuffer {
+ public:
+  OwnedBuffer() = default;
+  OwnedBuffer(const Context& context, VkDeviceSize size, VkBufferUsageFlags usage, bool host_visible);
+  OwnedBuffer(OwnedBuffer&& other) noexcept { *this = std::move(other); }
+  OwnedBuffer& operator=(OwnedBuffer&& other) noexcept;
+  OwnedBuffer(const OwnedBuffer&) = delete;
+  OwnedBuffer& operator=(const OwnedBuffer&) = delete;
+  ~OwnedBuffer() { reset(); }
+
+  void reset();
+  VkBuffer buffer() const { return buffer_; }
+  VkDeviceSize size() const { return size_; }
+  void* mapped() const { return mapped_; }
+  /// Makes host writes visible to the device / device writes visible to the host (non-coherent
+  /// memory); no-op on coherent memory.
+  void flush() const;
+  void invalidate() const;
+
+ private:
+  VkDevice device_ = VK_NULL_HANDLE;
+  VkBuffer buffer_ = VK_NULL_HANDLE;
+  VkDeviceMemory memory_ = VK_NULL_HANDLE;
+  VkDeviceSize size_ = 0;
+  void* mapped_ = nullptr;
+  bool coherent_ = true;
+};
+
+/// Bytes per texel of the formats glint handles.
+uint32_t texel_bytes(VkFormat format);
+
+}  // namespace glint::detail

@@ -1,0 +1,109 @@
+// HDR bloom: soft-knee bright-pass, mip-pyramid downsample, upsample with accumulation by gather,
+// composite. All compute. The exact algorithm (taps, edge rules, mapping between levels) is in
+// docs/BLOOM.md; host/reference/bloom_reference.h implements it in float64.
+#pragma once
+
+#include <glint/glint.h>
+
+#include <array>
+#include <memory>
+
+namespace glint {
+
+/// The filter used between pyramid levels.
+enum class BloomFilter : uint32_t {
+  cod13 = 0,   //!< 13-tap downsample, 3x3 tent upsample (Jimenez 2014). Default.
+  dual = 1,    //!< dual filter: 5-tap down, 8-tap up (Bjørge 2015). Cheapest; not a Gaussian.
+  gauss9 = 2,  //!< area downsample + the seed's separable 9-tap Gaussian per level.
+};
+
+/// Storage precision of the pyramid.
+enum class Precision : uint32_t {
+  fp16 = 0,  //!< RGBA16F intermediates (default)
+  fp32 = 1,  //!< RGBA32F intermediates
+};
+
+/// Bloom settings. Defaults are seed 001's; ranges are checked by validate(), which throws.
+/// Shape fields (iterations, filter, precision) decide images and pipelines: changing them through
+/// Bloom::set_config() rebuilds those. The other fields are per-frame push constants.
+struct BloomConfig {
+  float threshold = 1.0f;         //!< luminance where bloom starts (0 to 65504)
+  float soft_knee = 0.5f;         //!< knee width as a fraction of threshold (0 to 1)
+  float intensity = 0.3f;         //!< weight of the bloom added to the scene (0 to 100); 0 = off
+  uint32_t iterations = 5;        //!< pyramid levels (1 to 8); reduced at small sizes [shape]
+  float radius = 1.0f;            //!< scales the upsample (or Gaussian) footprint (0.25 to 4)
+  BloomFilter filter = BloomFilter::cod13;  //!< [shape]
+  bool firefly_guard = true;      //!< Karis average on the first downsample
+  float max_brightness = 1000.0f; //!< per-channel clamp before the bright-pass (1e-3 to 8000);
+                                  //!< also what +Inf becomes. Keeps fp16 levels finite.
+  Precision precision = Precision::fp16;  //!< intermediate storage [shape]
+
+  /// Throws Error(invalid_argument) naming the first field that is out of range or NaN.
+  void validate() const;
+};
+
+/// Size of one pyramid level.
+struct LevelSize {
+  uint32_t width = 0;
+  uint32_t height = 0;
+};
+
+/// The mip chain a bloom of `input` size with `iterations` uses (docs/BLOOM.md, "Mip chain").
+/// Returns at most `iterations` levels; fewer when a level would be under 2 pixels on a side.
+std::vector<LevelSize> bloom_mip_chain(VkExtent2D input, uint32_t iterations);
+
+/// One bloom effect. Make it once; call record() every frame.
+///
+/// Inputs: any RGBA16F or RGBA32F image with SAMPLED usage. Output: RGBA16F or RGBA32F with STORAGE
+/// usage, same extent. After record(), the input is in SHADER_READ_ONLY_OPTIMAL (GENERAL if it is
+/// also the output) and the output in GENERAL, both last used by the compute shader stage.
+/// Input and output may be the same image (in place).
+///
+/// Per size and config shape, images, pipelines and descriptor sets are made once: by prepare(),
+/// or by the first record() at that size. A record() at a prepared size with seen images creates
+/// no Vulkan object. Each distinct (input view, output view) pair gets its descriptor sets on
+/// first use; they live until the Bloom is destroyed or resized.
+class Bloom {
+ public:
+  /// Throws Error(invalid_argument) if config is invalid.
+  Bloom(const Context& context, const BloomConfig& config = {});
+  Bloom(const Bloom&) = delete;
+  Bloom& operator=(const Bloom&) = delete;
+  Bloom(Bloom&&) noexcept;
+  Bloom& operator=(Bloom&&) noexcept;
+  ~Bloom();
+
+  /// Replaces the config. Per-frame fields take effect at the next record(); changed shape fields
+  /// rebuild the pyramid and pipelines then. The caller must not have frames in flight that use
+  /// this Bloom when shape fields change (as for a swapchain resize).
+  void set_config(const BloomConfig& config);
+  const BloomConfig& config() const;
+
+  /// Makes everything a frame of this size needs, so record() allocates nothing. Optional.
+  /// Throws Error(unsupported_size) for a zero extent or one above the device's maximum.
+  void prepare(VkExtent2D extent);
+
+  /// Records the bloom of `input` into `output` on `cmd` (which must be in the recording state,
+  /// on a queue family with compute). Updates the state fields of both images. A different extent
+  /// than the last one re-makes the pyramid (see set_config for the in-flight rule).
+  /// `profiler` (may be null) gets a mark after each stage.
+  /// Throws Error before recording anything if an image has the wrong format, usage or extent.
+  void record(VkCommandBuffer cmd, Image& input, Image& output, Profiler* profiler = nullptr);
+
+  /// Levels the current size uses (after the small-size clamp), and whether iterations were
+  /// reduced to get there. Valid after prepare() or record().
+  uint32_t levels() const;
+  bool clamped() const;
+  std::vector<LevelSize> level_sizes() const;
+
+  /// Bytes the GPU must move at least for one frame at the prepared size (each image read and
+  /// written once): the floor that benchmarks report against.
+  uint64_t min_bytes_moved(VkFormat input_format, VkFormat output_format) const;
+
+  struct Impl;
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace glint

@@ -1,0 +1,196 @@
+// glint: Vulkan compute kernels for HDR post-processing.
+//
+// This header holds what every effect shares: the error type, the Vulkan context (standalone or
+// adopted from an engine), the view of a caller's image that effects read and write, and a GPU
+// timestamp profiler. One header per effect (bloom.h, ...) holds that effect's config and class.
+//
+// Conventions used across the API:
+// - Every failure throws glint::Error. Its message names the parameter, the value and the accepted
+//   range. Validation happens before anything is recorded, so a throwing record() leaves the
+//   command buffer exactly as it was.
+// - Effects record into the caller's VkCommandBuffer and never submit, wait or read back.
+// - Images are described by glint::Image, which also carries the caller's last use of the image
+//   (layout, stage, access). Effects write the state they leave the image in back into it.
+#pragma once
+
+#include <vulkan/vulkan.h>
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace glint {
+
+inline constexpr int kVersionMajor = 0;
+inline constexpr int kVersionMinor = 1;
+inline constexpr int kVersionPatch = 0;
+
+/// What kind of failure an Error reports.
+enum class ErrorCode {
+  invalid_argument,    //!< a config value or argument is out of range, NaN or inconsistent
+  unsupported_format,  //!< an image format the effect cannot read or write
+  unsupported_size,    //!< zero size, or larger than the device allows
+  missing_usage,       //!< an image lacks a usage flag the effect needs
+  vulkan_failure,      //!< a Vulkan call returned an error
+  no_device,           //!< no Vulkan device matches the request
+  io_failure,          //!< a file could not be read or written (CLI and io helpers)
+};
+
+/// The one exception type glint throws.
+class Error : public std::runtime_error {
+ public:
+  Error(ErrorCode code, const std::string& message) : std::runtime_error(message), code_(code) {}
+  ErrorCode code() const noexcept { return code_; }
+
+ private:
+  ErrorCode code_;
+};
+
+/// A description of one Vulkan physical device, as listed by list_devices().
+struct DeviceDescription {
+  uint32_t index = 0;           //!< position in vkEnumeratePhysicalDevices order
+  std::string name;             //!< VkPhysicalDeviceProperties::deviceName
+  VkPhysicalDeviceType type{};  //!< discrete, integrated, CPU (lavapipe), ...
+  uint32_t api_version = 0;     //!< VK_MAKE_API_VERSION encoded
+};
+
+/// Options for a standalone context (one that creates its own instance and device).
+struct ContextOptions {
+  /// Which device: a decimal index into list_devices(), or a case-insensitive substring of the
+  /// device name. Empty: the GLINT_DEVICE environment variable if set, else the first discrete
+  /// GPU, else the first integrated GPU, else the first CPU device (lavapipe).
+  std::string device;
+  /// Enable VK_LAYER_KHRONOS_validation with synchronization validation. Also enabled when the
+  /// environment variable GLINT_VALIDATION=1 is set. Messages are counted (validation_messages())
+  /// and printed to stderr.
+  bool validation = false;
+};
+
+/// What an engine hands glint when it adopts the engine's own Vulkan objects. glint never
+/// destroys them and never submits work: the engine records glint's commands and submits them.
+struct AdoptInfo {
+  VkInstance instance = VK_NULL_HANDLE;              //!< must not be null
+  VkPhysicalDevice physical_device = VK_NULL_HANDLE; //!< must not be null
+  VkDevice device = VK_NULL_HANDLE;                  //!< must not be null; Vulkan 1.3 with the
+                                                     //!< synchronization2 and maintenance4
+                                                     //!< features enabled (every 1.3 device has
+                                                     //!< both; kernels size their workgroups by
+                                                     //!< specialization, which needs maintenance4)
+  uint32_t queue_family_index = 0;                   //!< family the command buffers come from;
+                                                     //!< must support compute
+};
+
+/// Facts about the device that kernels are tuned by (rule: chosen per device, never assumed).
+struct DeviceInfo {
+  std::string name;
+  VkPhysicalDeviceType type{};
+  uint32_t subgroup_size = 0;
+  uint32_t max_shared_memory_bytes = 0;
+  uint32_t max_workgroup_invocations = 0;
+  uint32_t max_image_dimension_2d = 0;
+  float timestamp_period_ns = 0.0f;  //!< nanoseconds per timestamp tick
+  bool timestamps_supported = false;
+};
+
+namespace detail {
+struct ContextState;
+}
+
+/// The Vulkan device glint works on. Move-only; effects keep a reference, so a Context must
+/// outlive every effect made from it.
+class Context {
+ public:
+  /// Creates an instance and a device of its own (Vulkan 1.3, one queue with compute).
+  /// Throws Error(no_device) when no device matches options.device.
+  static Context create(const ContextOptions& options = {});
+
+  /// Wraps an engine's instance, physical device and device. Throws Error(invalid_argument) for
+  /// null handles or a queue family without compute.
+  static Context adopt(const AdoptInfo& info);
+
+  Context(Context&&) noexcept;
+  Context& operator=(Context&&) noexcept;
+  ~Context();
+
+  VkInstance instance() const;
+  VkPhysicalDevice physical_device() const;
+  VkDevice device() const;
+  uint32_t queue_family_index() const;
+  const DeviceInfo& info() const;
+  bool is_adopted() const;
+
+  /// Standalone contexts only: records commands with `record`, submits them, waits for the
+  /// queue and returns. For tools and tests; effects never call it. Throws in adopted mode.
+  void run_once(const std::function<void(VkCommandBuffer)>& record) const;
+
+  /// Number of validation-layer messages (errors and warnings) seen since creation, and their
+  /// text. Zero when validation is off.
+  uint32_t validation_messages() const;
+  std::vector<std::string> validation_log() const;
+
+  /// Number of Vulkan objects glint has created through this context (pipelines, images,
+  /// descriptor sets, ...). Tests use it to prove that recording a frame creates nothing.
+  uint64_t objects_created() const;
+
+  detail::ContextState& state() const { return *state_; }
+
+ private:
+  explicit Context(std::unique_ptr<detail::ContextState> state);
+  std::unique_ptr<detail::ContextState> state_;
+};
+
+/// Lists the Vulkan physical devices (creates and destroys a temporary instance).
+std::vector<DeviceDescription> list_devices();
+
+/// A view of a caller's 2D image that an effect reads or writes. The caller keeps ownership.
+/// `layout`, `stage` and `access` describe the caller's last use of the image, so the effect can
+/// write the right barrier; after record() they describe the effect's last use, which the caller's
+/// next barrier starts from.
+struct Image {
+  VkImage image = VK_NULL_HANDLE;
+  VkImageView view = VK_NULL_HANDLE;  //!< a 2D view of mip 0, layer 0, colour aspect
+  VkFormat format = VK_FORMAT_UNDEFINED;
+  VkExtent2D extent{0, 0};
+  VkImageUsageFlags usage = 0;  //!< the usage the image was created with
+  VkImageLayout layout = VK_IMAGE_LAYOUT_UNDEFINED;
+  VkPipelineStageFlags2 stage = VK_PIPELINE_STAGE_2_NONE;
+  VkAccessFlags2 access = VK_ACCESS_2_NONE;
+};
+
+/// GPU timestamps around the stages an effect records. Pass one to an effect's record(); read
+/// results() after the command buffer has completed.
+class Profiler {
+ public:
+  /// capacity: the most marks per frame (1 to 4096).
+  Profiler(const Context& context, uint32_t capacity = 64);
+  Profiler(const Profiler&) = delete;
+  Profiler& operator=(const Profiler&) = delete;
+  ~Profiler();
+
+  /// Resets the query pool; record once per frame before any mark().
+  void reset(VkCommandBuffer cmd);
+  /// Writes a timestamp once all earlier commands are done; `label` names the work since the
+  /// previous mark (the first mark only starts the clock).
+  void mark(VkCommandBuffer cmd, const std::string& label);
+
+  struct Stage {
+    std::string label;
+    double ms = 0.0;
+  };
+  /// The time between consecutive marks. Waits for the query results (call after the frame's
+  /// fence). Empty if timestamps are not supported.
+  std::vector<Stage> results() const;
+  /// Milliseconds from the first to the last mark.
+  double total_ms() const;
+
+ private:
+  const Context* context_;
+  VkQueryPool pool_ = VK_NULL_HANDLE;
+  uint32_t capacity_;
+  std::vector<std::string> labels_;
+};
+
+}  // namespace glint

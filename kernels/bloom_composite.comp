@@ -1,0 +1,26 @@
+#version 460
+#extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_samplerless_texture_functions : require
+// The last upsample fused with the composite: out = scene + intensity / N * Up(A0)
+// (docs/BLOOM.md "Composite"). Fusing saves a full-resolution bloom image write and read.
+layout(local_size_x_id = 0, local_size_y_id = 1) in;
+
+layout(binding = 0) uniform texture2D scene;
+layout(binding = 1) uniform texture2D level0;
+layout(binding = 2, DST_FORMAT) uniform writeonly image2D result;
+
+#include "bloom_params.h"
+layout(push_constant) uniform Push { BloomPush p; };
+
+vec3 source_texel(ivec2 ij) { return vec3(0.0); }  // unused
+
+#include "bloom.glsl"
+
+void main() {
+  ivec2 xy = ivec2(gl_GlobalInvocationID.xy);
+  ivec2 size = ivec2(p.dst_width, p.dst_height);
+  if (any(greaterThanEqual(xy, size))) return;
+  vec4 s = texelFetch(scene, xy, 0);
+  vec3 bloom = upsample(level0, ivec2(p.src_width, p.src_height), xy, size, p.radius);
+  imageStore(result, xy, vec4(s.rgb + p.composite_scale * bloom, s.a));
+}

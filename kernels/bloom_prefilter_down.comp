@@ -1,0 +1,31 @@
+#version 460
+#extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_samplerless_texture_functions : require
+// Bright-pass fused into the first downsample: full-resolution scene -> pyramid level 0.
+// Implements docs/BLOOM.md "Prefilter" (seed 001's soft knee) and "Downsample" with the Karis
+// guard (Jimenez 2014). Fusing saves writing and re-reading a full-resolution bright-pass image.
+layout(local_size_x_id = 0, local_size_y_id = 1) in;
+
+layout(binding = 0) uniform texture2D scene;
+layout(binding = 1, DST_FORMAT) uniform writeonly image2D level0;
+
+#include "bloom_params.h"
+layout(push_constant) uniform Push { BloomPush p; };
+
+vec3 sanitize(vec3 c, float max_brightness);
+vec3 soft_threshold(vec3 c, float threshold, float knee);
+vec3 source_texel(ivec2 ij) {
+  vec3 c = sanitize(texelFetch(scene, ij, 0).rgb, p.max_brightness);
+  return soft_threshold(c, p.threshold, p.knee);
+}
+
+#include "bloom.glsl"
+
+void main() {
+  ivec2 xy = ivec2(gl_GlobalInvocationID.xy);
+  ivec2 dst_size = ivec2(p.dst_width, p.dst_height);
+  if (any(greaterThanEqual(xy, dst_size))) return;
+  g_src_size = ivec2(p.src_width, p.src_height);
+  vec3 c = downsample(xy, dst_size, (p.flags & GLINT_BLOOM_FLAG_KARIS) != 0u);
+  imageStore(level0, xy, vec4(c, 1.0));
+}

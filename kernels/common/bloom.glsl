@@ -1,0 +1,112 @@
+// Bloom building blocks (docs/BLOOM.md). A kernel that includes this defines
+//   vec3 source_texel(ivec2 ij)   // the (possibly prefiltered) source texel, ij already clamped
+// before including it, and declares push constants `p` of type BloomPush.
+#include "bloom_params.h"
+#include "image_io.glsl"
+
+layout(constant_id = 2) const uint FILTER = GLINT_BLOOM_COD13;
+
+float luma(vec3 c) { return dot(c, vec3(0.2126, 0.7152, 0.0722)); }
+
+// NaN and negatives to 0, then clamp each channel (so +Inf becomes max_brightness).
+vec3 sanitize(vec3 c, float max_brightness) {
+  bvec3 bad = isnan(c);
+  c = mix(c, vec3(0.0), bad);
+  return clamp(c, vec3(0.0), vec3(max_brightness));
+}
+
+// Seed 001's soft knee, knee relative to threshold (docs/BLOOM.md, "Prefilter").
+vec3 soft_threshold(vec3 c, float threshold, float knee) {
+  float l = luma(c);
+  float soft = clamp(l - threshold + knee, 0.0, 2.0 * knee);
+  float contribution = soft * soft / (4.0 * knee + 1e-4);
+  float factor = max(l - threshold, contribution) / max(l, 1e-4);
+  return c * factor;
+}
+
+ivec2 g_src_size;
+
+vec3 src_at(ivec2 ij) { return source_texel(clamp(ij, ivec2(0), g_src_size - 1)); }
+
+vec3 src_bilinear(vec2 pos) {
+  vec2 f = floor(pos);
+  vec2 w = pos - f;
+  ivec2 i0 = ivec2(f);
+  vec3 a = src_at(i0);
+  vec3 b = src_at(i0 + ivec2(1, 0));
+  vec3 c = src_at(i0 + ivec2(0, 1));
+  vec3 d = src_at(i0 + ivec2(1, 1));
+  return mix(mix(a, b, w.x), mix(c, d, w.x), w.y);
+}
+
+// Accumulates one "box" (docs/BLOOM.md, Karis guard): weight w, mean m.
+void add_box(inout vec3 sum, inout float wsum, vec3 m, float w, bool karis) {
+  float k = karis ? w / (1.0 + luma(m)) : w;
+  sum += k * m;
+  wsum += k;
+}
+
+vec3 downsample(ivec2 xy, ivec2 dst_size, bool karis) {
+  vec3 sum = vec3(0.0);
+  float wsum = 0.0;
+  if (FILTER == GLINT_BLOOM_GAUSS9) {
+    // Area average: every source texel weighted by its overlap with the destination footprint.
+    vec2 s = vec2(g_src_size) / vec2(dst_size);
+    vec2 lo = vec2(xy) * s;
+    vec2 hi = vec2(xy + 1) * s;
+    ivec2 i0 = ivec2(floor(lo));
+    ivec2 i1 = ivec2(ceil(hi)) - 1;
+    for (int j = i0.y; j <= i1.y; ++j) {
+      float wy = min(float(j + 1), hi.y) - max(float(j), lo.y);
+      for (int i = i0.x; i <= i1.x; ++i) {
+        float wx = min(float(i + 1), hi.x) - max(float(i), lo.x);
+        add_box(sum, wsum, src_at(ivec2(i, j)), wx * wy, karis);
+      }
+    }
+    return sum / wsum;
+  }
+  vec2 c = map_position(xy, dst_size, g_src_size);
+  if (FILTER == GLINT_BLOOM_DUAL) {
+    add_box(sum, wsum, src_bilinear(c), 0.5, karis);
+    add_box(sum, wsum, src_bilinear(c + vec2(-1, -1)), 0.125, karis);
+    add_box(sum, wsum, src_bilinear(c + vec2(1, -1)), 0.125, karis);
+    add_box(sum, wsum, src_bilinear(c + vec2(-1, 1)), 0.125, karis);
+    add_box(sum, wsum, src_bilinear(c + vec2(1, 1)), 0.125, karis);
+    return sum / wsum;
+  }
+  // cod13: outer 3x3 grid at +-2 and the inner 2x2 at +-1 (Jimenez 2014).
+  vec3 g[9];
+  for (int j = 0; j < 3; ++j)
+    for (int i = 0; i < 3; ++i) g[j * 3 + i] = src_bilinear(c + vec2(2 * i - 2, 2 * j - 2));
+  vec3 inner = (src_bilinear(c + vec2(-1, -1)) + src_bilinear(c + vec2(1, -1)) +
+                src_bilinear(c + vec2(-1, 1)) + src_bilinear(c + vec2(1, 1))) * 0.25;
+  add_box(sum, wsum, inner, 0.5, karis);
+  add_box(sum, wsum, (g[0] + g[1] + g[3] + g[4]) * 0.25, 0.125, karis);
+  add_box(sum, wsum, (g[1] + g[2] + g[4] + g[5]) * 0.25, 0.125, karis);
+  add_box(sum, wsum, (g[3] + g[4] + g[6] + g[7]) * 0.25, 0.125, karis);
+  add_box(sum, wsum, (g[4] + g[5] + g[7] + g[8]) * 0.25, 0.125, karis);
+  return sum / wsum;
+}
+
+// The filter's upsample of `small` (size small_size) at texel xy of a larger image.
+vec3 upsample(texture2D small, ivec2 small_size, ivec2 xy, ivec2 dst_size, float radius) {
+  vec2 c = map_position(xy, dst_size, small_size);
+  if (FILTER == GLINT_BLOOM_GAUSS9) return bilinear(small, c, small_size);
+  if (FILTER == GLINT_BLOOM_DUAL) {
+    vec3 edges = bilinear(small, c + radius * vec2(-1, 0), small_size) +
+                 bilinear(small, c + radius * vec2(1, 0), small_size) +
+                 bilinear(small, c + radius * vec2(0, -1), small_size) +
+                 bilinear(small, c + radius * vec2(0, 1), small_size);
+    vec3 diagonals = bilinear(small, c + radius * vec2(-0.5, -0.5), small_size) +
+                     bilinear(small, c + radius * vec2(0.5, -0.5), small_size) +
+                     bilinear(small, c + radius * vec2(-0.5, 0.5), small_size) +
+                     bilinear(small, c + radius * vec2(0.5, 0.5), small_size);
+    return (edges + 2.0 * diagonals) / 12.0;
+  }
+  vec3 sum = vec3(0.0);
+  const float t[3] = float[3](0.25, 0.5, 0.25);
+  for (int j = 0; j < 3; ++j)
+    for (int i = 0; i < 3; ++i)
+      sum += (t[i] * t[j]) * bilinear(small, c + radius * vec2(i - 1, j - 1), small_size);
+  return sum;
+}

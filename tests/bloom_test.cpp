@@ -1,0 +1,443 @@
+// Bloom on the GPU (lavapipe in CI) against the float64 reference, and the properties the seeds
+// ask for, measured on real GPU output. Validation with synchronization validation is on for
+// every test (support/gpu_test.h fails a test on any message).
+#include <glint/bloom.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+#include "core/half.h"
+#include "reference/bloom_reference.h"
+#include "support/gpu_test.h"
+
+namespace glint::test {
+namespace {
+
+constexpr VkFormat kF16 = VK_FORMAT_R16G16B16A16_SFLOAT;
+constexpr VkFormat kF32 = VK_FORMAT_R32G32B32A32_SFLOAT;
+
+class BloomTest : public GpuTest {};
+
+// Runs one bloom of `input` and reads the output back. The output starts poisoned with NaN.
+CpuImage run_bloom(Bloom& bloom, const CpuImage& input, VkFormat in_format, VkFormat out_format,
+                   Profiler* profiler = nullptr) {
+  auto in = make_image(input, in_format);
+  auto out = make_poisoned({input.width, input.height}, out_format);
+  context().run_once([&](VkCommandBuffer cmd) {
+    if (profiler) {
+      profiler->reset(cmd);
+      profiler->mark(cmd, "start");
+    }
+    bloom.record(cmd, in.state, out.state, profiler);
+  });
+  return detail::download(context(), out.state);
+}
+
+CpuImage run_bloom(const BloomConfig& config, const CpuImage& input, VkFormat in_format = kF32,
+                   VkFormat out_format = kF32) {
+  Bloom bloom(context(), config);
+  return run_bloom(bloom, input, in_format, out_format);
+}
+
+// The value the GPU reads from an RGBA16F input: the reference must start from the same numbers.
+CpuImage as_stored(const CpuImage& img, VkFormat format) {
+  if (format != kF16) return img;
+  CpuImage out = img;
+  for (float& v : out.rgba) v = detail::round_to_half(v);
+  return out;
+}
+
+const char* filter_name(BloomFilter f) {
+  switch (f) {
+    case BloomFilter::cod13: return "cod13";
+    case BloomFilter::dual: return "dual";
+    case BloomFilter::gauss9: return "gauss9";
+  }
+  return "?";
+}
+
+constexpr BloomFilter kFilters[] = {BloomFilter::cod13, BloomFilter::dual, BloomFilter::gauss9};
+
+// Light the bloom added: out - in, summed over RGB, per pixel.
+std::vector<double> added_light(const CpuImage& out, const CpuImage& in) {
+  std::vector<double> added(size_t(in.width) * in.height);
+  for (uint32_t y = 0; y < in.height; ++y)
+    for (uint32_t x = 0; x < in.width; ++x) {
+      double s = 0;
+      for (int c = 0; c < 3; ++c) s += double(out.at(x, y)[c]) - double(in.at(x, y)[c]);
+      added[size_t(y) * in.width + x] = s;
+    }
+  return added;
+}
+
+struct Moments {
+  double energy = 0, xx = 0, yy = 0;
+};
+// Second moments of the added light about a centre (cx, cy), excluding the source pixel itself.
+Moments moments(const std::vector<double>& added, uint32_t w, uint32_t h, double cx, double cy) {
+  Moments m;
+  for (uint32_t y = 0; y < h; ++y)
+    for (uint32_t x = 0; x < w; ++x) {
+      const double a = added[size_t(y) * w + x];
+      m.energy += a;
+      m.xx += a * (x - cx) * (x - cx);
+      m.yy += a * (y - cy) * (y - cy);
+    }
+  m.xx /= m.energy;
+  m.yy /= m.energy;
+  return m;
+}
+
+CpuImage point_source(uint32_t w, uint32_t h, uint32_t px, uint32_t py, float value, float background = 0.05f) {
+  CpuImage img(w, h, background);
+  for (uint32_t y = 0; y < h; ++y)
+    for (uint32_t x = 0; x < w; ++x) img.at(x, y)[3] = 1.0f;
+  for (int c = 0; c < 3; ++c) img.at(px, py)[c] = value;
+  return img;
+}
+
+TEST_F(BloomTest, MipChainOf1080pMatchesTheSeed) {
+  auto chain = bloom_mip_chain({1920, 1080}, 5);
+  const std::vector<std::pair<uint32_t, uint32_t>> expected = {{960, 540}, {480, 270}, {240, 135}, {120, 67}, {60, 33}};
+  ASSERT_EQ(chain.size(), expected.size());
+  for (size_t i = 0; i < chain.size(); ++i) {
+    EXPECT_EQ(chain[i].width, expected[i].first) << "level " << i;
+    EXPECT_EQ(chain[i].height, expected[i].second) << "level " << i;
+  }
+  Bloom bloom(context());
+  bloom.prepare({1920, 1080});
+  EXPECT_EQ(bloom.levels(), 5u);
+  EXPECT_FALSE(bloom.clamped());
+}
+
+TEST_F(BloomTest, IterationsAreClampedAtSmallSizesAndReported) {
+  struct Case {
+    VkExtent2D size;
+    uint32_t iterations, levels;
+    bool clamped;
+  };
+  const Case cases[] = {{{64, 64}, 5, 5, false}, {{64, 64}, 8, 5, true}, {{3, 5}, 5, 1, true},
+                        {{1, 1}, 5, 1, true},    {{1, 1}, 1, 1, false}, {{4097, 3}, 8, 1, true},
+                        {{320, 240}, 8, 6, true}};
+  for (const Case& c : cases) {
+    BloomConfig config;
+    config.iterations = c.iterations;
+    Bloom bloom(context(), config);
+    bloom.prepare(c.size);
+    EXPECT_EQ(bloom.levels(), c.levels) << c.size.width << "x" << c.size.height;
+    EXPECT_EQ(bloom.clamped(), c.clamped) << c.size.width << "x" << c.size.height;
+    if (bloom.levels() > 1) {
+      for (const LevelSize& l : bloom.level_sizes()) EXPECT_GE(std::min(l.width, l.height), 2u);
+    }
+  }
+}
+
+// Every filter and precision against the float64 reference on random HDR input at an odd size.
+// Tolerances (issue 2): fp32 intermediates 1e-3 relative L2 (fp32 arithmetic lands far below);
+// fp16 5e-3 (each fp16 store rounds by up to 2^-11 relative, and the chain stores ~2N times).
+TEST_F(BloomTest, MatchesReferenceForEveryFilterAndPrecision) {
+  const CpuImage input = random_hdr(97, 61, 7);
+  for (BloomFilter filter : kFilters) {
+    for (Precision precision : {Precision::fp32, Precision::fp16}) {
+      for (VkFormat format : {kF32, kF16}) {
+        BloomConfig config;
+        config.filter = filter;
+        config.precision = precision;
+        config.iterations = 4;
+        config.radius = 1.3f;
+        config.intensity = 0.8f;
+        const CpuImage gpu = run_bloom(config, input, format, format);
+        ASSERT_TRUE(all_finite(gpu)) << "unwritten (poisoned) texels remain";
+        const auto ref = reference::bloom(as_stored(input, format), config);
+        const double err = reference::relative_l2(gpu, ref);
+        const double tol = (precision == Precision::fp32 && format == kF32) ? 1e-3 : 5e-3;
+        EXPECT_LT(err, tol) << filter_name(filter) << (precision == Precision::fp16 ? " fp16" : " fp32")
+                            << (format == kF16 ? " RGBA16F io" : " RGBA32F io");
+        // Alpha passes through untouched.
+        const CpuImage stored = as_stored(input, format);
+        for (size_t i = 3; i < gpu.rgba.size(); i += 4) ASSERT_EQ(gpu.rgba[i], stored.rgba[i]);
+      }
+    }
+  }
+}
+
+// The error must come from the bloom, not be hidden by it: a wrong threshold is caught.
+TEST_F(BloomTest, ReferenceComparisonDetectsAWrongParameter) {
+  const CpuImage input = random_hdr(64, 48, 11, 0.05f);
+  BloomConfig config;
+  config.intensity = 1.0f;
+  const CpuImage gpu = run_bloom(config, input);
+  BloomConfig other = config;
+  other.threshold = 1.2f;
+  EXPECT_GT(reference::relative_l2(gpu, reference::bloom(input, other)), 1e-3);
+  EXPECT_LT(reference::relative_l2(gpu, reference::bloom(input, config)), 1e-3);
+}
+
+TEST_F(BloomTest, AllSizesWorkAndMatchTheReference) {
+  const VkExtent2D sizes[] = {{320, 240}, {640, 480}, {1280, 720}, {1920, 1080}, {64, 64}, {3, 5}, {1, 1}, {1, 9}, {9, 1}};
+  Bloom bloom(context());  // one object, resized each time
+  for (VkExtent2D s : sizes) {
+    const CpuImage input = random_hdr(s.width, s.height, s.width * 31 + s.height, 0.01f);
+    const CpuImage gpu = run_bloom(bloom, input, kF16, kF16);
+    ASSERT_TRUE(all_finite(gpu)) << s.width << "x" << s.height;
+    const double err = reference::relative_l2(gpu, reference::bloom(as_stored(input, kF16), bloom.config()));
+    EXPECT_LT(err, 5e-3) << s.width << "x" << s.height;
+  }
+}
+
+TEST_F(BloomTest, ZeroIntensityCopiesBitForBit) {
+  const CpuImage input = random_hdr(33, 17, 3);
+  BloomConfig config;
+  config.intensity = 0.0f;
+  for (VkFormat format : {kF16, kF32}) {
+    const CpuImage stored = as_stored(input, format);
+    const CpuImage gpu = run_bloom(config, input, format, format);
+    ASSERT_EQ(0, std::memcmp(gpu.rgba.data(), stored.rgba.data(), stored.rgba.size() * 4));
+  }
+  // In place with intensity 0 records nothing: the image is unchanged and keeps its state.
+  auto img = make_image(input, kF32);
+  const Image before = img.state;
+  Bloom bloom(context(), config);
+  context().run_once([&](VkCommandBuffer cmd) { bloom.record(cmd, img.state, img.state); });
+  EXPECT_EQ(img.state.layout, before.layout);
+  const CpuImage after = detail::download(context(), img.state);
+  EXPECT_EQ(0, std::memcmp(after.rgba.data(), input.rgba.data(), input.rgba.size() * 4));
+}
+
+TEST_F(BloomTest, DimPixelsFarFromBrightOnesAreUnchanged) {
+  // Random dim background (luma < threshold - knee = 0.5) and one bright pixel near a corner.
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> dim(0.0f, 0.45f);
+  CpuImage input(640, 360);
+  for (float& v : input.rgba) v = dim(rng);
+  for (int c = 0; c < 3; ++c) input.at(10, 10)[c] = 500.0f;
+  for (BloomFilter filter : kFilters) {
+    BloomConfig config;
+    config.filter = filter;
+    const CpuImage gpu = run_bloom(config, input);
+    // Footprint of 5 levels at radius 1 (docs/BLOOM.md taps): each downsample reaches 3.5 source
+    // texels, 3.5 * (1 + 2 + ... + 16) * 2 = 217 px at most; each upsample reaches radius + 1 texels
+    // of the smaller level, 2 * (4 + 8 + 16 + 32) + 4 = 124 px. 260 px is beyond both.
+    size_t changed_far = 0, changed_near = 0;
+    for (uint32_t y = 0; y < input.height; ++y)
+      for (uint32_t x = 0; x < input.width; ++x) {
+        const bool differs = std::memcmp(gpu.at(x, y), input.at(x, y), 16) != 0;
+        const bool far = x > 260 || y > 260;
+        (far ? changed_far : changed_near) += differs;
+      }
+    EXPECT_EQ(changed_far, 0u) << filter_name(filter);
+    EXPECT_GT(changed_near, 100u) << filter_name(filter) << ": the bright pixel must bloom";
+  }
+}
+
+// The seed's bug was a vertical streak: the glow of a point must be as wide as it is tall.
+TEST_F(BloomTest, PointSourceGlowIsRadiallySymmetric) {
+  const uint32_t n = 257;
+  const CpuImage input = point_source(n, n, 128, 128, 1000.0f);
+  for (BloomFilter filter : kFilters) {
+    BloomConfig config;
+    config.filter = filter;
+    config.intensity = 1.0f;
+    const CpuImage gpu = run_bloom(config, input);
+    const Moments m = moments(added_light(gpu, input), n, n, 128, 128);
+    EXPECT_GT(m.energy, 0.0);
+    EXPECT_NEAR(m.xx / m.yy, 1.0, 0.02) << filter_name(filter) << " xx=" << m.xx << " yy=" << m.yy;
+  }
+}
+
+TEST_F(BloomTest, BrighterSourceGivesMoreBloomEnergy) {
+  double last = 0.0;
+  for (float value : {2.0f, 10.0f, 100.0f, 900.0f}) {
+    const CpuImage input = point_source(129, 129, 64, 64, value);
+    BloomConfig config;
+    const Moments m = moments(added_light(run_bloom(config, input), input), 129, 129, 64, 64);
+    EXPECT_GT(m.energy, last) << "brightness " << value;
+    last = m.energy;
+  }
+}
+
+TEST_F(BloomTest, LargerRadiusGivesWiderGlow) {
+  const CpuImage input = point_source(129, 129, 64, 64, 500.0f);
+  for (BloomFilter filter : kFilters) {
+    double last = 0.0;
+    for (float radius : {0.5f, 1.0f, 2.0f, 3.0f}) {
+      BloomConfig config;
+      config.filter = filter;
+      config.radius = radius;
+      const Moments m = moments(added_light(run_bloom(config, input), input), 129, 129, 64, 64);
+      EXPECT_GT(m.xx + m.yy, last * 1.02) << filter_name(filter) << " radius " << radius;
+      last = m.xx + m.yy;
+    }
+  }
+}
+
+TEST_F(BloomTest, UniformImageStaysUniformAtOddSizes) {
+  const VkExtent2D sizes[] = {{99, 37}, {3, 5}, {1, 1}, {641, 479}, {2, 7}};
+  for (BloomFilter filter : kFilters) {
+    for (VkExtent2D s : sizes) {
+      CpuImage input(s.width, s.height, 3.0f);
+      BloomConfig config;
+      config.filter = filter;
+      const CpuImage gpu = run_bloom(config, input);
+      float lo = gpu.rgba[0], hi = gpu.rgba[0];
+      for (size_t i = 0; i < gpu.rgba.size(); i += 4) {
+        lo = std::min(lo, gpu.rgba[i]);
+        hi = std::max(hi, gpu.rgba[i]);
+      }
+      // Bloom adds intensity * prefilter(3) = 0.3 * 2 = 0.6; fp16 levels round to ~1e-3.
+      EXPECT_LE(hi - lo, 2e-3f) << filter_name(filter) << " " << s.width << "x" << s.height;
+      EXPECT_NEAR(lo, 3.6f, 5e-3f) << filter_name(filter) << " " << s.width << "x" << s.height;
+    }
+  }
+}
+
+TEST_F(BloomTest, InPlaceEqualsOutOfPlace) {
+  const CpuImage input = random_hdr(80, 50, 21);
+  BloomConfig config;
+  const CpuImage separate = run_bloom(config, input, kF16, kF16);
+  auto img = make_image(input, kF16);
+  Bloom bloom(context(), config);
+  context().run_once([&](VkCommandBuffer cmd) { bloom.record(cmd, img.state, img.state); });
+  const CpuImage in_place = detail::download(context(), img.state);
+  EXPECT_EQ(0, std::memcmp(in_place.rgba.data(), separate.rgba.data(), separate.rgba.size() * 4));
+}
+
+TEST_F(BloomTest, RecordingAgainCreatesNoVulkanObject) {
+  const CpuImage input = random_hdr(64, 40, 2);
+  auto in = make_image(input, kF16);
+  auto out = make_poisoned({64, 40}, kF16);
+  Bloom bloom(context());
+  bloom.prepare({64, 40});
+  context().run_once([&](VkCommandBuffer cmd) { bloom.record(cmd, in.state, out.state); });
+  const uint64_t before = context().objects_created();
+  context().run_once([&](VkCommandBuffer cmd) {
+    bloom.record(cmd, in.state, out.state);
+    bloom.record(cmd, in.state, out.state);
+  });
+  EXPECT_EQ(context().objects_created(), before);
+  // Per-frame changes (threshold, intensity, radius) rebuild nothing either.
+  BloomConfig c = bloom.config();
+  c.threshold = 2.0f;
+  c.intensity = 0.7f;
+  c.radius = 2.0f;
+  bloom.set_config(c);
+  context().run_once([&](VkCommandBuffer cmd) { bloom.record(cmd, in.state, out.state); });
+  EXPECT_EQ(context().objects_created(), before);
+}
+
+TEST_F(BloomTest, ResizeAndShapeChangesRebuildAndStayCorrect) {
+  Bloom bloom(context());
+  for (VkExtent2D s : {VkExtent2D{64, 64}, VkExtent2D{65, 33}, VkExtent2D{64, 64}}) {
+    const CpuImage input = random_hdr(s.width, s.height, s.width + s.height);
+    const CpuImage gpu = run_bloom(bloom, input, kF32, kF32);
+    EXPECT_LT(reference::relative_l2(gpu, reference::bloom(input, bloom.config())), 5e-3);
+  }
+  BloomConfig c = bloom.config();
+  c.filter = BloomFilter::gauss9;
+  c.precision = Precision::fp32;
+  c.iterations = 3;
+  bloom.set_config(c);
+  const CpuImage input = random_hdr(64, 64, 99);
+  EXPECT_LT(reference::relative_l2(run_bloom(bloom, input, kF32, kF32), reference::bloom(input, c)), 1e-3);
+}
+
+TEST_F(BloomTest, ProfilerReportsEveryStage) {
+  Profiler profiler(context());
+  Bloom bloom(context());
+  run_bloom(bloom, random_hdr(128, 96, 4), kF16, kF16, &profiler);
+  const auto stages = profiler.results();
+  ASSERT_EQ(stages.size(), 4u);
+  EXPECT_EQ(stages[0].label, "bloom bright-pass + down 0");
+  EXPECT_EQ(stages[3].label, "bloom composite");
+  for (const auto& s : stages) EXPECT_GE(s.ms, 0.0);
+  EXPECT_GT(profiler.total_ms(), 0.0);
+}
+
+// ---- bad input: a clear error naming the value and range, and nothing recorded ----------------
+
+TEST_F(BloomTest, InvalidConfigIsRejectedWithTheFieldNamed) {
+  struct Case {
+    const char* field;
+    BloomConfig config;
+  };
+  std::vector<Case> cases;
+  auto add = [&](const char* field, auto mutate) {
+    BloomConfig c;
+    mutate(c);
+    cases.push_back({field, c});
+  };
+  add("threshold", [](BloomConfig& c) { c.threshold = std::nanf(""); });
+  add("threshold", [](BloomConfig& c) { c.threshold = -1.0f; });
+  add("soft_knee", [](BloomConfig& c) { c.soft_knee = 1.5f; });
+  add("intensity", [](BloomConfig& c) { c.intensity = -0.1f; });
+  add("intensity", [](BloomConfig& c) { c.intensity = INFINITY; });
+  add("iterations", [](BloomConfig& c) { c.iterations = 0; });
+  add("iterations", [](BloomConfig& c) { c.iterations = 9; });
+  add("radius", [](BloomConfig& c) { c.radius = 0.0f; });
+  add("radius", [](BloomConfig& c) { c.radius = 5.0f; });
+  add("max_brightness", [](BloomConfig& c) { c.max_brightness = 1e5f; });
+  add("filter", [](BloomConfig& c) { c.filter = static_cast<BloomFilter>(7); });
+  add("precision", [](BloomConfig& c) { c.precision = static_cast<Precision>(3); });
+  for (const Case& c : cases) {
+    try {
+      Bloom bloom(context(), c.config);
+      ADD_FAILURE() << c.field << ": no error";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.code(), ErrorCode::invalid_argument);
+      EXPECT_NE(std::string(e.what()).find(c.field), std::string::npos) << e.what();
+      if (std::string(c.field) != "filter" && std::string(c.field) != "precision") {
+        EXPECT_NE(std::string(e.what()).find("accepted"), std::string::npos) << e.what();
+      }
+    }
+    Bloom bloom(context());
+    EXPECT_THROW(bloom.set_config(c.config), Error) << c.field;
+  }
+}
+
+TEST_F(BloomTest, BadImagesAreRejectedAndNothingIsRecorded) {
+  const CpuImage input = random_hdr(32, 32, 8);
+  auto in = make_image(input, kF16);
+  auto out = make_poisoned({32, 32}, kF16);
+  auto small = make_poisoned({16, 32}, kF16);
+  detail::OwnedImage unorm(context(), {32, 32}, VK_FORMAT_R8G8B8A8_UNORM, detail::kToolImageUsage);
+  detail::OwnedImage no_storage(context(), {32, 32}, kF16, VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT);
+  Bloom bloom(context());
+  struct Case {
+    const char* what;
+    Image in, out;
+    ErrorCode code;
+  };
+  Image zero = out.state;
+  zero.extent = {0, 32};
+  Image null_view = out.state;
+  null_view.view = VK_NULL_HANDLE;
+  const Case cases[] = {
+      {"unorm input", unorm.state, out.state, ErrorCode::unsupported_format},
+      {"unorm output", in.state, unorm.state, ErrorCode::unsupported_format},
+      {"output without storage", in.state, no_storage.state, ErrorCode::missing_usage},
+      {"size mismatch", in.state, small.state, ErrorCode::invalid_argument},
+      {"zero size", zero, zero, ErrorCode::unsupported_size},
+      {"null view", in.state, null_view, ErrorCode::invalid_argument},
+  };
+  for (const Case& c : cases) {
+    Image a = c.in, b = c.out;
+    const uint64_t objects = context().objects_created();
+    context().run_once([&](VkCommandBuffer cmd) {
+      try {
+        bloom.record(cmd, a, b);
+        ADD_FAILURE() << c.what << ": no error";
+      } catch (const Error& e) {
+        EXPECT_EQ(e.code(), c.code) << c.what << ": " << e.what();
+      }
+    });
+    EXPECT_EQ(context().objects_created(), objects) << c.what;
+    EXPECT_EQ(b.layout, c.out.layout) << c.what << ": state must be untouched";
+  }
+  // The output was never written: still all NaN.
+  const CpuImage after = detail::download(context(), out.state);
+  EXPECT_TRUE(std::all_of(after.rgba.begin(), after.rgba.end(), [](float v) { return std::isnan(v); }));
+}
+
+}  // namespace
+}  // namespace glint::test

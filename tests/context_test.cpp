@@ -1,0 +1,172 @@
+// Context: device listing and selection, the adopted path (an engine's own device and command
+// buffer), and proof that the validation layer is really listening.
+#include <glint/bloom.h>
+
+#include <cstdlib>
+#include <cstring>
+
+#include "core/context_state.h"
+#include "reference/bloom_reference.h"
+#include "support/gpu_test.h"
+
+namespace glint::test {
+namespace {
+
+class ContextTest : public GpuTest {};
+
+TEST_F(ContextTest, ListsDevicesAndSelectsByNameAndIndex) {
+  const auto devices = list_devices();
+  ASSERT_FALSE(devices.empty());
+  ContextOptions by_index;
+  by_index.device = "0";
+  EXPECT_EQ(Context::create(by_index).info().name, devices[0].name);
+  ContextOptions by_name;
+  by_name.device = devices[0].name.substr(0, 4);
+  EXPECT_EQ(Context::create(by_name).info().name.substr(0, 4), devices[0].name.substr(0, 4));
+}
+
+TEST_F(ContextTest, UnknownDeviceIsAClearError) {
+  ContextOptions options;
+  options.device = "no-such-gpu-xyz";
+  try {
+    Context::create(options);
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::no_device);
+    EXPECT_NE(std::string(e.what()).find("no-such-gpu-xyz"), std::string::npos);
+  }
+  options.device = "99";
+  EXPECT_THROW(Context::create(options), Error);
+}
+
+// The validation layer reports a deliberately invalid call: without this, "no messages" could
+// mean "no layer". The messages it provokes are expected, so the fixture's count is reset.
+TEST(ContextValidation, ValidationLayerCatchesAnInvalidCall) {
+  const Context& ctx = context();
+  const uint32_t before = ctx.validation_messages();
+  VkBufferCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+  info.size = 0;  // VUID-VkBufferCreateInfo-size-00912: size must be greater than 0
+  info.usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+  VkBuffer buffer = VK_NULL_HANDLE;
+  VkResult r = vkCreateBuffer(ctx.device(), &info, nullptr, &buffer);
+  if (r == VK_SUCCESS && buffer) vkDestroyBuffer(ctx.device(), buffer, nullptr);
+  EXPECT_GT(ctx.validation_messages(), before);
+}
+
+// An engine creates its own instance, device, pool and command buffer; glint adopts them, records
+// bloom, and the engine submits. glint must submit nothing itself.
+TEST_F(ContextTest, AdoptedDeviceRunsBloomInTheEnginesCommandBuffer) {
+  const Context& mine = context();  // borrow its instance and physical device, make a new device
+  const uint32_t family = mine.queue_family_index();
+  VkPhysicalDeviceVulkan13Features f13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
+  f13.synchronization2 = VK_TRUE;
+  f13.maintenance4 = VK_TRUE;  // glint kernels take their workgroup size from specialization (LocalSizeId)
+  float priority = 1.0f;
+  VkDeviceQueueCreateInfo q{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
+  q.queueFamilyIndex = family;
+  q.queueCount = 1;
+  q.pQueuePriorities = &priority;
+  VkDeviceCreateInfo di{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
+  di.pNext = &f13;
+  di.queueCreateInfoCount = 1;
+  di.pQueueCreateInfos = &q;
+  VkDevice device = VK_NULL_HANDLE;
+  ASSERT_EQ(vkCreateDevice(mine.physical_device(), &di, nullptr, &device), VK_SUCCESS);
+  VkQueue queue;
+  vkGetDeviceQueue(device, family, 0, &queue);
+  VkCommandPoolCreateInfo pi{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+  pi.queueFamilyIndex = family;
+  VkCommandPool pool;
+  ASSERT_EQ(vkCreateCommandPool(device, &pi, nullptr, &pool), VK_SUCCESS);
+  {
+    Context engine = Context::adopt({mine.instance(), mine.physical_device(), device, family});
+    EXPECT_TRUE(engine.is_adopted());
+    EXPECT_THROW(engine.run_once([](VkCommandBuffer) {}), Error);
+
+    // Images live on the engine's device; uploads go through a staging buffer we copy ourselves.
+    const CpuImage input = random_hdr(48, 32, 17);
+    detail::OwnedImage in(engine, {48, 32}, VK_FORMAT_R32G32B32A32_SFLOAT, detail::kToolImageUsage);
+    detail::OwnedImage out(engine, {48, 32}, VK_FORMAT_R32G32B32A32_SFLOAT, detail::kToolImageUsage);
+    detail::OwnedBuffer up(engine, input.rgba.size() * 4, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, true);
+    detail::OwnedBuffer down(engine, input.rgba.size() * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true);
+    std::memcpy(up.mapped(), input.rgba.data(), input.rgba.size() * 4);
+    up.flush();
+
+    Bloom bloom(engine);
+    VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+    ai.commandPool = pool;
+    ai.commandBufferCount = 1;
+    VkCommandBuffer cmd;
+    ASSERT_EQ(vkAllocateCommandBuffers(device, &ai, &cmd), VK_SUCCESS);
+    VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+    vkBeginCommandBuffer(cmd, &bi);
+    VkBufferImageCopy region{};
+    region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+    region.imageExtent = {48, 32, 1};
+    VkImageMemoryBarrier2 to_dst{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
+    to_dst.dstStageMask = VK_PIPELINE_STAGE_2_COPY_BIT;
+    to_dst.dstAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;
+    to_dst.newLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
+    to_dst.image = in.state.image;
+    to_dst.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+    VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+    dep.imageMemoryBarrierCount = 1;
+    dep.pImageMemoryBarriers = &to_dst;
+    vkCmdPipelineBarrier2(cmd, &dep);
+    vkCmdCopyBufferToImage(cmd, up.buffer(), in.state.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
+    // Tell glint how the engine last used the images.
+    in.state.layout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
+    in.state.stage = VK_PIPELINE_STAGE_2_COPY_BIT;
+    in.state.access = VK_ACCESS_2_TRANSFER_WRITE_BIT;
+    bloom.record(cmd, in.state, out.state);
+    // glint documents the output's state after record(): GENERAL, written by compute.
+    EXPECT_EQ(out.state.layout, VK_IMAGE_LAYOUT_GENERAL);
+    VkImageMemoryBarrier2 to_src{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
+    to_src.srcStageMask = out.state.stage;
+    to_src.srcAccessMask = out.state.access;
+    to_src.dstStageMask = VK_PIPELINE_STAGE_2_COPY_BIT;
+    to_src.dstAccessMask = VK_ACCESS_2_TRANSFER_READ_BIT;
+    to_src.oldLayout = out.state.layout;
+    to_src.newLayout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
+    to_src.image = out.state.image;
+    to_src.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+    dep.pImageMemoryBarriers = &to_src;
+    vkCmdPipelineBarrier2(cmd, &dep);
+    vkCmdCopyImageToBuffer(cmd, out.state.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, down.buffer(), 1, &region);
+    VkMemoryBarrier2 host{VK_STRUCTURE_TYPE_MEMORY_BARRIER_2};
+    host.srcStageMask = VK_PIPELINE_STAGE_2_COPY_BIT;
+    host.srcAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;
+    host.dstStageMask = VK_PIPELINE_STAGE_2_HOST_BIT;
+    host.dstAccessMask = VK_ACCESS_2_HOST_READ_BIT;
+    VkDependencyInfo hdep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+    hdep.memoryBarrierCount = 1;
+    hdep.pMemoryBarriers = &host;
+    vkCmdPipelineBarrier2(cmd, &hdep);
+    vkEndCommandBuffer(cmd);
+    VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+    si.commandBufferCount = 1;
+    si.pCommandBuffers = &cmd;
+    ASSERT_EQ(vkQueueSubmit(queue, 1, &si, VK_NULL_HANDLE), VK_SUCCESS);
+    ASSERT_EQ(vkQueueWaitIdle(queue), VK_SUCCESS);
+    down.invalidate();
+    CpuImage result(48, 32);
+    std::memcpy(result.rgba.data(), down.mapped(), result.rgba.size() * 4);
+    EXPECT_LT(reference::relative_l2(result, reference::bloom(input, bloom.config())), 1e-3);
+  }
+  vkDestroyCommandPool(device, pool, nullptr);
+  vkDestroyDevice(device, nullptr);
+}
+
+TEST_F(ContextTest, AdoptRejectsNullHandlesAndBadQueueFamily) {
+  EXPECT_THROW(Context::adopt({}), Error);
+  const Context& mine = context();
+  try {
+    Context::adopt({mine.instance(), mine.physical_device(), mine.device(), 1000});
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("queue_family_index"), std::string::npos);
+  }
+}
+
+}  // namespace
+}  // namespace glint::test

@@ -1,0 +1,844 @@
+// Tests of the float64 bloom reference (host/reference/bloom_reference.h) on its own: CPU only,
+// no Vulkan. Hand-computed values check the formulas of docs/BLOOM.md stage by stage; property
+// tests (uniformity, symmetry, monotonicity, locality) check the assembled pipeline on random
+// inputs from fixed seeds.
+#include "reference/bloom_reference.h"
+
+#include "core/half.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <random>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace glint::reference {
+namespace {
+
+constexpr BloomFilter kFilters[] = {BloomFilter::cod13, BloomFilter::dual, BloomFilter::gauss9};
+
+std::string name_of(BloomFilter f) {
+  switch (f) {
+    case BloomFilter::cod13:
+      return "cod13";
+    case BloomFilter::dual:
+      return "dual";
+    case BloomFilter::gauss9:
+      return "gauss9";
+  }
+  return "?";
+}
+
+// A config whose prefilter is the identity for any texel with luma >= 1e-4 (threshold 0, knee 0:
+// factor = max(l, 0) / max(l, 1e-4) = 1), so downsample and blur can be checked in isolation.
+BloomConfig identity_prefilter_config(BloomFilter filter) {
+  BloomConfig c;
+  c.threshold = 0.0f;
+  c.soft_knee = 0.0f;
+  c.filter = filter;
+  c.firefly_guard = false;
+  c.iterations = 1;
+  return c;
+}
+
+// Random RGB in [lo, hi] per channel, alpha in [0, 1].
+CpuImage random_image(uint32_t w, uint32_t h, uint32_t seed, float lo, float hi) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> rgb(lo, hi), alpha(0.0f, 1.0f);
+  CpuImage img(w, h);
+  for (size_t i = 0; i < img.rgba.size(); i += 4) {
+    img.rgba[i] = rgb(rng);
+    img.rgba[i + 1] = rgb(rng);
+    img.rgba[i + 2] = rgb(rng);
+    img.rgba[i + 3] = alpha(rng);
+  }
+  return img;
+}
+
+// Random RGB in [0.1, 1] on a 1/1024 grid, so that adding 1, 2 or 0.5 in float is exact and an
+// impulse added on top of it is exactly the intended one.
+CpuImage gridded_background(uint32_t w, uint32_t h, uint32_t seed) {
+  CpuImage img = random_image(w, h, seed, 0.1f, 1.0f);
+  for (float& v : img.rgba) v = std::round(v * 1024.0f) / 1024.0f;
+  return img;
+}
+
+// Non-constant background whose luma is below threshold - knee of the default config (1 - 0.5):
+// every channel is at most 0.45, so luma <= 0.45 and the prefilter gives exactly 0 there.
+CpuImage dark_background(uint32_t w, uint32_t h, uint32_t seed) { return random_image(w, h, seed, 0.0f, 0.45f); }
+
+// Random HDR: channels log-uniform over [e^-4, e^5] (0.018 to 148), a few texels up to 900.
+CpuImage random_hdr(uint32_t w, uint32_t h, uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> expo(-4.0f, 5.0f), u(0.0f, 1.0f);
+  CpuImage img(w, h);
+  for (size_t i = 0; i < img.rgba.size(); i += 4) {
+    const float boost = u(rng) < 0.01f ? 6.0f : 1.0f;
+    for (size_t k = 0; k < 3; ++k) img.rgba[i + k] = boost * std::exp(expo(rng));
+    img.rgba[i + 3] = u(rng);
+  }
+  return img;
+}
+
+void set_rgb(CpuImage& img, uint32_t x, uint32_t y, float r, float g, float b) {
+  float* p = img.at(x, y);
+  p[0] = r;
+  p[1] = g;
+  p[2] = b;
+}
+
+// The light bloom added at each pixel, summed over RGB: out - in.
+std::vector<double> added_light(const DoubleImage& out, const CpuImage& in) {
+  std::vector<double> added(size_t(in.width) * in.height);
+  for (size_t p = 0; p < added.size(); ++p)
+    for (size_t k = 0; k < 3; ++k) added[p] += out.rgba[p * 4 + k] - double(in.rgba[p * 4 + k]);
+  return added;
+}
+
+double total(const std::vector<double>& v) {
+  double s = 0.0;
+  for (double x : v) s += x;
+  return s;
+}
+
+// Centroid and central second moments of the added light.
+struct Glow {
+  double energy = 0, cx = 0, cy = 0, mxx = 0, myy = 0, mxy = 0;
+};
+
+Glow glow_of(const DoubleImage& out, const CpuImage& in) {
+  const std::vector<double> added = added_light(out, in);
+  Glow g;
+  for (uint32_t y = 0; y < in.height; ++y)
+    for (uint32_t x = 0; x < in.width; ++x) {
+      const double l = added[size_t(y) * in.width + x];
+      g.energy += l;
+      g.cx += l * x;
+      g.cy += l * y;
+    }
+  g.cx /= g.energy;
+  g.cy /= g.energy;
+  for (uint32_t y = 0; y < in.height; ++y)
+    for (uint32_t x = 0; x < in.width; ++x) {
+      const double l = added[size_t(y) * in.width + x];
+      g.mxx += l * (x - g.cx) * (x - g.cx);
+      g.myy += l * (y - g.cy) * (y - g.cy);
+      g.mxy += l * (x - g.cx) * (y - g.cy);
+    }
+  g.mxx /= g.energy;
+  g.myy /= g.energy;
+  g.mxy /= g.energy;
+  return g;
+}
+
+CpuImage to_float(const DoubleImage& d) {
+  CpuImage img(d.width, d.height);
+  for (size_t i = 0; i < d.rgba.size(); ++i) img.rgba[i] = static_cast<float>(d.rgba[i]);
+  return img;
+}
+
+bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+std::array<double, 3> prefiltered(const BloomConfig& config, double r, double g, double b) {
+  const double in[3] = {r, g, b};
+  std::array<double, 3> out{};
+  prefilter(config, in, out.data());
+  return out;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Luma and prefilter
+
+TEST(BloomReferenceLuma, Rec709Weights) {
+  EXPECT_DOUBLE_EQ(luma(1, 0, 0), 0.2126);
+  EXPECT_DOUBLE_EQ(luma(0, 1, 0), 0.7152);
+  EXPECT_DOUBLE_EQ(luma(0, 0, 1), 0.0722);
+  EXPECT_NEAR(luma(2, 4, 1), 3.3582, 1e-12);
+}
+
+TEST(BloomReferencePrefilter, BelowThresholdMinusKneeIsExactlyZero) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  struct Case {
+    float threshold, soft_knee;
+  };
+  for (const Case c : {Case{1.0f, 0.5f}, Case{2.0f, 0.25f}, Case{1.0f, 0.0f}, Case{5.0f, 1.0f}}) {
+    BloomConfig config;
+    config.threshold = c.threshold;
+    config.soft_knee = c.soft_knee;
+    const double edge = double(c.threshold) * (1.0 - double(c.soft_knee));  // threshold - knee
+    for (int i = 0; i < 2000; ++i) {
+      // A random colour scaled to a random luma strictly below the edge.
+      double rgb[3] = {u(rng), u(rng), u(rng)};
+      const double target = edge * u(rng) * 0.9999;
+      const double scale = target / luma(rgb[0], rgb[1], rgb[2]);
+      for (double& v : rgb) v *= scale;
+      const auto out = prefiltered(config, rgb[0], rgb[1], rgb[2]);
+      ASSERT_EQ(out[0], 0.0) << "t=" << c.threshold << " knee=" << c.soft_knee << " luma " << target;
+      ASSERT_EQ(out[1], 0.0);
+      ASSERT_EQ(out[2], 0.0);
+    }
+  }
+}
+
+TEST(BloomReferencePrefilter, WellAboveKneeScalesByExcessOverLuma) {
+  BloomConfig config;  // threshold 1, knee 0.5: the knee ends at luma 1.5
+  // Hand-computed: luma(2, 4, 1) = 3.3582, factor = (3.3582 - 1) / 3.3582 = 0.70222142814603.
+  const auto out = prefiltered(config, 2, 4, 1);
+  EXPECT_NEAR(out[0], 1.40444285629206, 1e-12);
+  EXPECT_NEAR(out[1], 2.80888571258412, 1e-12);
+  EXPECT_NEAR(out[2], 0.70222142814603, 1e-12);
+  // Grey 4: factor 3/4.
+  const auto grey = prefiltered(config, 4, 4, 4);
+  for (double v : grey) EXPECT_NEAR(v, 3.0, 1e-12);
+
+  // Random colours with luma well above threshold + knee.
+  std::mt19937 rng(12);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (int i = 0; i < 1000; ++i) {
+    double rgb[3] = {u(rng), u(rng), u(rng)};
+    const double l = 1.6 + 50.0 * u(rng);
+    const double s = l / (0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2]);
+    for (double& v : rgb) v *= s;
+    const auto o = prefiltered(config, rgb[0], rgb[1], rgb[2]);
+    for (int k = 0; k < 3; ++k) ASSERT_NEAR(o[size_t(k)], rgb[k] * (l - 1.0) / l, 1e-9 * rgb[k]);
+  }
+}
+
+TEST(BloomReferencePrefilter, InsideKneeFollowsQuadraticCurve) {
+  BloomConfig config;  // threshold 1, knee 0.5
+  // Grey g has luma g, and the output of a grey is the contribution itself:
+  // luma 1:    soft = 0.5,  contribution = 0.25 / 2.0001   = 0.124993750312484
+  // luma 0.75: soft = 0.25, contribution = 0.0625 / 2.0001 = 0.031248437578121
+  for (double v : prefiltered(config, 1, 1, 1)) EXPECT_NEAR(v, 0.124993750312484, 1e-12);
+  for (double v : prefiltered(config, 0.75, 0.75, 0.75)) EXPECT_NEAR(v, 0.031248437578121, 1e-12);
+}
+
+TEST(BloomReferencePrefilter, ContinuousAndMonotonicAcrossTheKnee) {
+  BloomConfig config;
+  config.threshold = 2.0f;
+  config.soft_knee = 0.5f;  // knee 1: curve between luma 1 and 3
+  // For a grey the output luma is max(l - t, contribution), whose slope is at most 1: over a
+  // step h the output may not jump by more than h, and it never decreases.
+  const double h = 1e-4;
+  double prev = 0.0;
+  for (double g = 0.0; g <= 5.0; g += h) {
+    const auto o = prefiltered(config, g, g, g);
+    const double l = luma(o[0], o[1], o[2]);
+    ASSERT_GE(l, prev) << "at grey " << g;
+    ASSERT_LE(l - prev, 1.0001 * h) << "jump at grey " << g;
+    prev = l;
+  }
+  // Both edges of the knee, approached from either side.
+  for (double edge : {1.0, 3.0}) {
+    const double d = 1e-7;
+    const auto below = prefiltered(config, edge - d, edge - d, edge - d);
+    const auto above = prefiltered(config, edge + d, edge + d, edge + d);
+    EXPECT_NEAR(below[1], above[1], 3 * d) << "edge " << edge;
+  }
+  // Past the upper edge the line l - t takes over: at luma 3 the output is 1 (not 4/(4.0001)).
+  const auto at3 = prefiltered(config, 3.0 + 1e-9, 3.0 + 1e-9, 3.0 + 1e-9);
+  EXPECT_NEAR(at3[0], 1.0, 1e-8);
+}
+
+TEST(BloomReferencePrefilter, SanitizesNaNNegativeAndInf) {
+  BloomConfig config = identity_prefilter_config(BloomFilter::cod13);
+  config.max_brightness = 1000.0f;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  const auto a = prefiltered(config, nan, -3.0, inf);
+  EXPECT_EQ(a[0], 0.0);
+  EXPECT_EQ(a[1], 0.0);
+  EXPECT_DOUBLE_EQ(a[2], 1000.0);
+  const auto b = prefiltered(config, 5000.0, 1.0, -inf);
+  EXPECT_DOUBLE_EQ(b[0], 1000.0);
+  EXPECT_DOUBLE_EQ(b[1], 1.0);
+  EXPECT_EQ(b[2], 0.0);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Mip chain and the individual filters
+
+TEST(BloomReferenceLevels, MipChainSizesAndClamp) {
+  struct Case {
+    uint32_t w, h, iterations;
+    std::vector<std::pair<uint32_t, uint32_t>> sizes;
+  };
+  const std::vector<Case> cases = {
+      {1920, 1080, 5, {{960, 540}, {480, 270}, {240, 135}, {120, 67}, {60, 33}}},
+      {3, 5, 5, {{1, 2}}},
+      {1, 1, 5, {{1, 1}}},
+      {1, 40, 5, {{1, 20}}},
+      {40, 1, 5, {{20, 1}}},
+      {16, 16, 8, {{8, 8}, {4, 4}, {2, 2}}},
+      {17, 9, 5, {{8, 4}, {4, 2}}},
+      {5, 5, 1, {{2, 2}}},
+  };
+  for (const Case& c : cases) {
+    BloomConfig config;
+    config.iterations = c.iterations;
+    const auto levels = downsampled_levels(random_image(c.w, c.h, 21, 0.0f, 2.0f), config);
+    ASSERT_EQ(levels.size(), c.sizes.size()) << c.w << "x" << c.h;
+    for (size_t k = 0; k < levels.size(); ++k) {
+      EXPECT_EQ(levels[k].width, c.sizes[k].first) << c.w << "x" << c.h << " level " << k;
+      EXPECT_EQ(levels[k].height, c.sizes[k].second) << c.w << "x" << c.h << " level " << k;
+      EXPECT_EQ(levels[k].rgba.size(), size_t(levels[k].width) * levels[k].height * 4);
+    }
+  }
+}
+
+// Level 0 of (random background + colour impulse at one texel) minus level 0 of the background
+// alone: with an identity prefilter and no Karis guard the downsample is linear, so the difference
+// is the filter's impulse response times the colour, which is hand-computed below.
+std::vector<double> level0_impulse_response(BloomFilter filter, uint32_t w, uint32_t h, uint32_t px, uint32_t py,
+                                            uint32_t seed) {
+  const BloomConfig config = identity_prefilter_config(filter);
+  const CpuImage bg = gridded_background(w, h, seed);
+  CpuImage with = bg;
+  float* t = with.at(px, py);
+  t[0] += 1.0f;
+  t[1] += 2.0f;
+  t[2] += 0.5f;
+  const DoubleImage a = downsampled_levels(with, config)[0];
+  const DoubleImage b = downsampled_levels(bg, config)[0];
+  std::vector<double> diff(a.rgba.size());
+  for (size_t i = 0; i < diff.size(); ++i) diff[i] = a.rgba[i] - b.rgba[i];
+  return diff;
+}
+
+void expect_response(const std::vector<double>& diff, uint32_t width, const std::vector<double>& expected,
+                     const char* what) {
+  // Colour (1, 2, 0.5) times the scalar response.
+  const double colour[3] = {1.0, 2.0, 0.5};
+  ASSERT_EQ(diff.size(), expected.size() * 4);
+  for (size_t p = 0; p < expected.size(); ++p)
+    for (size_t k = 0; k < 3; ++k)
+      EXPECT_NEAR(diff[p * 4 + k], expected[p] * colour[k], 1e-12)
+          << what << " texel (" << p % width << ", " << p / width << ") channel " << k;
+}
+
+TEST(BloomReferenceLevels, Cod13DownsampleImpulseResponse) {
+  // 8x8 -> 4x4, impulse at (4, 4). Texel (x, y) samples at (2x + 0.5, 2y + 0.5) + offsets; a tap
+  // at a half-integer next to texel 4 gives it weight 1/2 per axis. Worked out per texel from the
+  // centre box (weight 0.5) and the four corner boxes (0.125 each).
+  const std::vector<double> expected = {
+      0, 0,         0,        0,          //
+      0, 0.0390625, 0.046875, 0.0078125,  //
+      0, 0.046875,  0.0625,   0.015625,   //
+      0, 0.0078125, 0.015625, 0.0078125,  //
+  };
+  expect_response(level0_impulse_response(BloomFilter::cod13, 8, 8, 4, 4, 31), 4, expected, "cod13");
+}
+
+TEST(BloomReferenceLevels, DualDownsampleImpulseResponse) {
+  // (4 bilinear(p) + diagonals) / 8 at p = (2x + 0.5, 2y + 0.5): texel (2,2) gets (4/4 + 1/4) / 8;
+  // (1,1), (1,2), (2,1) get one diagonal tap of weight 1/4, i.e. 1/32.
+  const std::vector<double> expected = {
+      0, 0,       0,       0,  //
+      0, 0.03125, 0.03125, 0,  //
+      0, 0.03125, 0.15625, 0,  //
+      0, 0,       0,       0,  //
+  };
+  expect_response(level0_impulse_response(BloomFilter::dual, 8, 8, 4, 4, 32), 4, expected, "dual");
+}
+
+TEST(BloomReferenceLevels, Gauss9AreaDownsampleThenBlur) {
+  // 32x1 -> level 0 is 16x1 (the only level). Raising source texels 16 and 17 by the colour raises
+  // level texel 8's area average by the colour; the horizontal blur at radius 1 then spreads it as
+  // the 9 weights, and the vertical blur of a 1-row level is the identity (weights sum to 1).
+  const double w[5] = {0.2270270270, 0.1945945946, 0.1216216216, 0.0540540541, 0.0162162162};
+  for (float radius : {1.0f, 0.5f}) {
+    BloomConfig config = identity_prefilter_config(BloomFilter::gauss9);
+    config.radius = radius;
+    const CpuImage bg = gridded_background(32, 1, 33);
+    CpuImage with = bg;
+    for (uint32_t x : {16u, 17u}) {
+      float* t = with.at(x, 0);
+      t[0] += 1.0f;
+      t[1] += 2.0f;
+      t[2] += 0.5f;
+    }
+    const auto la = downsampled_levels(with, config);
+    const auto lb = downsampled_levels(bg, config);
+    ASSERT_EQ(la.size(), 1u);
+    ASSERT_EQ(la[0].width, 16u);
+    std::vector<double> diff(la[0].rgba.size());
+    for (size_t i = 0; i < diff.size(); ++i) diff[i] = la[0].rgba[i] - lb[0].rgba[i];
+    std::vector<double> expected(16, 0.0);
+    if (radius == 1.0f) {
+      for (int d = -4; d <= 4; ++d) expected[size_t(8 + d)] = w[std::abs(d)];
+    } else {
+      // Taps at half-texel offsets read linear interpolations; hat(q) = max(0, 1 - |q - 8|).
+      // d = 0: w0 + w1 (hat(8.5) + hat(7.5));  d = 1: 0.5 w1 (8.5) + w2 (8) + 0.5 w3 (7.5);
+      // d = 2: 0.5 w3 (8.5) + w4 (8);  d = 3: the nearest taps are 9 and 9.5: nothing.
+      expected[8] = w[0] + w[1];
+      expected[7] = expected[9] = 0.5 * w[1] + w[2] + 0.5 * w[3];
+      expected[6] = expected[10] = 0.5 * w[3] + w[4];
+    }
+    expect_response(diff, 16, expected, radius == 1.0f ? "gauss9 r=1" : "gauss9 r=0.5");
+  }
+}
+
+TEST(BloomReferenceLevels, KarisGuardWeightsBoxesByInverseLuma) {
+  // 2x1 -> 1x1 with gauss9: two boxes of overlap 1: texel 0 black, texel 1 grey 3 (luma 3).
+  // Guard off: mean 1.5. Guard on: (0 + 3/4) / (1/1 + 1/4) = 0.6.
+  CpuImage in(2, 1, 0.0f);
+  set_rgb(in, 1, 0, 3, 3, 3);
+  BloomConfig config = identity_prefilter_config(BloomFilter::gauss9);
+  config.firefly_guard = false;
+  const auto off = downsampled_levels(in, config);
+  config.firefly_guard = true;
+  const auto on = downsampled_levels(in, config);
+  ASSERT_EQ(on.size(), 1u);
+  for (size_t k = 0; k < 3; ++k) {
+    EXPECT_NEAR(off[0].rgba[k], 1.5, 1e-12);
+    EXPECT_NEAR(on[0].rgba[k], 0.6, 1e-12);
+  }
+  // The full bloom of that 1-level pyramid: out = in + intensity * 0.6 everywhere.
+  const DoubleImage out = bloom(in, config);
+  const double intensity = config.intensity;  // 0.3f, not exactly 0.3
+  EXPECT_NEAR(out.rgba[0], intensity * 0.6, 1e-12);
+  EXPECT_NEAR(out.rgba[4], 3.0 + intensity * 0.6, 1e-12);
+}
+
+TEST(BloomReferenceLevels, KarisGuardUsesLumaOfTheBoxMean) {
+  // Same 2x1 -> 1x1 setup with a coloured texel m: (m / (1 + l)) / (1 + 1 / (1 + l)) = m / (2 + l),
+  // l = luma(3, 0, 6) = 0.6378 + 0.4332 = 1.071.
+  CpuImage in(2, 1, 0.0f);
+  set_rgb(in, 1, 0, 3, 0, 6);
+  BloomConfig config = identity_prefilter_config(BloomFilter::gauss9);
+  config.firefly_guard = true;
+  const DoubleImage l0 = downsampled_levels(in, config)[0];
+  EXPECT_NEAR(l0.rgba[0], 3.0 / 3.071, 1e-12);
+  EXPECT_NEAR(l0.rgba[1], 0.0, 1e-12);
+  EXPECT_NEAR(l0.rgba[2], 6.0 / 3.071, 1e-12);
+}
+
+TEST(BloomReferenceLevels, Gauss9AreaDownsampleAtOddSize) {
+  // 5x1 -> 2x1: texel 0 covers [0, 2.5), texel 1 [2.5, 5), so source texel 2 is split in half:
+  // L0 = (a + b + c/2) / 2.5, L1 = (c/2 + d + e) / 2.5. The horizontal blur of a 2-texel level
+  // (radius 1, clamp to edge) reads L1 at every positive offset and L0 at every negative one:
+  // out0 = (w0 + S) L0 + S L1 and out1 = S L0 + (w0 + S) L1 with S = w1 + w2 + w3 + w4.
+  CpuImage in(5, 1, 0.0f);
+  const float v[5] = {1.0f, 2.0f, 4.0f, 8.0f, 0.5f};
+  for (uint32_t x = 0; x < 5; ++x) set_rgb(in, x, 0, v[x], 2 * v[x], v[4 - x]);
+  const BloomConfig config = identity_prefilter_config(BloomFilter::gauss9);
+  const auto levels = downsampled_levels(in, config);
+  ASSERT_EQ(levels.size(), 1u);
+  ASSERT_EQ(levels[0].width, 2u);
+  const double w0 = 0.2270270270, S = 0.1945945946 + 0.1216216216 + 0.0540540541 + 0.0162162162;
+  for (size_t k = 0; k < 3; ++k) {
+    const double c[5] = {in.at(0, 0)[k], in.at(1, 0)[k], in.at(2, 0)[k], in.at(3, 0)[k], in.at(4, 0)[k]};
+    const double l0 = (c[0] + c[1] + 0.5 * c[2]) / 2.5;
+    const double l1 = (0.5 * c[2] + c[3] + c[4]) / 2.5;
+    EXPECT_NEAR(levels[0].at(0, 0)[k], (w0 + S) * l0 + S * l1, 1e-9) << "channel " << k;
+    EXPECT_NEAR(levels[0].at(1, 0)[k], S * l0 + (w0 + S) * l1, 1e-9) << "channel " << k;
+  }
+}
+
+TEST(BloomReferenceLevels, KarisGuardOnlyOnTheFirstDownsample) {
+  // Level 1 of a guarded pyramid must be the plain (unguarded) downsample of its level 0. Feed
+  // level 0 back in as an image with an identity prefilter: its level 0 is then Down(level 0).
+  const CpuImage in = random_hdr(64, 48, 41);
+  BloomConfig config;
+  config.iterations = 2;
+  config.firefly_guard = true;
+  const auto levels = downsampled_levels(in, config);
+  ASSERT_EQ(levels.size(), 2u);
+  const DoubleImage& l0 = levels[0];
+  CpuImage l0_image(l0.width, l0.height);
+  for (size_t i = 0; i < l0.rgba.size(); ++i) l0_image.rgba[i] = static_cast<float>(l0.rgba[i]);
+
+  BloomConfig plain = identity_prefilter_config(BloomFilter::cod13);
+  const DoubleImage unguarded = downsampled_levels(l0_image, plain)[0];
+  plain.firefly_guard = true;
+  const DoubleImage guarded = downsampled_levels(l0_image, plain)[0];
+  ASSERT_EQ(unguarded.width, levels[1].width);
+  ASSERT_EQ(unguarded.height, levels[1].height);
+  double err = 0.0, diff_if_guarded = 0.0, norm = 0.0;
+  for (size_t i = 0; i < unguarded.rgba.size(); i += 4)
+    for (size_t k = 0; k < 3; ++k) {
+      err = std::max(err, std::abs(levels[1].rgba[i + k] - unguarded.rgba[i + k]));
+      diff_if_guarded = std::max(diff_if_guarded, std::abs(levels[1].rgba[i + k] - guarded.rgba[i + k]));
+      norm = std::max(norm, std::abs(levels[1].rgba[i + k]));
+    }
+  EXPECT_LT(err, 1e-6 * norm);             // only float rounding of the fed-back level 0
+  EXPECT_GT(diff_if_guarded, 1e-3 * norm);  // a guard at level 1 would be visible
+
+  // And the guard does change level 0.
+  config.firefly_guard = false;
+  const auto off = downsampled_levels(in, config);
+  double diff0 = 0.0;
+  for (size_t i = 0; i < l0.rgba.size(); ++i) diff0 = std::max(diff0, std::abs(l0.rgba[i] - off[0].rgba[i]));
+  EXPECT_GT(diff0, 1e-2);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Upsample
+
+// Up of (random background + unit impulse at small texel (1, 1)) minus Up of the background.
+std::vector<double> upsample_impulse_response(BloomFilter filter, double radius) {
+  DoubleImage bg;
+  bg.width = 3;
+  bg.height = 3;
+  std::mt19937 rng(51);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (int i = 0; i < 36; ++i) bg.rgba.push_back(u(rng));
+  DoubleImage with = bg;
+  double* t = with.at(1, 1);
+  t[0] += 1.0;
+  t[1] += 2.0;
+  t[2] += 0.5;
+  const DoubleImage a = upsample(with, 6, 6, filter, radius);
+  const DoubleImage b = upsample(bg, 6, 6, filter, radius);
+  std::vector<double> diff(a.rgba.size());
+  for (size_t i = 0; i < diff.size(); ++i) diff[i] = a.rgba[i] - b.rgba[i];
+  return diff;
+}
+
+TEST(BloomReferenceUpsample, ImpulseResponsesAtHandComputedTexels) {
+  // 3x3 -> 6x6: texel x maps to p = x / 2 - 0.25. Per axis the bilinear weight of small texel 1
+  // at position q is max(0, 1 - |q - 1|).
+  //  cod13 (tent, radius 1), x = 2 (p = 0.75): 0.25*w(-0.25) + 0.5*w(0.75) + 0.25*w(1.75) = 0.4375,
+  //    same for x = 3; x = 0 (p = -0.25): 0.25 * w(0.75) = 0.1875.
+  //  dual (radius 1) at (2, 2): edges 0 + 0.1875 + 0 + 0.1875, diagonals 0.0625 + 2 * 0.1875 + 0.5625
+  //    = 1: (0.375 + 2) / 12; at (0, 0): only the diagonal (0.25, 0.25): 2 * 0.0625 / 12.
+  //  gauss9: plain bilinear, (2, 2): 0.75^2.
+  struct Probe {
+    BloomFilter filter;
+    uint32_t x, y;
+    double expected;
+  };
+  const Probe probes[] = {
+      {BloomFilter::cod13, 2, 2, 0.4375 * 0.4375},   {BloomFilter::cod13, 3, 3, 0.4375 * 0.4375},
+      {BloomFilter::cod13, 2, 3, 0.4375 * 0.4375},   {BloomFilter::cod13, 0, 0, 0.1875 * 0.1875},
+      {BloomFilter::cod13, 5, 5, 0.1875 * 0.1875},   {BloomFilter::cod13, 0, 2, 0.1875 * 0.4375},
+      {BloomFilter::dual, 2, 2, 2.375 / 12.0},       {BloomFilter::dual, 3, 3, 2.375 / 12.0},
+      {BloomFilter::dual, 0, 0, 0.125 / 12.0},       {BloomFilter::gauss9, 2, 2, 0.5625},
+      {BloomFilter::gauss9, 0, 0, 0.0},              {BloomFilter::gauss9, 2, 3, 0.75 * 0.75},
+  };
+  const double colour[3] = {1.0, 2.0, 0.5};
+  for (const Probe& p : probes) {
+    const auto diff = upsample_impulse_response(p.filter, 1.0);
+    for (size_t k = 0; k < 3; ++k)
+      EXPECT_NEAR(diff[(size_t(p.y) * 6 + p.x) * 4 + k], p.expected * colour[k], 1e-12)
+          << name_of(p.filter) << " (" << p.x << ", " << p.y << ")";
+  }
+}
+
+TEST(BloomReferenceUpsample, RadiusScalesTheTapOffsets) {
+  // With radius 2 the cod13 tent at x = 2 (p = 0.75) has taps at -1.25, 0.75, 2.75:
+  // 0.5 * 0.75 = 0.375 per axis.
+  const auto diff = upsample_impulse_response(BloomFilter::cod13, 2.0);
+  EXPECT_NEAR(diff[(2 * 6 + 2) * 4 + 0], 0.375 * 0.375, 1e-12);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Full bloom: properties
+
+TEST(BloomReferenceBloom, UniformImageStaysUniform) {
+  // Every filter's weights sum to 1, so a uniform colour c gains exactly intensity * prefilter(c)
+  // (docs/BLOOM.md "Composite"), whatever the size, edges and iteration clamp.
+  std::mt19937 rng(61);
+  std::uniform_real_distribution<float> u(1.5f, 20.0f);
+  struct Size {
+    uint32_t w, h;
+  };
+  for (BloomFilter filter : kFilters) {
+    for (const Size s : {Size{17, 9}, Size{3, 5}, Size{1, 1}, Size{1, 17}, Size{17, 1}, Size{64, 48}}) {
+      for (bool guard : {true, false}) {
+        BloomConfig config;
+        config.filter = filter;
+        config.firefly_guard = guard;
+        config.radius = 1.5f;
+        const float c[3] = {u(rng), u(rng), u(rng)};
+        CpuImage in(s.w, s.h);
+        std::uniform_real_distribution<float> alpha(0.0f, 1.0f);
+        for (uint32_t y = 0; y < s.h; ++y)
+          for (uint32_t x = 0; x < s.w; ++x) {
+            set_rgb(in, x, y, c[0], c[1], c[2]);
+            in.at(x, y)[3] = alpha(rng);
+          }
+        const auto pf = prefiltered(config, c[0], c[1], c[2]);
+        const DoubleImage out = bloom(in, config);
+        const DoubleImage half = bloom(in, config, true);
+        for (uint32_t y = 0; y < s.h; ++y)
+          for (uint32_t x = 0; x < s.w; ++x) {
+            for (size_t k = 0; k < 3; ++k) {
+              const double want = double(c[k]) + double(config.intensity) * pf[k];
+              ASSERT_NEAR(out.at(x, y)[k], want, 1e-12 * want)
+                  << name_of(filter) << " " << s.w << "x" << s.h << " guard " << guard << " at " << x << "," << y;
+              // fp16 storage rounds each stored value the same way everywhere: still uniform.
+              ASSERT_EQ(half.at(x, y)[k], half.at(0, 0)[k]);
+              ASSERT_NEAR(half.at(x, y)[k], want, 2e-3 * want);
+            }
+            ASSERT_EQ(out.at(x, y)[3], double(in.at(x, y)[3]));
+          }
+      }
+    }
+  }
+}
+
+TEST(BloomReferenceBloom, HalfModeRoundsEveryStoredImage) {
+  // 32x32 uniform colour, 5 iterations -> levels 16, 8, 4, 2 (N = 4). Each level holds
+  // q = half(prefilter(c)) (a uniform downsample or blur reproduces q, and half(q) = q); the
+  // accumulation then stores A2 = half(2q) = 2q, A1 = half(q + 2q), A0 = half(q + A1), so
+  // out = c + intensity / 4 * A0 exactly, which differs from the double result c + intensity * pf.
+  const auto h = [](double x) { return double(detail::round_to_half(static_cast<float>(x))); };
+  std::mt19937 rng(62);
+  std::uniform_real_distribution<float> u(1.5f, 20.0f);
+  for (BloomFilter filter : kFilters) {
+    BloomConfig config;
+    config.filter = filter;
+    const float c[3] = {u(rng), u(rng), u(rng)};
+    CpuImage in(32, 32, 1.0f);
+    for (uint32_t y = 0; y < 32; ++y)
+      for (uint32_t x = 0; x < 32; ++x) set_rgb(in, x, y, c[0], c[1], c[2]);
+    const auto levels = downsampled_levels(in, config, true);
+    ASSERT_EQ(levels.size(), 4u);
+    for (const DoubleImage& level : levels)
+      for (size_t i = 0; i < level.rgba.size(); ++i) ASSERT_EQ(level.rgba[i], h(level.rgba[i])) << "not an fp16 value";
+    const auto pf = prefiltered(config, c[0], c[1], c[2]);
+    const DoubleImage out = bloom(in, config, true);
+    bool differs_from_double = false;
+    for (size_t k = 0; k < 3; ++k) {
+      const double q = h(pf[k]);
+      const double a0 = h(q + h(q + 2 * q));
+      const double want = double(c[k]) + double(config.intensity) / 4.0 * a0;
+      EXPECT_NEAR(out.at(5, 7)[k], want, 1e-12 * want) << name_of(filter) << " channel " << k;
+      differs_from_double |= std::abs(want - (double(c[k]) + double(config.intensity) * pf[k])) > 1e-9;
+    }
+    EXPECT_TRUE(differs_from_double) << "pick another seed: fp16 rounding happened to be exact";
+  }
+}
+
+TEST(BloomReferenceBloom, BrighterPointAddsMoreEnergy) {
+  const CpuImage bg = dark_background(48, 40, 71);
+  for (BloomFilter filter : kFilters) {
+    for (bool guard : {true, false}) {
+      BloomConfig config;
+      config.filter = filter;
+      config.firefly_guard = guard;
+      double prev = -1.0;
+      for (float b : {0.45f, 1.2f, 2.0f, 4.0f, 16.0f, 100.0f, 1000.0f}) {
+        CpuImage in = bg;
+        set_rgb(in, 20, 17, b, b, b);
+        const double e = total(added_light(bloom(in, config), in));
+        if (b < 0.5f) {
+          EXPECT_EQ(e, 0.0) << name_of(filter) << ": a point below threshold - knee must add nothing";
+        } else {
+          EXPECT_GT(e, prev) << name_of(filter) << " guard " << guard << " brightness " << b;
+        }
+        prev = e;
+      }
+    }
+  }
+}
+
+TEST(BloomReferenceBloom, FireflyGuardDampensAnIsolatedFirefly) {
+  const CpuImage bg = dark_background(64, 64, 72);
+  for (BloomFilter filter : kFilters) {
+    CpuImage in = bg;
+    set_rgb(in, 30, 33, 1000, 1000, 1000);
+    BloomConfig config;
+    config.filter = filter;
+    config.firefly_guard = false;
+    const double off = total(added_light(bloom(in, config), in));
+    config.firefly_guard = true;
+    const double on = total(added_light(bloom(in, config), in));
+    EXPECT_GT(on, 0.0) << name_of(filter);
+    EXPECT_LT(on, 0.5 * off) << name_of(filter);
+  }
+}
+
+TEST(BloomReferenceBloom, SingleCentredPointIsRadiallySymmetricCod13) {
+  const CpuImage bg = dark_background(129, 129, 81);
+  CpuImage in = bg;
+  set_rgb(in, 64, 64, 50, 50, 50);
+  BloomConfig config;  // cod13, 5 levels: 64, 32, 16, 8, 4
+  const Glow g = glow_of(bloom(in, config), in);
+  ASSERT_GT(g.energy, 0.0);
+  // The mapping is mirror-symmetric about texel 64 on both axes.
+  EXPECT_NEAR(g.cx, 64.0, 1e-6);
+  EXPECT_NEAR(g.cy, 64.0, 1e-6);
+  EXPECT_NEAR(g.mxx, g.myy, 0.02 * 0.5 * (g.mxx + g.myy));
+  EXPECT_NEAR(g.mxy, 0.0, 1e-6 * g.mxx);
+}
+
+TEST(BloomReferenceBloom, OffCentrePointIsStillNearlyIsotropic) {
+  // Off the symmetry axes x and y see different sub-texel phases at each level; the glow must
+  // still be round to within a few percent for every filter.
+  // (Positions chosen off the image's mirror axes: x and 159 - x would give equal moments trivially.)
+  const CpuImage bg = dark_background(160, 160, 82);
+  struct Point {
+    uint32_t x, y;
+  };
+  for (BloomFilter filter : kFilters) {
+    for (const Point p : {Point{70, 85}, Point{81, 66}, Point{64, 97}}) {
+      CpuImage in = bg;
+      set_rgb(in, p.x, p.y, 50, 50, 50);
+      BloomConfig config;
+      config.filter = filter;
+      config.iterations = 4;
+      const Glow g = glow_of(bloom(in, config), in);
+      EXPECT_NEAR(g.mxx, g.myy, 0.05 * 0.5 * (g.mxx + g.myy)) << name_of(filter) << " at " << p.x << "," << p.y;
+      EXPECT_NEAR(g.cx, p.x, 1.5) << name_of(filter);
+      EXPECT_NEAR(g.cy, p.y, 1.5) << name_of(filter);
+    }
+  }
+}
+
+TEST(BloomReferenceBloom, LargerRadiusGivesWiderGlow) {
+  const CpuImage bg = dark_background(257, 257, 91);
+  for (BloomFilter filter : kFilters) {
+    CpuImage in = bg;
+    set_rgb(in, 128, 128, 50, 50, 50);
+    double prev = 0.0;
+    for (float radius : {0.5f, 1.0f, 2.0f, 4.0f}) {
+      BloomConfig config;
+      config.filter = filter;
+      config.radius = radius;
+      config.iterations = 4;
+      const Glow g = glow_of(bloom(in, config), in);
+      const double spread = g.mxx + g.myy;
+      EXPECT_GT(spread, prev * 1.05) << name_of(filter) << " radius " << radius;
+      prev = spread;
+    }
+  }
+}
+
+TEST(BloomReferenceBloom, ZeroIntensityReturnsInputExactly) {
+  CpuImage in = random_hdr(37, 23, 101);
+  in.at(3, 4)[0] = std::numeric_limits<float>::quiet_NaN();
+  in.at(5, 6)[1] = std::numeric_limits<float>::infinity();
+  in.at(7, 8)[2] = -2.5f;
+  for (BloomFilter filter : kFilters) {
+    for (bool half : {false, true}) {
+      BloomConfig config;
+      config.filter = filter;
+      config.intensity = 0.0f;
+      const DoubleImage out = bloom(in, config, half);
+      ASSERT_EQ(out.width, in.width);
+      ASSERT_EQ(out.height, in.height);
+      ASSERT_EQ(out.rgba.size(), in.rgba.size());
+      for (size_t i = 0; i < in.rgba.size(); ++i)
+        ASSERT_TRUE(same_bits(out.rgba[i], double(in.rgba[i]))) << "value " << i;
+    }
+  }
+}
+
+TEST(BloomReferenceBloom, DarkPixelsFarFromBrightOnesAreUnchanged) {
+  // Bloom has a finite footprint (at most a few taps per level, 3 levels here): pixels far from
+  // the bright spot, whose own luma is below threshold - knee, must come out bit-identical.
+  const CpuImage bg = dark_background(256, 256, 111);
+  for (BloomFilter filter : kFilters) {
+    for (bool half : {false, true}) {
+      CpuImage in = bg;
+      for (uint32_t y = 12; y < 15; ++y)
+        for (uint32_t x = 12; x < 15; ++x) set_rgb(in, x, y, 20, 30, 10);
+      BloomConfig config;
+      config.filter = filter;
+      config.iterations = 3;
+      const DoubleImage out = bloom(in, config, half);
+      size_t unchanged_far = 0;
+      for (uint32_t y = 0; y < 256; ++y)
+        for (uint32_t x = 0; x < 256; ++x) {
+          if (x < 128 && y < 128) continue;
+          for (size_t k = 0; k < 4; ++k)
+            ASSERT_TRUE(same_bits(out.at(x, y)[k], double(in.at(x, y)[k])))
+                << name_of(filter) << " changed far pixel " << x << "," << y;
+          ++unchanged_far;
+        }
+      EXPECT_EQ(unchanged_far, 256u * 256u - 128u * 128u);
+      // ...while dark pixels near the spot did receive light, so the check above is not vacuous.
+      EXPECT_GT(out.at(20, 20)[1], double(in.at(20, 20)[1])) << name_of(filter);
+    }
+  }
+}
+
+TEST(BloomReferenceBloom, TinyAndThinImages) {
+  struct Size {
+    uint32_t w, h;
+  };
+  for (BloomFilter filter : kFilters) {
+    for (const Size s : {Size{1, 1}, Size{3, 5}, Size{1, 57}, Size{57, 1}, Size{2, 2}, Size{2, 3}}) {
+      const CpuImage in = random_hdr(s.w, s.h, 121);
+      BloomConfig config;
+      config.filter = filter;
+      const DoubleImage out = bloom(in, config);
+      ASSERT_EQ(out.width, s.w);
+      ASSERT_EQ(out.height, s.h);
+      double added = 0.0;
+      for (size_t i = 0; i < in.rgba.size(); ++i) {
+        ASSERT_TRUE(std::isfinite(out.rgba[i]));
+        if (i % 4 == 3) {
+          ASSERT_EQ(out.rgba[i], double(in.rgba[i]));
+        } else {
+          ASSERT_GE(out.rgba[i], double(in.rgba[i]));  // bloom only adds light
+          added += out.rgba[i] - double(in.rgba[i]);
+        }
+      }
+      EXPECT_GT(added, 0.0) << name_of(filter) << " " << s.w << "x" << s.h;
+    }
+  }
+}
+
+TEST(BloomReferenceBloom, HalfIntermediatesStayCloseToDouble) {
+  const CpuImage in = random_hdr(96, 64, 131);
+  for (BloomFilter filter : kFilters) {
+    BloomConfig config;
+    config.filter = filter;
+    const DoubleImage exact = bloom(in, config, false);
+    const DoubleImage half = bloom(in, config, true);
+    const double full = relative_l2(to_float(half), exact);
+    EXPECT_LT(full, 5e-3) << name_of(filter);
+    // The scene dominates the output; compare the added light alone as well.
+    DoubleImage added_exact = exact;
+    DoubleImage added_half = half;
+    for (size_t i = 0; i < in.rgba.size(); ++i) {
+      added_exact.rgba[i] -= double(in.rgba[i]);
+      added_half.rgba[i] -= double(in.rgba[i]);
+    }
+    const double bloom_only = relative_l2(to_float(added_half), added_exact);
+    EXPECT_LT(bloom_only, 5e-3) << name_of(filter);
+    // fp16 storage really was applied (a mode that changed nothing would pass the bounds above).
+    EXPECT_GT(bloom_only, 1e-6) << name_of(filter);
+  }
+}
+
+TEST(BloomReferenceBloom, RejectsInvalidInput) {
+  BloomConfig config;
+  EXPECT_THROW(bloom(CpuImage(), config), std::invalid_argument);
+  CpuImage bad(4, 4);
+  bad.rgba.pop_back();
+  EXPECT_THROW(bloom(bad, config), std::invalid_argument);
+  config.iterations = 0;
+  EXPECT_THROW(bloom(CpuImage(4, 4), config), std::invalid_argument);
+}
+
+// ---------------------------------------------------------------------------------------------
+// relative_l2
+
+TEST(BloomReferenceRelativeL2, HandComputed) {
+  DoubleImage ref;
+  ref.width = 2;
+  ref.height = 1;
+  ref.rgba = {3, 4, 0, 1, 0, 0, 0, 1};
+  CpuImage gpu(2, 1);
+  gpu.rgba = {3, 4, 1, 0.25f, 0, 0, 0, 7};  // alpha differs and must not count
+  EXPECT_DOUBLE_EQ(relative_l2(gpu, ref), 0.2);  // |(0,0,1)| / |(3,4,0)|
+  gpu.rgba = {3, 4, 0, 9, 0, 0, 0, 9};
+  EXPECT_EQ(relative_l2(gpu, ref), 0.0);
+  gpu.rgba[0] = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_FALSE(relative_l2(gpu, ref) < 1.0);  // a NaN never passes a tolerance
+  EXPECT_THROW(relative_l2(CpuImage(1, 2), ref), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace glint::reference

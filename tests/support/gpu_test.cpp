@@ -1,0 +1,65 @@
+#include "support/gpu_test.h"
+
+#include <cmath>
+#include <cstdlib>
+#include <memory>
+
+namespace glint::test {
+
+const Context& context() {
+  static std::unique_ptr<Context> ctx = [] {
+    ContextOptions options;
+    options.validation = true;
+    return std::make_unique<Context>(Context::create(options));
+  }();
+  return *ctx;
+}
+
+void GpuTest::SetUp() { messages_before_ = context().validation_messages(); }
+
+void GpuTest::TearDown() {
+  const uint32_t after = context().validation_messages();
+  if (after != messages_before_) {
+    auto log = context().validation_log();
+    std::string text;
+    for (size_t i = messages_before_; i < log.size(); ++i) text += log[i] + "\n";
+    ADD_FAILURE() << (after - messages_before_) << " validation message(s):\n" << text;
+  }
+}
+
+CpuImage random_hdr(uint32_t width, uint32_t height, uint32_t seed, float bright_fraction, float peak) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> base(0.0f, 1.5f);
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+  CpuImage img(width, height);
+  for (uint32_t y = 0; y < height; ++y) {
+    for (uint32_t x = 0; x < width; ++x) {
+      float* px = img.at(x, y);
+      const bool bright = unit(rng) < bright_fraction;
+      for (int c = 0; c < 3; ++c) px[c] = bright ? 2.0f + unit(rng) * (peak - 2.0f) : base(rng);
+      px[3] = unit(rng);
+    }
+  }
+  return img;
+}
+
+detail::OwnedImage make_image(const CpuImage& pixels, VkFormat format) {
+  detail::OwnedImage img(context(), {pixels.width, pixels.height}, format, detail::kToolImageUsage);
+  detail::upload(context(), img.state, pixels);
+  return img;
+}
+
+detail::OwnedImage make_poisoned(VkExtent2D extent, VkFormat format) {
+  detail::OwnedImage img(context(), extent, format, detail::kToolImageUsage);
+  detail::fill(context(), img.state, std::nanf(""));
+  return img;
+}
+
+bool all_finite(const CpuImage& image) {
+  for (float v : image.rgba) {
+    if (!std::isfinite(v)) return false;
+  }
+  return true;
+}
+
+}  // namespace glint::test

@@ -1,0 +1,41 @@
+// Shared test helpers: one validated Context per test program, random HDR images, comparisons.
+#pragma once
+
+#include <glint/glint.h>
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "core/cpu_image.h"
+#include "core/resources.h"
+#include "core/transfer.h"
+
+namespace glint::test {
+
+/// The test program's Context: lavapipe unless GLINT_DEVICE says otherwise, validation and
+/// synchronization validation always on.
+const Context& context();
+
+/// Base fixture: fails the test if any validation message appeared during it.
+class GpuTest : public ::testing::Test {
+ protected:
+  void SetUp() override;
+  void TearDown() override;
+
+ private:
+  uint32_t messages_before_ = 0;
+};
+
+/// Random HDR image: mostly values in [0, 1.5) with a fraction of bright pixels up to `peak`.
+CpuImage random_hdr(uint32_t width, uint32_t height, uint32_t seed, float bright_fraction = 0.02f,
+                    float peak = 40.0f);
+
+/// An image with its content uploaded, in the given format, with test usage flags.
+detail::OwnedImage make_image(const CpuImage& pixels, VkFormat format);
+/// An image poisoned with NaN so that an unwritten texel fails any comparison.
+detail::OwnedImage make_poisoned(VkExtent2D extent, VkFormat format);
+
+/// True if every channel of every texel is finite (no NaN left from poisoning).
+bool all_finite(const CpuImage& image);
+
+}  // namespace glint::test
