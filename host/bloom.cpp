@@ -1,6 +1,7 @@
 // Bloom driver: validates, owns the pyramid and pipelines, records the passes of docs/BLOOM.md.
 #include <glint/bloom.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <map>
@@ -69,6 +70,25 @@ constexpr VkPipelineStageFlags2 kCompute = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BI
 constexpr VkAccessFlags2 kSampled = VK_ACCESS_2_SHADER_SAMPLED_READ_BIT;
 constexpr VkAccessFlags2 kStorageWrite = VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT;
 constexpr VkAccessFlags2 kStorageRead = VK_ACCESS_2_SHADER_STORAGE_READ_BIT;
+
+// Shared memory the tiled kernels declare for a workgroup (kernels/common/bloom_down_tiled.glsl and
+// bloom_up_tiled.glsl): vec4 windows of the source.
+uint32_t bloom_shared_bytes(detail::Workgroup2D g) {
+  const uint32_t down = ((2 * g.x + 4) * (2 * g.y + 4) + (2 * g.x + 3) * (2 * g.y + 3)) * 16;
+  const uint32_t up = ((g.x + 10) * (g.y + 10) + g.x * (g.y + 10)) * 16;
+  return std::max(down, up);
+}
+
+// The device's preferred workgroup if its shared memory holds the tiles, else 8x8 (12 KiB).
+detail::Workgroup2D bloom_workgroup(const DeviceInfo& info) {
+  detail::Workgroup2D g = detail::choose_workgroup_2d(info);
+  if (bloom_shared_bytes(g) > info.max_shared_memory_bytes) g = {8, 8};
+  if (bloom_shared_bytes(g) > info.max_shared_memory_bytes) {
+    throw Error(ErrorCode::no_device, concat("bloom needs ", bloom_shared_bytes(g), " bytes of shared memory; device '",
+                                             info.name, "' has ", info.max_shared_memory_bytes));
+  }
+  return g;
+}
 
 }  // namespace
 
@@ -326,7 +346,7 @@ Bloom::Bloom(const Context& context, const BloomConfig& config) : impl_(std::mak
   config.validate();
   impl_->context = &context;
   impl_->config = config;
-  impl_->workgroup = detail::choose_workgroup_2d(context.info());
+  impl_->workgroup = bloom_workgroup(context.info());
   impl_->make_pipelines();
 }
 

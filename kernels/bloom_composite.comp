@@ -15,12 +15,13 @@ layout(push_constant) uniform Push { BloomPush p; };
 vec3 source_texel(ivec2 ij) { return vec3(0.0); }  // unused
 
 #include "bloom.glsl"
+#include "bloom_up_tiled.glsl"
 
 void main() {
   ivec2 xy = ivec2(gl_GlobalInvocationID.xy);
   ivec2 size = ivec2(p.dst_width, p.dst_height);
-  if (any(greaterThanEqual(xy, size))) return;
+  vec3 bloom = upsample_tiled(level0, ivec2(p.src_width, p.src_height), size, p.radius);
+  if (any(greaterThanEqual(xy, size))) return;  // after the barriers inside upsample_tiled
   vec4 s = texelFetch(scene, xy, 0);
-  vec3 bloom = upsample(level0, ivec2(p.src_width, p.src_height), xy, size, p.radius);
   imageStore(result, xy, vec4(s.rgb + p.composite_scale * bloom, s.a));
 }

@@ -14,11 +14,13 @@ layout(push_constant) uniform Push { BloomPush p; };
 vec3 source_texel(ivec2 ij) { return texelFetch(src, ij, 0).rgb; }
 
 #include "bloom.glsl"
+#include "bloom_down_tiled.glsl"
 
 void main() {
   ivec2 xy = ivec2(gl_GlobalInvocationID.xy);
   ivec2 dst_size = ivec2(p.dst_width, p.dst_height);
-  if (any(greaterThanEqual(xy, dst_size))) return;
+  bool inside = all(lessThan(xy, dst_size));
   g_src_size = ivec2(p.src_width, p.src_height);
-  imageStore(dst, xy, vec4(downsample(xy, dst_size, false), 1.0));
+  vec3 c = downsample_any(xy, dst_size, inside, false);
+  if (inside) imageStore(dst, xy, vec4(c, 1.0));
 }

@@ -20,12 +20,13 @@ vec3 source_texel(ivec2 ij) {
 }
 
 #include "bloom.glsl"
+#include "bloom_down_tiled.glsl"
 
 void main() {
   ivec2 xy = ivec2(gl_GlobalInvocationID.xy);
   ivec2 dst_size = ivec2(p.dst_width, p.dst_height);
-  if (any(greaterThanEqual(xy, dst_size))) return;
+  bool inside = all(lessThan(xy, dst_size));
   g_src_size = ivec2(p.src_width, p.src_height);
-  vec3 c = downsample(xy, dst_size, (p.flags & GLINT_BLOOM_FLAG_KARIS) != 0u);
-  imageStore(level0, xy, vec4(c, 1.0));
+  vec3 c = downsample_any(xy, dst_size, inside, (p.flags & GLINT_BLOOM_FLAG_KARIS) != 0u);
+  if (inside) imageStore(level0, xy, vec4(c, 1.0));
 }

@@ -14,12 +14,13 @@ layout(push_constant) uniform Push { BloomPush p; };
 vec3 source_texel(ivec2 ij) { return vec3(0.0); }  // unused: upsample reads `smaller` directly
 
 #include "bloom.glsl"
+#include "bloom_up_tiled.glsl"
 
 void main() {
   ivec2 xy = ivec2(gl_GlobalInvocationID.xy);
   ivec2 dst_size = ivec2(p.dst_width, p.dst_height);
-  if (any(greaterThanEqual(xy, dst_size))) return;
-  vec3 up = upsample(smaller, ivec2(p.src_width, p.src_height), xy, dst_size, p.radius);
+  vec3 up = upsample_tiled(smaller, ivec2(p.src_width, p.src_height), dst_size, p.radius);
+  if (any(greaterThanEqual(xy, dst_size))) return;  // after the barriers inside upsample_tiled
   vec3 own = imageLoad(level, xy).rgb;
   imageStore(level, xy, vec4(own + up, 1.0));
 }

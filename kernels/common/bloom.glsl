@@ -87,26 +87,3 @@ vec3 downsample(ivec2 xy, ivec2 dst_size, bool karis) {
   add_box(sum, wsum, (g[4] + g[5] + g[7] + g[8]) * 0.25, 0.125, karis);
   return sum / wsum;
 }
-
-// The filter's upsample of `small` (size small_size) at texel xy of a larger image.
-vec3 upsample(texture2D small, ivec2 small_size, ivec2 xy, ivec2 dst_size, float radius) {
-  vec2 c = map_position(xy, dst_size, small_size);
-  if (FILTER == GLINT_BLOOM_GAUSS9) return bilinear(small, c, small_size);
-  if (FILTER == GLINT_BLOOM_DUAL) {
-    vec3 edges = bilinear(small, c + radius * vec2(-1, 0), small_size) +
-                 bilinear(small, c + radius * vec2(1, 0), small_size) +
-                 bilinear(small, c + radius * vec2(0, -1), small_size) +
-                 bilinear(small, c + radius * vec2(0, 1), small_size);
-    vec3 diagonals = bilinear(small, c + radius * vec2(-0.5, -0.5), small_size) +
-                     bilinear(small, c + radius * vec2(0.5, -0.5), small_size) +
-                     bilinear(small, c + radius * vec2(-0.5, 0.5), small_size) +
-                     bilinear(small, c + radius * vec2(0.5, 0.5), small_size);
-    return (edges + 2.0 * diagonals) / 12.0;
-  }
-  vec3 sum = vec3(0.0);
-  const float t[3] = float[3](0.25, 0.5, 0.25);
-  for (int j = 0; j < 3; ++j)
-    for (int i = 0; i < 3; ++i)
-      sum += (t[i] * t[j]) * bilinear(small, c + radius * vec2(i - 1, j - 1), small_size);
-  return sum;
-}

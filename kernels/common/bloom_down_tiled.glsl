@@ -1,0 +1,67 @@
+// The downsample for an exact 2:1 reduction (both source sides even, docs/BLOOM.md): every
+// bilinear tap of cod13 and dual then sits on a corner shared by four source texels, so it is the
+// mean of that 2x2 box. A workgroup loads its source window once into shared memory, forms the box
+// means at every corner once, and each invocation reads its 13 (cod13) or 5 (dual) boxes from
+// there, instead of 52 or 20 texel fetches. Same arithmetic as downsample() up to fp32 rounding.
+// Requires bloom.glsl (src_at, add_box, FILTER) to be included first.
+
+const uint TILE_W = 2u * gl_WorkGroupSize.x + 4u;  // source texels 2*x0-2 .. 2*(x0+W-1)+3
+const uint TILE_H = 2u * gl_WorkGroupSize.y + 4u;
+const uint BOX_W = TILE_W - 1u;                   // corners between them
+const uint BOX_H = TILE_H - 1u;
+const uint GROUP_SIZE = gl_WorkGroupSize.x * gl_WorkGroupSize.y;
+
+shared vec4 s_texel[TILE_W * TILE_H];
+shared vec4 s_box[BOX_W * BOX_H];
+
+// Every invocation of the workgroup must call this (it has barriers), inside the image or not.
+vec3 downsample_2to1(bool karis) {
+  ivec2 origin = ivec2(gl_GlobalInvocationID.xy - gl_LocalInvocationID.xy) * 2 - 2;  // (see bloom_up_tiled)
+  for (uint i = gl_LocalInvocationIndex; i < TILE_W * TILE_H; i += GROUP_SIZE) {
+    s_texel[i] = vec4(src_at(origin + ivec2(i % TILE_W, i / TILE_W)), 0.0);
+  }
+  barrier();
+  for (uint i = gl_LocalInvocationIndex; i < BOX_W * BOX_H; i += GROUP_SIZE) {
+    uint t = (i / BOX_W) * TILE_W + (i % BOX_W);
+    s_box[i] = 0.25 * (s_texel[t] + s_texel[t + 1u] + s_texel[t + TILE_W] + s_texel[t + TILE_W + 1u]);
+  }
+  barrier();
+  // Output (x, y) is centred on the corner between source texels 2x and 2x+1, which is corner
+  // 2*lx + 2 of the window.
+  ivec2 c = ivec2(gl_LocalInvocationID.xy) * 2 + 2;
+#define BOX(dx, dy) s_box[uint(c.y + (dy)) * BOX_W + uint(c.x + (dx))].rgb
+  vec3 sum = vec3(0.0);
+  float wsum = 0.0;
+  if (FILTER == GLINT_BLOOM_GAUSS9) {
+    if (!karis) return BOX(0, 0);
+    for (int j = 0; j < 2; ++j)
+      for (int i = 0; i < 2; ++i) add_box(sum, wsum, s_texel[uint(c.y + j) * TILE_W + uint(c.x + i)].rgb, 0.25, true);
+    return sum / wsum;
+  }
+  if (FILTER == GLINT_BLOOM_DUAL) {
+    add_box(sum, wsum, BOX(0, 0), 0.5, karis);
+    add_box(sum, wsum, BOX(-1, -1), 0.125, karis);
+    add_box(sum, wsum, BOX(1, -1), 0.125, karis);
+    add_box(sum, wsum, BOX(-1, 1), 0.125, karis);
+    add_box(sum, wsum, BOX(1, 1), 0.125, karis);
+    return sum / wsum;
+  }
+  vec3 inner = (BOX(-1, -1) + BOX(1, -1) + BOX(-1, 1) + BOX(1, 1)) * 0.25;
+  vec3 g00 = BOX(-2, -2), g10 = BOX(0, -2), g20 = BOX(2, -2);
+  vec3 g01 = BOX(-2, 0), g11 = BOX(0, 0), g21 = BOX(2, 0);
+  vec3 g02 = BOX(-2, 2), g12 = BOX(0, 2), g22 = BOX(2, 2);
+#undef BOX
+  add_box(sum, wsum, inner, 0.5, karis);
+  add_box(sum, wsum, (g00 + g10 + g01 + g11) * 0.25, 0.125, karis);
+  add_box(sum, wsum, (g10 + g20 + g11 + g21) * 0.25, 0.125, karis);
+  add_box(sum, wsum, (g01 + g11 + g02 + g12) * 0.25, 0.125, karis);
+  add_box(sum, wsum, (g11 + g21 + g12 + g22) * 0.25, 0.125, karis);
+  return sum / wsum;
+}
+
+// The downsample of the invocation's texel: the shared-memory 2:1 path when it applies (a
+// uniform branch), else the general one. Call from every invocation.
+vec3 downsample_any(ivec2 xy, ivec2 dst_size, bool inside, bool karis) {
+  if (g_src_size == 2 * dst_size) return downsample_2to1(karis);
+  return inside ? downsample(xy, dst_size, karis) : vec3(0.0);
+}
