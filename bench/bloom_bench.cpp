@@ -76,6 +76,21 @@ void BM_Bloom(benchmark::State& state) {
     frame_ms.push_back(median);
     state.SetIterationTime(median * 1e-3);
   }
+  // Stage breakdown of one more frame (bloom's own profiler marks), for docs/PERF.md.
+  Profiler stages(ctx, 8);
+  ctx.run_once([&](VkCommandBuffer cmd) {
+    stages.reset(cmd);
+    stages.mark(cmd, "start");
+    bloom.record(cmd, in.state, out.state, &stages);
+  });
+  for (const auto& s : stages.results()) {
+    const std::string& l = s.label;
+    const char* key = l.find("bright") != std::string::npos ? "us_prefilter_down0"
+                      : l.find("downsample") != std::string::npos ? "us_down"
+                      : l.find("upsample") != std::string::npos ? "us_up"
+                                                                 : "us_composite";
+    state.counters[key] = s.ms * 1e3;
+  }
   const double bytes = static_cast<double>(bloom.min_bytes_moved(format, format));
   state.counters["floor_bytes"] = bytes;
   state.counters["bytes_per_second"] = benchmark::Counter(bytes, benchmark::Counter::kIsIterationInvariantRate);

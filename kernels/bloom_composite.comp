@@ -20,8 +20,8 @@ vec3 source_texel(ivec2 ij) { return vec3(0.0); }  // unused
 void main() {
   ivec2 xy = ivec2(gl_GlobalInvocationID.xy);
   ivec2 size = ivec2(p.dst_width, p.dst_height);
+  vec4 s = texelFetch(scene, min(xy, size - 1), 0);  // issued first: its latency overlaps the tile work
   vec3 bloom = upsample_tiled(level0, ivec2(p.src_width, p.src_height), size, p.radius);
   if (any(greaterThanEqual(xy, size))) return;  // after the barriers inside upsample_tiled
-  vec4 s = texelFetch(scene, xy, 0);
   imageStore(result, xy, vec4(s.rgb + p.composite_scale * bloom, s.a));
 }

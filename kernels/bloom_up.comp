@@ -19,8 +19,8 @@ vec3 source_texel(ivec2 ij) { return vec3(0.0); }  // unused: upsample reads `sm
 void main() {
   ivec2 xy = ivec2(gl_GlobalInvocationID.xy);
   ivec2 dst_size = ivec2(p.dst_width, p.dst_height);
+  vec3 own = imageLoad(level, min(xy, dst_size - 1)).rgb;  // issued first, as in bloom_composite
   vec3 up = upsample_tiled(smaller, ivec2(p.src_width, p.src_height), dst_size, p.radius);
   if (any(greaterThanEqual(xy, dst_size))) return;  // after the barriers inside upsample_tiled
-  vec3 own = imageLoad(level, xy).rgb;
   imageStore(level, xy, vec4(own + up, 1.0));
 }

@@ -3,11 +3,20 @@
 #include "core/context_state.h"
 #include "core/kernel_table.h"
 
+#include <cstdio>
+#include <cstdlib>
 #include <utility>
 
 namespace glint::detail {
 
 Workgroup2D choose_workgroup_2d(const DeviceInfo& info) {
+  // GLINT_WORKGROUP=WxH overrides the choice (for tuning benchmarks); ignored if malformed.
+  if (const char* env = std::getenv("GLINT_WORKGROUP")) {
+    unsigned w = 0, h = 0;
+    if (std::sscanf(env, "%ux%u", &w, &h) == 2 && w >= 1 && h >= 1 && w * h <= info.max_workgroup_invocations) {
+      return {w, h};
+    }
+  }
   // CPU devices (lavapipe) run a workgroup per thread with 8-wide SIMD: 8x8 keeps groups small
   // enough to spread over cores. GPUs with 32/64-wide subgroups get 16x16 when allowed.
   if (info.type != VK_PHYSICAL_DEVICE_TYPE_CPU && info.max_workgroup_invocations >= 256 && info.subgroup_size >= 32) {

@@ -4,12 +4,14 @@
 // means at every corner once, and each invocation reads its 13 (cod13) or 5 (dual) boxes from
 // there, instead of 52 or 20 texel fetches. Same arithmetic as downsample() up to fp32 rounding.
 // Requires bloom.glsl (src_at, add_box, FILTER) to be included first.
+#extension GL_EXT_control_flow_attributes : require
 
 const uint TILE_W = 2u * gl_WorkGroupSize.x + 4u;  // source texels 2*x0-2 .. 2*(x0+W-1)+3
 const uint TILE_H = 2u * gl_WorkGroupSize.y + 4u;
 const uint BOX_W = TILE_W - 1u;                   // corners between them
 const uint BOX_H = TILE_H - 1u;
 const uint GROUP_SIZE = gl_WorkGroupSize.x * gl_WorkGroupSize.y;
+const uint LOADS_PER_INVOCATION = (TILE_W * TILE_H + GROUP_SIZE - 1u) / GROUP_SIZE;
 
 shared vec4 s_texel[TILE_W * TILE_H];
 shared vec4 s_box[BOX_W * BOX_H];
@@ -17,8 +19,15 @@ shared vec4 s_box[BOX_W * BOX_H];
 // Every invocation of the workgroup must call this (it has barriers), inside the image or not.
 vec3 downsample_2to1(bool karis) {
   ivec2 origin = ivec2(gl_GlobalInvocationID.xy - gl_LocalInvocationID.xy) * 2 - 2;  // (see bloom_up_tiled)
-  for (uint i = gl_LocalInvocationIndex; i < TILE_W * TILE_H; i += GROUP_SIZE) {
-    s_texel[i] = vec4(src_at(origin + ivec2(i % TILE_W, i / TILE_W)), 0.0);
+  // All fetches are issued before the first store, so their latencies overlap.
+  vec3 fetched[LOADS_PER_INVOCATION];
+  [[unroll]] for (uint n = 0u; n < LOADS_PER_INVOCATION; ++n) {
+    uint i = min(gl_LocalInvocationIndex + n * GROUP_SIZE, TILE_W * TILE_H - 1u);
+    fetched[n] = src_at(origin + ivec2(i % TILE_W, i / TILE_W));
+  }
+  [[unroll]] for (uint n = 0u; n < LOADS_PER_INVOCATION; ++n) {
+    uint i = gl_LocalInvocationIndex + n * GROUP_SIZE;
+    if (i < TILE_W * TILE_H) s_texel[i] = vec4(fetched[n], 0.0);
   }
   barrier();
   for (uint i = gl_LocalInvocationIndex; i < BOX_W * BOX_H; i += GROUP_SIZE) {

@@ -1,0 +1,77 @@
+// The copy-bandwidth floor, measured in the same run as the effects: a compute kernel that reads
+// one RGBA16F image and writes another (kernels/image_copy.comp), timed with timestamps. Effects
+// quote their time as a ratio to this (docs/PERF.md).
+#include <benchmark/benchmark.h>
+
+#include "bench_support.h"
+#include "bloom_params.h"
+#include "core/barriers.h"
+#include "core/pipeline.h"
+#include "core/resources.h"
+#include "core/transfer.h"
+
+namespace glint::bench {
+namespace {
+
+void BM_CopyFloor(benchmark::State& state) {
+  const auto width = static_cast<uint32_t>(state.range(0));
+  const auto height = static_cast<uint32_t>(state.range(1));
+  const Context& ctx = context();
+  const VkFormat format = VK_FORMAT_R16G16B16A16_SFLOAT;
+  detail::OwnedImage src(ctx, {width, height}, format, detail::kToolImageUsage);
+  detail::OwnedImage dst(ctx, {width, height}, format, detail::kToolImageUsage);
+  detail::upload(ctx, src.state, random_hdr(width, height, 7));
+  detail::PipelineDesc desc;
+  desc.kernel_id = "image_copy_rgba16f";
+  desc.bindings = {VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE};
+  desc.push_constant_bytes = sizeof(BloomPush);
+  desc.workgroup = detail::choose_workgroup_2d(ctx.info());
+  detail::ComputePipeline copy(ctx, desc);
+  detail::DescriptorArena arena(ctx, 1);
+  VkDescriptorSet set = arena.make_set(copy, {{src.state.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL},
+                                              {dst.state.view, VK_IMAGE_LAYOUT_GENERAL}});
+  BloomPush push{};
+  push.dst_width = static_cast<int32_t>(width);
+  push.dst_height = static_cast<int32_t>(height);
+  constexpr int kCopies = 16;
+  Profiler profiler(ctx, kCopies + 1);
+  std::vector<double> all;
+  for (auto _ : state) {
+    ctx.run_once([&](VkCommandBuffer cmd) {
+      profiler.reset(cmd);
+      profiler.mark(cmd, "start");
+      for (int i = 0; i < kCopies; ++i) {
+        detail::Barriers b;
+        b.use(src.state, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+              VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
+        b.use(dst.state, VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+              VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+        b.flush(cmd);
+        copy.dispatch(cmd, set, push, width, height);
+        profiler.mark(cmd, "copy");
+      }
+    });
+    std::vector<double> ms;
+    for (const auto& s : profiler.results()) ms.push_back(s.ms);
+    const double m = median_of(ms);
+    all.push_back(m);
+    state.SetIterationTime(m * 1e-3);
+  }
+  const double bytes = double(width) * height * 16.0;  // 8 bytes read + 8 written per texel
+  state.counters["bytes_per_second"] = benchmark::Counter(bytes, benchmark::Counter::kIsIterationInvariantRate);
+  state.counters["median_us"] = median_of(all) * 1e3;
+  state.counters["floor_bytes"] = bytes;
+  state.SetLabel("RGBA16F image copy on " + ctx.info().name);
+}
+
+BENCHMARK(BM_CopyFloor)
+    ->Args({640, 480})
+    ->Args({1920, 1080})
+    ->Args({3840, 2160})
+    ->Args({7680, 4320})
+    ->ArgNames({"w", "h"})
+    ->UseManualTime()
+    ->Unit(benchmark::kMicrosecond);
+
+}  // namespace
+}  // namespace glint::bench
