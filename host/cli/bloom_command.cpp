@@ -1,0 +1,110 @@
+// glint bloom IN.exr OUT.exr: bloom of an EXR file on a standalone context, written as RGBA half
+// EXR (and optionally a tonemapped PNG). Ranges are checked by BloomConfig::validate(), not here,
+// so the CLI and the library can never disagree about them.
+#include <cstdio>
+#include <memory>
+
+#include <glint/bloom.h>
+
+#include "cli/commands.h"
+#include "core/resources.h"
+#include "core/transfer.h"
+#include "io/exr_io.h"
+#include "io/png_io.h"
+
+namespace glint::cli {
+namespace {
+
+struct BloomOptions {
+  std::string input;
+  std::string output;
+  std::string png;
+  std::string device;
+  std::string filter = "cod13";
+  bool fp32 = false;
+  float exposure = 1.0f;
+  BloomConfig config;
+};
+
+BloomFilter filter_from_name(const std::string& name) {
+  if (name == "dual") return BloomFilter::dual;
+  if (name == "gauss9") return BloomFilter::gauss9;
+  return BloomFilter::cod13;  // IsMember() has already rejected anything else
+}
+
+const char* filter_name(BloomFilter f) {
+  switch (f) {
+    case BloomFilter::dual: return "dual";
+    case BloomFilter::gauss9: return "gauss9";
+    default: return "cod13";
+  }
+}
+
+void run_bloom(BloomOptions& o) {
+  o.config.filter = filter_from_name(o.filter);
+  o.config.precision = o.fp32 ? Precision::fp32 : Precision::fp16;
+  o.config.validate();  // bad flags fail before any file or device is touched
+  check_exposure(o.exposure);
+  check_output_path(o.output);
+  if (!o.png.empty()) check_output_path(o.png);
+
+  const CpuImage input = io::read_exr(o.input);
+  const VkExtent2D extent{input.width, input.height};
+
+  ContextOptions options;
+  options.device = o.device;
+  const Context context = Context::create(options);
+  Bloom bloom(context, o.config);
+  bloom.prepare(extent);  // throws unsupported_size before any image is made for a too-large input
+
+  detail::OwnedImage source(context, extent, VK_FORMAT_R32G32B32A32_SFLOAT, detail::kToolImageUsage);
+  detail::OwnedImage result(context, extent, VK_FORMAT_R16G16B16A16_SFLOAT, detail::kToolImageUsage);
+  detail::upload(context, source.image(), input);
+  Profiler profiler(context);
+  context.run_once([&](VkCommandBuffer cmd) {
+    profiler.reset(cmd);
+    profiler.mark(cmd, "start");
+    bloom.record(cmd, source.image(), result.image(), &profiler);
+  });
+  const CpuImage output = detail::download(context, result.image());
+
+  std::printf("device: %s (%s)\n", context.info().name.c_str(), device_type_name(context.info().type));
+  std::printf("input: %s, %ux%u\n", o.input.c_str(), input.width, input.height);
+  std::printf("bloom: filter %s, %s intermediates, %u level%s", filter_name(o.config.filter), o.fp32 ? "fp32" : "fp16",
+              bloom.levels(), bloom.levels() == 1 ? "" : "s");
+  if (bloom.clamped()) {
+    std::printf(" (clamped: --iterations %u does not fit %ux%u)\n", o.config.iterations, input.width, input.height);
+  } else {
+    std::printf(" (not clamped)\n");
+  }
+  print_stages(profiler);
+
+  io::write_exr_half(o.output, output);
+  std::printf("wrote %s\n", o.output.c_str());
+  if (!o.png.empty()) {
+    io::write_png_tonemapped(o.png, output, o.exposure);
+    std::printf("wrote %s\n", o.png.c_str());
+  }
+}
+
+}  // namespace
+
+Command add_bloom_command(CLI::App& app) {
+  auto o = std::make_shared<BloomOptions>();
+  CLI::App* sub = app.add_subcommand("bloom", "Apply bloom to an OpenEXR image; write RGBA half EXR");
+  sub->add_option("input", o->input, "Input OpenEXR file (R,G,B[,A], or one grey channel)")->required();
+  sub->add_option("output", o->output, "Output OpenEXR file (RGBA half)")->required();
+  sub->add_option("--threshold", o->config.threshold, "Luminance where bloom starts (0 to 65504)");
+  sub->add_option("--knee", o->config.soft_knee, "Soft knee width as a fraction of the threshold (0 to 1)");
+  sub->add_option("--intensity", o->config.intensity, "Weight of the bloom added to the image (0 to 100)");
+  sub->add_option("--iterations", o->config.iterations, "Pyramid levels (1 to 8; fewer at small sizes)");
+  sub->add_option("--radius", o->config.radius, "Scale of the upsample footprint (0.25 to 4)");
+  sub->add_option("--filter", o->filter, "Filter between levels")->check(CLI::IsMember({"cod13", "dual", "gauss9"}));
+  sub->add_flag("--fp32", o->fp32, "Keep the pyramid in RGBA32F instead of RGBA16F");
+  sub->add_option("--png", o->png, "Also write a tonemapped (ACES fitted) 8-bit sRGB PNG here");
+  sub->add_option("--exposure", o->exposure, "Linear exposure applied before the PNG tonemap (> 0)");
+  add_device_option(*sub, o->device);
+  return {sub, [o] { run_bloom(*o); }};
+}
+
+}  // namespace glint::cli

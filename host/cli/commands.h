@@ -1,0 +1,47 @@
+// The glint command: one file per subcommand (devices_command.cpp, bloom_command.cpp, ...), each
+// registering its options on the CLI11 app and returning what to run once parsing succeeded.
+// Adding an effect adds one <effect>_command.cpp and one line in main.cpp.
+#pragma once
+
+#include <glint/glint.h>
+
+#include <CLI/CLI.hpp>
+
+#include <functional>
+#include <string>
+
+namespace glint::cli {
+
+/// A registered subcommand. `run` is called only if `app` was the subcommand given; it reports
+/// failures by throwing (glint::Error for anything the user can fix).
+struct Command {
+  CLI::App* app = nullptr;
+  std::function<void()> run;
+};
+
+Command add_devices_command(CLI::App& app);
+Command add_bloom_command(CLI::App& app);
+Command add_demo_command(CLI::App& app);
+
+// ---- helpers shared by the commands (common.cpp) ----
+
+/// "discrete GPU", "CPU", ...
+const char* device_type_name(VkPhysicalDeviceType type);
+
+/// Parses "WIDTHxHEIGHT" (each 1 to 16384). Throws Error(invalid_argument) naming `option`.
+VkExtent2D parse_size(const std::string& option, const std::string& text);
+
+/// Throws Error(invalid_argument) unless --exposure is finite and > 0.
+void check_exposure(float exposure);
+
+/// Throws Error(io_failure) when `path` cannot be an output file: its directory is missing or it
+/// is a directory. Checked before GPU work so that a typo does not cost a run.
+void check_output_path(const std::string& path);
+
+/// Adds --device to a subcommand (an index or a name substring, as ContextOptions::device).
+void add_device_option(CLI::App& sub, std::string& device);
+
+/// Prints each profiler stage and the total in ms, or a note when the device has no timestamps.
+void print_stages(const Profiler& profiler);
+
+}  // namespace glint::cli

@@ -1,0 +1,72 @@
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+
+#include "cli/commands.h"
+#include "io/exr_io.h"
+
+namespace glint::cli {
+
+const char* device_type_name(VkPhysicalDeviceType type) {
+  switch (type) {
+    case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU: return "discrete GPU";
+    case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU: return "integrated GPU";
+    case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU: return "virtual GPU";
+    case VK_PHYSICAL_DEVICE_TYPE_CPU: return "CPU";
+    default: return "other";
+  }
+}
+
+VkExtent2D parse_size(const std::string& option, const std::string& text) {
+  const auto bad = [&] {
+    return Error(ErrorCode::invalid_argument, option + ": '" + text + "' is not WIDTHxHEIGHT with each from 1 to " +
+                                                  std::to_string(io::kMaxImageDimension) + " (e.g. 1920x1080)");
+  };
+  const size_t x = text.find_first_of("xX");
+  if (x == std::string::npos || x == 0 || x + 1 >= text.size()) throw bad();
+  uint32_t w = 0, h = 0;
+  const char* begin = text.data();
+  const char* end = text.data() + text.size();
+  const auto rw = std::from_chars(begin, begin + x, w);
+  const auto rh = std::from_chars(begin + x + 1, end, h);
+  if (rw.ec != std::errc() || rw.ptr != begin + x || rh.ec != std::errc() || rh.ptr != end) throw bad();
+  if (w == 0 || h == 0 || w > io::kMaxImageDimension || h > io::kMaxImageDimension) throw bad();
+  return {w, h};
+}
+
+void check_exposure(float exposure) {
+  if (!std::isfinite(exposure) || !(exposure > 0.0f)) {
+    char text[128];
+    std::snprintf(text, sizeof text, "--exposure = %g is out of range: accepted finite and > 0", double(exposure));
+    throw Error(ErrorCode::invalid_argument, text);
+  }
+}
+
+void check_output_path(const std::string& path) {
+  namespace fs = std::filesystem;
+  const fs::path p(path);
+  const fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec)) throw Error(ErrorCode::io_failure, path + ": directory " + dir.string() + " does not exist");
+  if (fs::is_directory(p, ec)) throw Error(ErrorCode::io_failure, path + ": is a directory");
+}
+
+void add_device_option(CLI::App& sub, std::string& device) {
+  sub.add_option("--device", device,
+                 "Vulkan device: an index from 'glint devices' or part of its name (default: GLINT_DEVICE, "
+                 "else the first discrete GPU, integrated GPU, then CPU)");
+}
+
+void print_stages(const Profiler& profiler) {
+  const auto stages = profiler.results();
+  if (stages.empty()) {
+    std::printf("GPU time: not available (the device has no timestamp queries)\n");
+    return;
+  }
+  std::printf("GPU time per stage:\n");
+  for (const auto& s : stages) std::printf("  %-28s %9.3f ms\n", s.label.c_str(), s.ms);
+  std::printf("  %-28s %9.3f ms\n", "total", profiler.total_ms());
+}
+
+}  // namespace glint::cli

@@ -1,0 +1,248 @@
+// OpenEXR io through the generic FrameBuffer API (OpenEXR 3.1 "Reading and Writing Image Files",
+// section "Reading an image file with an arbitrary set of channels"), so that any channel set and
+// pixel type converts to float. OpenEXR reports problems by throwing Iex exceptions (std::exception
+// subclasses); each is caught here and re-thrown as glint::Error(io_failure) naming the path.
+#include "io/exr_io.h"
+
+#include <glint/glint.h>
+
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfInputFile.h>
+#include <ImfRgbaFile.h>
+#include <ImfTestFile.h>
+#include <ImathBox.h>
+#include <half.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <climits>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <new>
+#include <sstream>
+
+namespace glint::io {
+namespace {
+
+[[noreturn]] void fail(const std::string& path, const std::string& what) {
+  throw Error(ErrorCode::io_failure, path + ": " + what);
+}
+
+// OpenEXR messages sometimes span lines; callers print errors on one line.
+std::string one_line(const char* text) {
+  std::string s = text ? text : "unknown error";
+  std::replace(s.begin(), s.end(), '\n', ' ');
+  std::replace(s.begin(), s.end(), '\r', ' ');
+  return s;
+}
+
+// OpenEXR's own header sanity check: a bound on the data window and tile size, so that a corrupt
+// header cannot make OpenEXR allocate a huge line-offset table before our size check runs. Looser
+// than kMaxImageDimension so that most oversized files get our clearer message below.
+void limit_openexr_sizes() {
+  static const bool done = [] {
+    Imf::Header::setMaxImageSize(4 * int(kMaxImageDimension), 4 * int(kMaxImageDimension));
+    Imf::Header::setMaxTileSize(int(kMaxImageDimension), int(kMaxImageDimension));
+    return true;
+  }();
+  (void)done;
+}
+
+// Checks what the filesystem can tell before OpenEXR opens the file, for precise messages.
+void check_input_file(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::file_status st = fs::status(path, ec);
+  if (ec && ec != std::errc::no_such_file_or_directory) fail(path, "cannot access: " + ec.message());
+  if (!fs::exists(st)) fail(path, "no such file");
+  if (fs::is_directory(st)) fail(path, "is a directory, not an OpenEXR file");
+  if (!fs::is_regular_file(st)) fail(path, "not a regular file");
+  const auto bytes = fs::file_size(path, ec);
+  if (ec) fail(path, "cannot access: " + ec.message());
+  if (bytes == 0) fail(path, "empty file (0 bytes), not an OpenEXR file");
+  {
+    std::ifstream probe(path, std::ios::binary);
+    if (!probe) fail(path, std::string("cannot open for reading: ") + std::strerror(errno));
+  }
+  bool tiled = false, deep = false, multi_part = false;
+  if (!Imf::isOpenExrFile(path.c_str(), tiled, deep, multi_part)) {
+    fail(path, "not an OpenEXR file (no OpenEXR magic number and version)");
+  }
+  if (deep) fail(path, "deep OpenEXR files are not supported");
+}
+
+// Data window size, checked against the limits before anything is allocated.
+struct Window {
+  Imath::Box2i box;
+  uint32_t width = 0;
+  uint32_t height = 0;
+};
+
+Window checked_window(const std::string& path, const Imf::Header& header) {
+  Window w;
+  w.box = header.dataWindow();
+  const int64_t width = int64_t(w.box.max.x) - w.box.min.x + 1;
+  const int64_t height = int64_t(w.box.max.y) - w.box.min.y + 1;
+  if (width <= 0 || height <= 0) fail(path, "empty data window (zero-size image)");
+  if (width > kMaxImageDimension || height > kMaxImageDimension || uint64_t(width) * uint64_t(height) > kMaxImagePixels) {
+    std::ostringstream m;
+    m << "image is " << width << "x" << height << ", larger than glint reads (at most " << kMaxImageDimension
+      << " on a side and " << kMaxImagePixels << " pixels)";
+    fail(path, m.str());
+  }
+  w.width = uint32_t(width);
+  w.height = uint32_t(height);
+  return w;
+}
+
+void require_full_resolution(const std::string& path, const char* name, const Imf::Channel& channel) {
+  if (channel.xSampling != 1 || channel.ySampling != 1) {
+    fail(path, std::string("channel ") + name + " is subsampled, which glint does not read");
+  }
+}
+
+size_t channel_count(const Imf::ChannelList& channels) {
+  size_t n = 0;
+  for (auto it = channels.begin(); it != channels.end(); ++it) ++n;
+  return n;
+}
+
+std::string channel_names(const Imf::ChannelList& channels) {
+  std::string names;
+  for (auto it = channels.begin(); it != channels.end(); ++it) {
+    if (!names.empty()) names += ", ";
+    names += it.name();
+  }
+  return names.empty() ? "none" : names;
+}
+
+// Y (luminance), else the only channel of a one-channel file; empty when neither exists.
+std::string grey_channel(const Imf::ChannelList& channels) {
+  if (channels.findChannel("Y")) return std::string("Y");
+  if (channel_count(channels) == 1) return std::string(channels.begin().name());
+  return std::string();
+}
+
+// Runs `body` (which uses OpenEXR) and turns any exception but glint::Error into io_failure.
+template <typename F>
+auto guarded(const std::string& path, const char* action, F&& body) -> decltype(body()) {
+  try {
+    return body();
+  } catch (const Error&) {
+    throw;
+  } catch (const std::bad_alloc&) {
+    fail(path, std::string("out of memory, cannot ") + action);
+  } catch (const std::exception& e) {
+    fail(path, std::string("cannot ") + action + ": " + one_line(e.what()));
+  } catch (...) {
+    fail(path, std::string("cannot ") + action + ": unknown error");
+  }
+}
+
+void check_output_image(const std::string& path, const CpuImage& image) {
+  if (image.width == 0 || image.height == 0) {
+    fail(path, "cannot write an empty image (" + std::to_string(image.width) + "x" + std::to_string(image.height) + ")");
+  }
+  if (image.rgba.size() != size_t(image.width) * image.height * 4) {
+    throw Error(ErrorCode::invalid_argument, path + ": CpuImage has " + std::to_string(image.rgba.size()) +
+                                                 " floats; width * height * 4 = " +
+                                                 std::to_string(size_t(image.width) * image.height * 4));
+  }
+  if (image.width > kMaxImageDimension || image.height > kMaxImageDimension ||
+      uint64_t(image.width) * image.height > kMaxImagePixels) {
+    fail(path, "image is " + std::to_string(image.width) + "x" + std::to_string(image.height) +
+                   ", larger than glint writes (at most " + std::to_string(kMaxImageDimension) + " on a side)");
+  }
+}
+
+}  // namespace
+
+CpuImage read_exr(const std::string& path) {
+  limit_openexr_sizes();
+  check_input_file(path);
+  return guarded(path, "read OpenEXR file", [&] {
+    Imf::InputFile file(path.c_str());
+    const Window w = checked_window(path, file.header());
+    if (!file.isComplete()) fail(path, "truncated or incomplete OpenEXR file (missing pixel data)");
+    const Imf::ChannelList& channels = file.header().channels();
+
+    CpuImage image(w.width, w.height, 0.0f);
+    const size_t x_stride = 4 * sizeof(float);
+    const size_t y_stride = x_stride * w.width;
+    Imf::FrameBuffer fb;
+    const bool has_rgb = channels.findChannel("R") || channels.findChannel("G") || channels.findChannel("B");
+    if (has_rgb) {
+      // Missing colour channels are filled with 0 and a missing alpha with 1 by OpenEXR itself.
+      const char* names[4] = {"R", "G", "B", "A"};
+      for (int c = 0; c < 4; ++c) {
+        if (const Imf::Channel* ch = channels.findChannel(names[c])) require_full_resolution(path, names[c], *ch);
+        fb.insert(names[c], Imf::Slice::Make(Imf::FLOAT, image.rgba.data() + c, w.box, x_stride, y_stride, 1, 1,
+                                             c == 3 ? 1.0 : 0.0));
+      }
+      file.setFrameBuffer(fb);
+      file.readPixels(w.box.min.y, w.box.max.y);
+      return image;
+    }
+
+    // Grey: Y (luminance), else the only channel. Read into R, copy to G and B.
+    const std::string grey = grey_channel(channels);
+    if (grey.empty()) {
+      fail(path, "no R, G, B or Y channel and more than one channel to choose from (channels: " +
+                     channel_names(channels) + ")");
+    }
+    require_full_resolution(path, grey.c_str(), *channels.findChannel(grey));
+    fb.insert(grey, Imf::Slice::Make(Imf::FLOAT, image.rgba.data(), w.box, x_stride, y_stride));
+    fb.insert("A", Imf::Slice::Make(Imf::FLOAT, image.rgba.data() + 3, w.box, x_stride, y_stride, 1, 1, 1.0));
+    file.setFrameBuffer(fb);
+    file.readPixels(w.box.min.y, w.box.max.y);
+    for (size_t i = 0; i < image.rgba.size(); i += 4) image.rgba[i + 1] = image.rgba[i + 2] = image.rgba[i];
+    return image;
+  });
+}
+
+ExrChannel read_exr_channel(const std::string& path, const std::string& preferred_name) {
+  limit_openexr_sizes();
+  check_input_file(path);
+  return guarded(path, "read OpenEXR file", [&] {
+    Imf::InputFile file(path.c_str());
+    const Window w = checked_window(path, file.header());
+    if (!file.isComplete()) fail(path, "truncated or incomplete OpenEXR file (missing pixel data)");
+    const Imf::ChannelList& channels = file.header().channels();
+    if (channels.begin() == channels.end()) fail(path, "the file has no channels");
+
+    ExrChannel out;
+    out.name = (!preferred_name.empty() && channels.findChannel(preferred_name)) ? preferred_name
+                                                                                 : std::string(channels.begin().name());
+    require_full_resolution(path, out.name.c_str(), *channels.findChannel(out.name));
+    out.width = w.width;
+    out.height = w.height;
+    out.values.assign(size_t(w.width) * w.height, 0.0f);
+    Imf::FrameBuffer fb;
+    fb.insert(out.name, Imf::Slice::Make(Imf::FLOAT, out.values.data(), w.box, sizeof(float),
+                                         sizeof(float) * w.width));
+    file.setFrameBuffer(fb);
+    file.readPixels(w.box.min.y, w.box.max.y);
+    return out;
+  });
+}
+
+void write_exr_half(const std::string& path, const CpuImage& image) {
+  limit_openexr_sizes();
+  check_output_image(path, image);
+  guarded(path, "write OpenEXR file", [&] {
+    std::vector<Imf::Rgba> pixels(size_t(image.width) * image.height);
+    for (size_t i = 0; i < pixels.size(); ++i) {
+      const float* p = &image.rgba[i * 4];
+      pixels[i] = Imf::Rgba(half(p[0]), half(p[1]), half(p[2]), half(p[3]));
+    }
+    Imf::Header header(int(image.width), int(image.height));  // ZIP compression by default
+    Imf::RgbaOutputFile file(path.c_str(), header, Imf::WRITE_RGBA);
+    file.setFrameBuffer(pixels.data(), 1, image.width);
+    file.writePixels(int(image.height));
+  });
+}
+
+}  // namespace glint::io

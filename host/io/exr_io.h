@@ -1,0 +1,55 @@
+// OpenEXR reading and writing for the CLI, tests and benchmarks (OpenEXR 3.1).
+//
+// Every failure throws glint::Error(ErrorCode::io_failure, "<path>: <what is wrong>"), including
+// the exceptions OpenEXR itself throws, which are caught and re-thrown with the path in front.
+// Nothing here crashes on a missing, empty, foreign, truncated or corrupt file.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/cpu_image.h"
+
+namespace glint::io {
+
+/// The largest image the readers accept: 16384 on a side and 2^28 pixels in all (a 4 GiB
+/// CpuImage). Larger data windows are rejected before anything is allocated.
+inline constexpr uint32_t kMaxImageDimension = 16384;
+inline constexpr uint64_t kMaxImagePixels = uint64_t(1) << 28;
+
+/// Reads the colour of an OpenEXR file as RGBA float.
+///
+/// The image is the file's data window (the display window is ignored), top row first. Channels:
+/// R, G and B when any of them is present (a missing one reads as 0); else a channel named Y, or
+/// the only channel of a one-channel file (Z, Y, anything), goes to R = G = B. A is read when
+/// present, else alpha is 1. Half, float and uint channels are all converted to float. Scanline
+/// and tiled single-part files are read (the first part of a multi-part file); deep files are not.
+/// path: the file to read.
+CpuImage read_exr(const std::string& path);
+
+/// One channel of an OpenEXR file.
+struct ExrChannel {
+  uint32_t width = 0;
+  uint32_t height = 0;
+  std::string name;           //!< the channel that was read
+  std::vector<float> values;  //!< width * height floats, row-major, top row first
+};
+
+/// Reads one channel of an OpenEXR file as float (for depth and other non-colour data).
+///
+/// Reads the channel called `preferred_name` when the file has it, else the file's first channel
+/// in OpenEXR's (alphabetical) order; ExrChannel::name says which. The channel must not be
+/// subsampled.
+/// path: the file to read.
+/// preferred_name: may be empty, which means "the first channel".
+ExrChannel read_exr_channel(const std::string& path, const std::string& preferred_name);
+
+/// Writes `image` as an RGBA half-float OpenEXR file (ZIP compression), replacing `path`.
+///
+/// Values beyond the half range (+-65504) become +-Inf; NaN stays NaN.
+/// path: the file to write; its directory must exist.
+/// image: must be non-empty, with rgba.size() == width * height * 4 (else Error(invalid_argument)).
+void write_exr_half(const std::string& path, const CpuImage& image);
+
+}  // namespace glint::io

@@ -1,0 +1,110 @@
+#!/usr/bin/env bash
+# Smoke test of the glint command: the happy paths write their files with nothing on stderr, and
+# every bad flag or bad file exits 2 with exactly one line "glint: error: ..." on stderr (never a
+# crash, a stack trace or CLI11's own exit codes).
+# Usage: tests/cli_test.sh path/to/glint   (glint.sh test runs it; so can ctest)
+set -uo pipefail
+
+GLINT="${1:?usage: cli_test.sh path/to/glint}"
+tmp="$(mktemp -d)"
+trap 'rm -rf "$tmp"' EXIT
+failures=0
+
+fail() { printf 'FAIL: %s\n' "$*" >&2; failures=$((failures + 1)); }
+
+# ok ARGS...: exit 0, nothing on stderr.
+ok() {
+  "$GLINT" "$@" >"$tmp/out" 2>"$tmp/err"
+  local rc=$?
+  if ((rc != 0)) || [[ -s "$tmp/err" ]]; then
+    fail "glint $* -> exit $rc; stderr:"
+    cat "$tmp/err" >&2
+  fi
+}
+
+# bad ARGS...: exit 2, exactly one stderr line starting "glint: error: ".
+bad() {
+  "$GLINT" "$@" >"$tmp/out" 2>"$tmp/err"
+  local rc=$? lines
+  lines=$(wc -l <"$tmp/err")
+  if ((rc != 2)) || ((lines != 1)) || ! grep -q '^glint: error: ' "$tmp/err"; then
+    fail "glint $* -> exit $rc, $lines stderr line(s):"
+    cat "$tmp/err" >&2
+  fi
+}
+
+expect_file() { [[ -s "$1" ]] || fail "missing or empty output $1"; }
+
+# Happy paths.
+ok --help
+ok bloom --help
+ok --version
+ok devices
+grep -q '^index' "$tmp/out" || fail "glint devices printed no table"
+ok demo --size 96x64 --out "$tmp/demo"
+expect_file "$tmp/demo/scene.exr"
+expect_file "$tmp/demo/bloom.exr"
+expect_file "$tmp/demo/bloom.png"
+grep -q 'total' "$tmp/out" || grep -q 'not available' "$tmp/out" || fail "glint demo printed no stage times"
+scene="$tmp/demo/scene.exr"
+for filter in cod13 dual gauss9; do
+  ok bloom "$scene" "$tmp/$filter.exr" --png "$tmp/$filter.png" --filter "$filter" --threshold 0.8 --knee 0.3 \
+    --intensity 0.5 --iterations 4 --radius 1.5
+  expect_file "$tmp/$filter.exr"
+  expect_file "$tmp/$filter.png"
+done
+ok bloom "$scene" "$tmp/fp32.exr" --fp32
+ok bloom "$tmp/cod13.exr" "$tmp/again.exr"  # its own output is valid input
+ok demo --size 1x1 --out "$tmp/tiny"
+grep -q 'clamped' "$tmp/out" || fail "a 1x1 demo did not report clamped levels"
+
+# Bad command lines.
+bad
+bad frobnicate
+bad bloom
+bad bloom "$scene"
+bad bloom "$scene" "$tmp/x.exr" extra
+bad bloom "$scene" "$tmp/x.exr" --no-such-flag
+bad bloom "$scene" "$tmp/x.exr" --threshold
+bad bloom "$scene" "$tmp/x.exr" --threshold abc
+bad bloom "$scene" "$tmp/x.exr" --threshold -1
+bad bloom "$scene" "$tmp/x.exr" --threshold nan
+bad bloom "$scene" "$tmp/x.exr" --knee 2
+bad bloom "$scene" "$tmp/x.exr" --intensity -0.5
+bad bloom "$scene" "$tmp/x.exr" --iterations 0
+bad bloom "$scene" "$tmp/x.exr" --iterations 99
+bad bloom "$scene" "$tmp/x.exr" --iterations -1
+bad bloom "$scene" "$tmp/x.exr" --radius 0.1
+bad bloom "$scene" "$tmp/x.exr" --radius inf
+bad bloom "$scene" "$tmp/x.exr" --filter box
+bad bloom "$scene" "$tmp/x.exr" --png "$tmp/x.png" --exposure 0
+bad bloom "$scene" "$tmp/x.exr" --device 99
+bad bloom "$scene" "$tmp/x.exr" --device no-such-gpu
+bad demo --size 0x10 --out "$tmp/d"
+bad demo --size 10 --out "$tmp/d"
+bad demo --size 20000x10 --out "$tmp/d"
+bad demo --exposure -1 --out "$tmp/d"
+bad demo --out "$scene"  # a file, not a directory
+
+# Bad files.
+bad bloom "$tmp/missing.exr" "$tmp/x.exr"
+bad bloom "$tmp" "$tmp/x.exr"
+: >"$tmp/empty.exr"
+bad bloom "$tmp/empty.exr" "$tmp/x.exr"
+head -c 4096 /dev/urandom >"$tmp/noise.exr"
+bad bloom "$tmp/noise.exr" "$tmp/x.exr"
+bad bloom "$tmp/cod13.png" "$tmp/x.exr"
+size=$(stat -c %s "$scene")
+head -c $((size / 2)) "$scene" >"$tmp/half.exr"
+bad bloom "$tmp/half.exr" "$tmp/x.exr"
+head -c 40 "$scene" >"$tmp/header.exr"
+bad bloom "$tmp/header.exr" "$tmp/x.exr"
+bad bloom "$scene" "$tmp/no/such/dir/x.exr"
+bad bloom "$scene" "$tmp"
+bad bloom "$scene" "$tmp/x.exr" --png "$tmp/no/such/dir/x.png"
+
+if ((failures)); then
+  printf 'cli_test: %d failure(s)\n' "$failures" >&2
+  exit 1
+fi
+echo "cli_test: ok"
