@@ -75,7 +75,7 @@ constexpr VkAccessFlags2 kStorageRead = VK_ACCESS_2_SHADER_STORAGE_READ_BIT;
 // bloom_up_tiled.glsl): vec4 windows of the source.
 uint32_t bloom_shared_bytes(detail::Workgroup2D g) {
   const uint32_t down = ((2 * g.x + 4) * (2 * g.y + 4) + (2 * g.x + 3) * (2 * g.y + 3)) * 16;
-  const uint32_t up = ((g.x + 11) * (g.y + 11) + 2 * g.x * (g.y + 11)) * 16;
+  const uint32_t up = ((g.x + 10) * (g.y + 10) + g.x * (g.y + 10)) * 16;
   return std::max(down, up);
 }
 
@@ -142,15 +142,10 @@ struct Bloom::Impl {
     down = detail::ComputePipeline(*context, desc("bloom_down_" + lv, {S, W}));
     blur = config.filter == BloomFilter::gauss9 ? detail::ComputePipeline(*context, desc("bloom_blur_" + lv, {S, W}))
                                                 : detail::ComputePipeline();
-    auto blocks = [](detail::PipelineDesc d) {  // these kernels write 2x2 texels per invocation
-      d.texels_per_invocation = 2;
-      return d;
-    };
-    up = detail::ComputePipeline(*context, blocks(desc("bloom_up_" + lv, {S, W})));
+    up = detail::ComputePipeline(*context, desc("bloom_up_" + lv, {S, W}));
     const char* out_variants[2] = {"rgba16f", "rgba32f"};
     for (int i = 0; i < 2; ++i) {
-      composite[i] =
-          detail::ComputePipeline(*context, blocks(desc(std::string("bloom_composite_") + out_variants[i], {S, S, W})));
+      composite[i] = detail::ComputePipeline(*context, desc(std::string("bloom_composite_") + out_variants[i], {S, S, W}));
       copy[i] = detail::ComputePipeline(*context, desc(std::string("image_copy_") + out_variants[i], {S, W}));
     }
   }

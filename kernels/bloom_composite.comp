@@ -18,17 +18,10 @@ vec3 source_texel(ivec2 ij) { return vec3(0.0); }  // unused
 #include "bloom_up_tiled.glsl"
 
 void main() {
+  ivec2 xy = ivec2(gl_GlobalInvocationID.xy);
   ivec2 size = ivec2(p.dst_width, p.dst_height);
-  ivec2 origin = block_origin();
-  vec4 s[4];
-  for (int k = 0; k < 4; ++k) {  // issued first: their latency overlaps the tile work
-    ivec2 xy = origin + ivec2(k & 1, k >> 1);  // only own texels: in place, others are being written
-    s[k] = all(lessThan(xy, size)) ? texelFetch(scene, xy, 0) : vec4(0.0);
-  }
-  vec3 bloom[4];
-  upsample_block(level0, ivec2(p.src_width, p.src_height), size, p.radius, bloom);
-  for (int k = 0; k < 4; ++k) {
-    ivec2 xy = origin + ivec2(k & 1, k >> 1);
-    if (all(lessThan(xy, size))) imageStore(result, xy, vec4(s[k].rgb + p.composite_scale * bloom[k], s[k].a));
-  }
+  vec4 s = texelFetch(scene, min(xy, size - 1), 0);  // issued first: its latency overlaps the tile work
+  vec3 bloom = upsample_tiled(level0, ivec2(p.src_width, p.src_height), size, p.radius);
+  if (any(greaterThanEqual(xy, size))) return;  // after the barriers inside upsample_tiled
+  imageStore(result, xy, vec4(s.rgb + p.composite_scale * bloom, s.a));
 }

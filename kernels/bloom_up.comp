@@ -17,17 +17,10 @@ vec3 source_texel(ivec2 ij) { return vec3(0.0); }  // unused: upsample reads `sm
 #include "bloom_up_tiled.glsl"
 
 void main() {
+  ivec2 xy = ivec2(gl_GlobalInvocationID.xy);
   ivec2 dst_size = ivec2(p.dst_width, p.dst_height);
-  ivec2 origin = block_origin();
-  vec3 own[4];
-  for (int k = 0; k < 4; ++k) {  // issued first, as in bloom_composite
-    ivec2 xy = origin + ivec2(k & 1, k >> 1);  // only own texels: the others are being written
-    own[k] = all(lessThan(xy, dst_size)) ? imageLoad(level, xy).rgb : vec3(0.0);
-  }
-  vec3 up[4];
-  upsample_block(smaller, ivec2(p.src_width, p.src_height), dst_size, p.radius, up);
-  for (int k = 0; k < 4; ++k) {
-    ivec2 xy = origin + ivec2(k & 1, k >> 1);
-    if (all(lessThan(xy, dst_size))) imageStore(level, xy, vec4(own[k] + up[k], 1.0));
-  }
+  vec3 own = imageLoad(level, min(xy, dst_size - 1)).rgb;  // issued first, as in bloom_composite
+  vec3 up = upsample_tiled(smaller, ivec2(p.src_width, p.src_height), dst_size, p.radius);
+  if (any(greaterThanEqual(xy, dst_size))) return;  // after the barriers inside upsample_tiled
+  imageStore(level, xy, vec4(own + up, 1.0));
 }

@@ -30,7 +30,6 @@ ComputePipeline::ComputePipeline(const Context& context, const PipelineDesc& des
   id_ = desc.kernel_id;
   push_bytes_ = desc.push_constant_bytes;
   workgroup_ = desc.workgroup;
-  texels_per_invocation_ = desc.texels_per_invocation;
   bindings_ = desc.bindings;
   auto& s = context.state();
   const KernelBinary* bin = find_kernel(desc.kernel_id.c_str());
@@ -95,7 +94,6 @@ ComputePipeline& ComputePipeline::operator=(ComputePipeline&& o) noexcept {
     pipeline_ = std::exchange(o.pipeline_, VK_NULL_HANDLE);
     push_bytes_ = o.push_bytes_;
     workgroup_ = o.workgroup_;
-    texels_per_invocation_ = o.texels_per_invocation_;
     bindings_ = std::move(o.bindings_);
   }
   return *this;
@@ -122,9 +120,7 @@ void ComputePipeline::dispatch_raw(VkCommandBuffer cmd, VkDescriptorSet set, con
   vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_);
   vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, layout_, 0, 1, &set, 0, nullptr);
   if (bytes) vkCmdPushConstants(cmd, layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, bytes, push);
-  const uint32_t tile_x = workgroup_.x * texels_per_invocation_;
-  const uint32_t tile_y = workgroup_.y * texels_per_invocation_;
-  vkCmdDispatch(cmd, (width + tile_x - 1) / tile_x, (height + tile_y - 1) / tile_y, 1);
+  vkCmdDispatch(cmd, (width + workgroup_.x - 1) / workgroup_.x, (height + workgroup_.y - 1) / workgroup_.y, 1);
 }
 
 DescriptorArena::DescriptorArena(const Context& context, uint32_t max_sets) : context_(&context) {

@@ -23,7 +23,6 @@ struct PipelineDesc {
   uint32_t push_constant_bytes = 0;
   Workgroup2D workgroup;                        //!< constant_id 0 and 1 (local_size_x_id/y_id)
   std::vector<uint32_t> specialization;         //!< constant_id 2, 3, ...
-  uint32_t texels_per_invocation = 1;           //!< per axis: 2 for kernels that write 2x2 blocks
 };
 
 class ComputePipeline {
@@ -57,7 +56,6 @@ class ComputePipeline {
   VkPipeline pipeline_ = VK_NULL_HANDLE;
   uint32_t push_bytes_ = 0;
   Workgroup2D workgroup_;
-  uint32_t texels_per_invocation_ = 1;
   std::vector<VkDescriptorType> bindings_;
 };
 
