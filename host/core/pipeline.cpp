@@ -18,9 +18,11 @@ Workgroup2D choose_workgroup_2d(const DeviceInfo& info) {
     }
   }
   // CPU devices (lavapipe) run a workgroup per thread with 8-wide SIMD: 8x8 keeps groups small
-  // enough to spread over cores. GPUs with 32/64-wide subgroups get 16x16 when allowed.
-  if (info.type != VK_PHYSICAL_DEVICE_TYPE_CPU && info.max_workgroup_invocations >= 256 && info.subgroup_size >= 32) {
-    return {16, 16};
+  // enough to spread over cores. GPUs with 32/64-wide subgroups get 16x8: on an H100 it beat 8x8,
+  // 16x16 and 32x8 for the bloom chain (docs/PERF.md), as a compromise between the shared-memory
+  // apron (smaller groups re-read more) and occupancy (larger tiles hold more shared memory).
+  if (info.type != VK_PHYSICAL_DEVICE_TYPE_CPU && info.max_workgroup_invocations >= 128 && info.subgroup_size >= 32) {
+    return {16, 8};
   }
   return {8, 8};
 }
