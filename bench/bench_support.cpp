@@ -28,6 +28,21 @@ CpuImage random_hdr(uint32_t width, uint32_t height, uint32_t seed) {
   return img;
 }
 
+double median_frame_ms(const Context& context, Profiler& profiler, int frames,
+                       const std::function<void(VkCommandBuffer)>& record_frame) {
+  context.run_once([&](VkCommandBuffer cmd) {
+    profiler.reset(cmd);
+    profiler.mark(cmd, "start");
+    for (int i = 0; i < frames; ++i) {
+      record_frame(cmd);
+      profiler.mark(cmd, "frame");
+    }
+  });
+  std::vector<double> ms;
+  for (const auto& s : profiler.results()) ms.push_back(s.ms);
+  return median_of(ms);
+}
+
 double median_of(std::vector<double> v) {
   if (v.empty()) return 0.0;
   std::sort(v.begin(), v.end());

@@ -62,17 +62,8 @@ void BM_Bloom(benchmark::State& state) {
 
   std::vector<double> frame_ms;
   for (auto _ : state) {
-    ctx.run_once([&](VkCommandBuffer cmd) {
-      profiler.reset(cmd);
-      profiler.mark(cmd, "start");
-      for (int i = 0; i < kFramesPerIteration; ++i) {
-        bloom.record(cmd, in.state, out.state);
-        profiler.mark(cmd, "frame");
-      }
-    });
-    std::vector<double> ms;
-    for (const auto& s : profiler.results()) ms.push_back(s.ms);
-    const double median = median_of(ms);
+    const double median = median_frame_ms(ctx, profiler, kFramesPerIteration,
+                                          [&](VkCommandBuffer cmd) { bloom.record(cmd, in.state, out.state); });
     frame_ms.push_back(median);
     state.SetIterationTime(median * 1e-3);
   }

@@ -37,23 +37,15 @@ void BM_CopyFloor(benchmark::State& state) {
   Profiler profiler(ctx, kCopies + 1);
   std::vector<double> all;
   for (auto _ : state) {
-    ctx.run_once([&](VkCommandBuffer cmd) {
-      profiler.reset(cmd);
-      profiler.mark(cmd, "start");
-      for (int i = 0; i < kCopies; ++i) {
-        detail::Barriers b;
-        b.use(src.state, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-              VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
-        b.use(dst.state, VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-              VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
-        b.flush(cmd);
-        copy.dispatch(cmd, set, push, width, height);
-        profiler.mark(cmd, "copy");
-      }
+    const double m = median_frame_ms(ctx, profiler, kCopies, [&](VkCommandBuffer cmd) {
+      detail::Barriers b;
+      b.use(src.state, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+            VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
+      b.use(dst.state, VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+            VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+      b.flush(cmd);
+      copy.dispatch(cmd, set, push, width, height);
     });
-    std::vector<double> ms;
-    for (const auto& s : profiler.results()) ms.push_back(s.ms);
-    const double m = median_of(ms);
     all.push_back(m);
     state.SetIterationTime(m * 1e-3);
   }

@@ -142,7 +142,9 @@ auto guarded(const std::string& path, const char* action, F&& body) -> decltype(
   }
 }
 
-void check_output_image(const std::string& path, const CpuImage& image) {
+}  // namespace
+
+void check_writable_image(const std::string& path, const CpuImage& image) {
   if (image.width == 0 || image.height == 0) {
     fail(path, "cannot write an empty image (" + std::to_string(image.width) + "x" + std::to_string(image.height) + ")");
   }
@@ -157,8 +159,6 @@ void check_output_image(const std::string& path, const CpuImage& image) {
                    ", larger than glint writes (at most " + std::to_string(kMaxImageDimension) + " on a side)");
   }
 }
-
-}  // namespace
 
 CpuImage read_exr(const std::string& path) {
   limit_openexr_sizes();
@@ -231,7 +231,7 @@ ExrChannel read_exr_channel(const std::string& path, const std::string& preferre
 
 void write_exr_half(const std::string& path, const CpuImage& image) {
   limit_openexr_sizes();
-  check_output_image(path, image);
+  check_writable_image(path, image);
   guarded(path, "write OpenEXR file", [&] {
     std::vector<Imf::Rgba> pixels(size_t(image.width) * image.height);
     for (size_t i = 0; i < pixels.size(); ++i) {

@@ -52,4 +52,8 @@ ExrChannel read_exr_channel(const std::string& path, const std::string& preferre
 /// image: must be non-empty, with rgba.size() == width * height * 4 (else Error(invalid_argument)).
 void write_exr_half(const std::string& path, const CpuImage& image);
 
+/// Throws Error naming `path` unless `image` can be written: non-empty, its pixel buffer
+/// width * height * 4 floats, and within the size limits above. Shared by the EXR and PNG writers.
+void check_writable_image(const std::string& path, const CpuImage& image);
+
 }  // namespace glint::io

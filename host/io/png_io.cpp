@@ -41,20 +41,7 @@ void write_png_tonemapped(const std::string& path, const CpuImage& image, float 
     std::snprintf(text, sizeof text, ": exposure = %g is out of range: accepted finite and > 0", double(exposure));
     throw Error(ErrorCode::invalid_argument, path + text);
   }
-  if (image.width == 0 || image.height == 0) {
-    throw Error(ErrorCode::io_failure, path + ": cannot write an empty image (" + std::to_string(image.width) + "x" +
-                                           std::to_string(image.height) + ")");
-  }
-  if (image.rgba.size() != size_t(image.width) * image.height * 4) {
-    throw Error(ErrorCode::invalid_argument, path + ": CpuImage has " + std::to_string(image.rgba.size()) +
-                                                 " floats; width * height * 4 = " +
-                                                 std::to_string(size_t(image.width) * image.height * 4));
-  }
-  if (image.width > kMaxImageDimension || image.height > kMaxImageDimension ||
-      uint64_t(image.width) * image.height > kMaxImagePixels) {
-    throw Error(ErrorCode::io_failure, path + ": image is " + std::to_string(image.width) + "x" +
-                                           std::to_string(image.height) + ", larger than glint writes");
-  }
+  check_writable_image(path, image);
   if (std::filesystem::is_directory(path)) throw Error(ErrorCode::io_failure, path + ": is a directory");
 
   const size_t pixels = size_t(image.width) * image.height;
