@@ -39,13 +39,39 @@ void Barriers::use(Image& image, VkImageLayout layout, VkPipelineStageFlags2 sta
   image.access = access;
 }
 
+void Barriers::use(Buffer& buffer, VkPipelineStageFlags2 stage, VkAccessFlags2 access) {
+  const bool was_write = (buffer.access & kWriteAccess) != 0;
+  const bool is_write = (access & kWriteAccess) != 0;
+  if (!was_write && !is_write) {  // read after read
+    buffer.stage |= stage;
+    buffer.access |= access;
+    return;
+  }
+  VkBufferMemoryBarrier2 b{VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER_2};
+  b.srcStageMask = buffer.stage;
+  b.srcAccessMask = buffer.access & kWriteAccess;
+  b.dstStageMask = stage;
+  b.dstAccessMask = access;
+  b.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+  b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+  b.buffer = buffer.buffer;
+  b.offset = buffer.offset;
+  b.size = buffer.size;
+  pending_buffers_.push_back(b);
+  buffer.stage = stage;
+  buffer.access = access;
+}
+
 void Barriers::flush(VkCommandBuffer cmd) {
-  if (pending_.empty()) return;
+  if (pending_.empty() && pending_buffers_.empty()) return;
   VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
   dep.imageMemoryBarrierCount = static_cast<uint32_t>(pending_.size());
   dep.pImageMemoryBarriers = pending_.data();
+  dep.bufferMemoryBarrierCount = static_cast<uint32_t>(pending_buffers_.size());
+  dep.pBufferMemoryBarriers = pending_buffers_.data();
   vkCmdPipelineBarrier2(cmd, &dep);
   pending_.clear();
+  pending_buffers_.clear();
 }
 
 }  // namespace glint::detail

@@ -13,11 +13,14 @@ class Barriers {
   /// Declares that `image` is next used with (layout, stage, access). Read-after-read in the same
   /// layout needs no barrier and only widens the tracked use; anything else queues one.
   void use(Image& image, VkImageLayout layout, VkPipelineStageFlags2 stage, VkAccessFlags2 access);
+  /// The same for a buffer range (no layouts).
+  void use(Buffer& buffer, VkPipelineStageFlags2 stage, VkAccessFlags2 access);
   /// Records every queued barrier in one vkCmdPipelineBarrier2 (nothing if none are queued).
   void flush(VkCommandBuffer cmd);
 
  private:
   std::vector<VkImageMemoryBarrier2> pending_;
+  std::vector<VkBufferMemoryBarrier2> pending_buffers_;
 };
 
 inline constexpr VkAccessFlags2 kWriteAccess =

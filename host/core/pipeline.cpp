@@ -182,4 +182,32 @@ VkDescriptorSet DescriptorArena::make_set(const ComputePipeline& pipeline, const
   return set;
 }
 
+VkDescriptorSet DescriptorArena::make_buffer_set(const ComputePipeline& pipeline, const std::vector<Buffer>& buffers) {
+  const auto& types = pipeline.bindings();
+  if (buffers.size() != types.size()) {
+    throw Error(ErrorCode::invalid_argument, concat("descriptor set: ", buffers.size(), " buffers for ", types.size(), " bindings"));
+  }
+  VkDescriptorSetLayout layout = pipeline.set_layout();
+  VkDescriptorSetAllocateInfo alloc{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
+  alloc.descriptorPool = pool_;
+  alloc.descriptorSetCount = 1;
+  alloc.pSetLayouts = &layout;
+  VkDescriptorSet set = VK_NULL_HANDLE;
+  vk_check(vkAllocateDescriptorSets(context_->device(), &alloc, &set), "vkAllocateDescriptorSets");
+  context_->state().count_object();
+  std::vector<VkDescriptorBufferInfo> infos(buffers.size());
+  std::vector<VkWriteDescriptorSet> writes(buffers.size());
+  for (uint32_t i = 0; i < buffers.size(); ++i) {
+    infos[i] = {buffers[i].buffer, buffers[i].offset, buffers[i].size};
+    writes[i] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+    writes[i].dstSet = set;
+    writes[i].dstBinding = i;
+    writes[i].descriptorCount = 1;
+    writes[i].descriptorType = types[i];
+    writes[i].pBufferInfo = &infos[i];
+  }
+  vkUpdateDescriptorSets(context_->device(), static_cast<uint32_t>(writes.size()), writes.data(), 0, nullptr);
+  return set;
+}
+
 }  // namespace glint::detail

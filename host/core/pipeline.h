@@ -77,6 +77,8 @@ class DescriptorArena {
   };
   /// Allocates a set for `pipeline` and writes one image per binding, in binding order.
   VkDescriptorSet make_set(const ComputePipeline& pipeline, const std::vector<ImageBinding>& images);
+  /// The same for pipelines whose bindings are all storage buffers.
+  VkDescriptorSet make_buffer_set(const ComputePipeline& pipeline, const std::vector<Buffer>& buffers);
 
  private:
   const Context* context_ = nullptr;

@@ -160,6 +160,16 @@ struct Image {
   VkAccessFlags2 access = VK_ACCESS_2_NONE;
 };
 
+/// A view of a caller's buffer (or a range of it), with the caller's last use, like Image.
+struct Buffer {
+  VkBuffer buffer = VK_NULL_HANDLE;
+  VkDeviceSize offset = 0;             //!< a multiple of minStorageBufferOffsetAlignment
+  VkDeviceSize size = VK_WHOLE_SIZE;   //!< bytes from offset, or VK_WHOLE_SIZE
+  VkBufferUsageFlags usage = 0;        //!< the usage the buffer was created with
+  VkPipelineStageFlags2 stage = VK_PIPELINE_STAGE_2_NONE;
+  VkAccessFlags2 access = VK_ACCESS_2_NONE;
+};
+
 /// GPU timestamps around the stages an effect records. Pass one to an effect's record(); read
 /// results() after the command buffer has completed.
 class Profiler {
