@@ -103,6 +103,23 @@ bad bloom "$scene" "$tmp/no/such/dir/x.exr"
 bad bloom "$scene" "$tmp"
 bad bloom "$scene" "$tmp/x.exr" --png "$tmp/no/such/dir/x.png"
 
+# glint lod: every row comes back with a lod column; the level of a 256x256 tile seen at 4 texels
+# per pixel is 2 (log2 4), whatever the atlas.
+printf 'dudx,dvdx,dudy,dvdy,tex_w,tex_h,off_x,off_y\n0.015625,0,0,0.015625,256,256,0,0\n0.015625,0,0,0.015625,256,256,3840,3840\n' >"$tmp/q.csv"
+ok lod --atlas 4096x4096 --levels 13 "$tmp/q.csv" "$tmp/lod.csv"
+[[ "$(sed -n 2p "$tmp/lod.csv")" == "0.015625,0,0,0.015625,256,256,0,0,2.000000" ]] || fail "lod row 1: $(sed -n 2p "$tmp/lod.csv")"
+[[ "$(sed -n 3p "$tmp/lod.csv" | cut -d, -f9)" == "2.000000" ]] || fail "lod row 2: $(sed -n 3p "$tmp/lod.csv")"
+ok lod --levels 13 --aniso 4 --bias 0.5 --padding 8 "$tmp/q.csv" "$tmp/lod2.csv"
+bad lod --levels 0 "$tmp/q.csv" "$tmp/x.csv"
+bad lod --levels 13 --aniso 0.5 "$tmp/q.csv" "$tmp/x.csv"
+bad lod --levels 13 --padding -3 "$tmp/q.csv" "$tmp/x.csv"
+bad lod --levels 13 --atlas 0x4 "$tmp/q.csv" "$tmp/x.csv"
+bad lod --levels 13 "$tmp/missing.csv" "$tmp/x.csv"
+printf '1,2,3\n' >"$tmp/short.csv"
+bad lod --levels 13 "$tmp/short.csv" "$tmp/x.csv"
+printf '0.1,0,0,0.1,nan?,4,0,0\n' >"$tmp/junk.csv"
+bad lod --levels 13 "$tmp/junk.csv" "$tmp/x.csv"
+
 if ((failures)); then
   printf 'cli_test: %d failure(s)\n' "$failures" >&2
   exit 1
