@@ -108,8 +108,9 @@ TEST_F(LodTest, BatchKernelMatchesTheCppTwin) {
         ASSERT_GE(gpu[i], 0.0f);
         ASSERT_LE(gpu[i], 12.0f);
       }
-      // 2^-8 levels: the issue's bound; the twin differs only by the device's log2/sqrt rounding.
-      EXPECT_LT(worst, 1.0 / 256) << "aniso " << aniso << " padding " << padding;
+      // The issue asks the twin to agree to 1e-5 levels: both run lod_impl.h in fp32 and differ
+      // only by the device's log2/sqrt rounding (measured: 2.4e-7 lavapipe, 4.8e-7 H100).
+      EXPECT_LT(worst, 1e-5) << "aniso " << aniso << " padding " << padding;
       EXPECT_EQ(gpu[0], 0.0f);
       EXPECT_EQ(gpu[1], 0.0f);
       EXPECT_EQ(gpu[2], 0.0f);
