@@ -51,7 +51,10 @@ GLINT_LOD_FN float glint_lod_unclamped(GlintLodQuery q, GlintLodAtlas a) {
   float rho_min = min(rx, ry);
   float eta = 1.0;
   if ((a.flags & GLINT_LOD_ANISOTROPIC) != 0u && rho_max > 0.0) {
-    eta = rho_min > 0.0 ? min(rho_max / rho_min, a.max_aniso) : a.max_aniso;
+    // min(rho_max / rho_min, max_aniso), written as a comparison so that it never divides inf by
+    // inf: when both scale factors overflow float to +inf that gave NaN, and the level fell to 0
+    // instead of levels - 1. rho_min == 0 gives 0 * max_aniso = 0, not above rho_max: max_aniso.
+    eta = rho_max < rho_min * a.max_aniso ? rho_max / rho_min : a.max_aniso;
   }
   float rho = rho_max / eta;
   float lambda = rho > 0.0 ? log2(rho) : GLINT_LOD_MIN_LAMBDA;
