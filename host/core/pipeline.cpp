@@ -154,7 +154,7 @@ void DescriptorArena::reset() {
   pool_ = VK_NULL_HANDLE;
 }
 
-VkDescriptorSet DescriptorArena::make_set(const ComputePipeline& pipeline, const std::vector<ImageBinding>& images) {
+VkDescriptorSet DescriptorArena::allocate(const ComputePipeline& pipeline) {
   VkDescriptorSetLayout layout = pipeline.set_layout();
   VkDescriptorSetAllocateInfo alloc{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
   alloc.descriptorPool = pool_;
@@ -163,6 +163,11 @@ VkDescriptorSet DescriptorArena::make_set(const ComputePipeline& pipeline, const
   VkDescriptorSet set = VK_NULL_HANDLE;
   vk_check(vkAllocateDescriptorSets(context_->device(), &alloc, &set), "vkAllocateDescriptorSets");
   context_->state().count_object();
+  return set;
+}
+
+VkDescriptorSet DescriptorArena::make_set(const ComputePipeline& pipeline, const std::vector<ImageBinding>& images) {
+  VkDescriptorSet set = allocate(pipeline);
   const auto& types = pipeline.bindings();
   if (images.size() != types.size()) {
     throw Error(ErrorCode::invalid_argument, concat("descriptor set: ", images.size(), " images for ", types.size(), " bindings"));
@@ -187,14 +192,7 @@ VkDescriptorSet DescriptorArena::make_buffer_set(const ComputePipeline& pipeline
   if (buffers.size() != types.size()) {
     throw Error(ErrorCode::invalid_argument, concat("descriptor set: ", buffers.size(), " buffers for ", types.size(), " bindings"));
   }
-  VkDescriptorSetLayout layout = pipeline.set_layout();
-  VkDescriptorSetAllocateInfo alloc{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
-  alloc.descriptorPool = pool_;
-  alloc.descriptorSetCount = 1;
-  alloc.pSetLayouts = &layout;
-  VkDescriptorSet set = VK_NULL_HANDLE;
-  vk_check(vkAllocateDescriptorSets(context_->device(), &alloc, &set), "vkAllocateDescriptorSets");
-  context_->state().count_object();
+  VkDescriptorSet set = allocate(pipeline);
   std::vector<VkDescriptorBufferInfo> infos(buffers.size());
   std::vector<VkWriteDescriptorSet> writes(buffers.size());
   for (uint32_t i = 0; i < buffers.size(); ++i) {

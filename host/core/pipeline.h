@@ -81,6 +81,7 @@ class DescriptorArena {
   VkDescriptorSet make_buffer_set(const ComputePipeline& pipeline, const std::vector<Buffer>& buffers);
 
  private:
+  VkDescriptorSet allocate(const ComputePipeline& pipeline);
   const Context* context_ = nullptr;
   VkDescriptorPool pool_ = VK_NULL_HANDLE;
 };
