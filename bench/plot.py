@@ -2,11 +2,23 @@
 """Charts benchmark results: GPU time against error versus the float64 reference.
 
 Reads Google Benchmark JSON written by glint_bench (--benchmark_out=FILE --benchmark_out_format=json,
-with --benchmark_repetitions so that *_median aggregates exist) and draws, for each device file, one
-point per method at the chosen size: median GPU time (x) against relative L2 error (y).
+with --benchmark_repetitions so that *_median aggregates exist) and draws one panel per device file.
+
+--chart bloom (default): one point per bloom filter at the chosen size, median GPU time (x) against
+relative L2 error versus the float64 reference (y).
 
     python3 bench/plot.py --size 1920x1080 --out docs/charts/bloom_pareto.svg \
         "H100=docs/perf/bloom_h100.json" "lavapipe=docs/perf/bloom_lavapipe.json"
+
+--chart blur: the Gaussian blur's speed against accuracy (issue 3), one series per method, the method
+being the benchmark name's prefix BM_Blur<Method> (BM_BlurSeparable/..., BM_BlurDual/...). Each run
+with a `rel_l2` counter (relative L2 against the exact Gaussian) is one point: median GPU time (x,
+the `median_us` counter or else the run's time) against rel_l2 (log y), labelled with its `sigma`
+counter. With --size, only names containing w:W/h:H (or no size at all) are drawn. Medians of
+repetitions are used when the file has them, single runs otherwise.
+
+    python3 bench/plot.py --chart blur --size 3840x2160 \
+        "H100=docs/perf/blur_h100.json" "lavapipe=docs/perf/blur_lavapipe.json"
 """
 import argparse
 import json
@@ -35,12 +47,79 @@ def points(path, size):
     return out
 
 
+TIME_TO_US = {"ns": 1e-3, "us": 1.0, "ms": 1e3, "s": 1e6}
+
+
+def blur_points(path, size):
+    """{method: [(median_us, rel_l2, sigma or None, name)]} for every BM_Blur<Method> run with rel_l2."""
+    benchmarks = json.load(open(path))["benchmarks"]
+    has_median = any(b.get("aggregate_name") == "median" for b in benchmarks)
+    series = {}
+    for b in benchmarks:
+        m = re.match(r"BM_Blur([A-Za-z0-9]+)", b["name"])
+        if not m or "rel_l2" not in b:
+            continue
+        if has_median and b.get("aggregate_name") != "median":
+            continue
+        if not has_median and b.get("run_type", "iteration") != "iteration":
+            continue
+        if size:
+            dims = re.search(r"w:(\d+)/h:(\d+)", b["name"])
+            if dims and "x".join(dims.groups()) != size:
+                continue
+        us = b.get("median_us")
+        if us is None:
+            us = b["real_time"] * TIME_TO_US[b.get("time_unit", "ns")]
+        rel = b["rel_l2"]
+        if not (rel > 0 and us > 0):  # log axis: a zero error would vanish; skip it loudly
+            print(f"skipped {b['name']}: rel_l2 {rel}, time {us} us")
+            continue
+        series.setdefault(m.group(1), []).append((us, rel, b.get("sigma"), b["name"]))
+    return series
+
+
+def plot_blur(args):
+    fig, axes = plt.subplots(1, len(args.inputs), figsize=(6.0 * len(args.inputs), 4.6), squeeze=False)
+    markers = "osD^vP*X"
+    for ax, spec in zip(axes[0], args.inputs):
+        device, path = spec.split("=", 1)
+        series = blur_points(path, args.size)
+        for i, (method, pts) in enumerate(sorted(series.items())):
+            pts.sort()
+            ax.plot([p[0] for p in pts], [p[1] for p in pts], marker=markers[i % len(markers)], linestyle="",
+                    label=method)
+            for us, err, sigma, _ in pts:
+                if sigma is not None:
+                    ax.annotate(f"{sigma:g}", (us, err), textcoords="offset points", xytext=(4, 3), fontsize=7)
+        times = [p[0] for pts in series.values() for p in pts]
+        if times and max(times) / min(times) > 20:
+            ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel("median GPU time, us")
+        ax.set_ylabel("relative L2 error vs exact Gaussian (log)")
+        ax.set_title(f"Gaussian blur{' ' + args.size if args.size else ''} on {device} (labels: sigma)")
+        ax.grid(True, which="both", alpha=0.3)
+        if series:
+            ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(args.out)
+    print("wrote", args.out)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("inputs", nargs="+", help="DEVICE=results.json")
-    ap.add_argument("--size", default="1920x1080")
-    ap.add_argument("--out", default="docs/charts/bloom_pareto.svg")
+    ap.add_argument("--chart", choices=["bloom", "blur"], default="bloom")
+    ap.add_argument("--size", default=None, help="WxH (bloom default 1920x1080; blur default: all sizes)")
+    ap.add_argument("--out", default=None, help="default docs/charts/<chart>_pareto.svg")
     args = ap.parse_args()
+    if args.out is None:
+        args.out = f"docs/charts/{args.chart}_pareto.svg"
+    if args.chart == "blur":
+        plot_blur(args)
+        return
+    if args.size is None:
+        args.size = "1920x1080"
     fig, axes = plt.subplots(1, len(args.inputs), figsize=(5.5 * len(args.inputs), 4.2), squeeze=False)
     for ax, spec in zip(axes[0], args.inputs):
         device, path = spec.split("=", 1)

@@ -103,6 +103,31 @@ bad bloom "$scene" "$tmp/no/such/dir/x.exr"
 bad bloom "$scene" "$tmp"
 bad bloom "$scene" "$tmp/x.exr" --png "$tmp/no/such/dir/x.png"
 
+# glint blur / gauss: level files at 1/2, 1/4, 1/8 of the 96x64 scene; the method is reported.
+ok blur "$scene" "$tmp/bp" --sigmas 0.8,1.2,2
+for k in 1 2 3; do expect_file "$tmp/bp.blur$k.exr"; done
+grep -q 'blur3.exr (12x8' "$tmp/out" || fail "glint blur level 3 size: $(grep blur3 "$tmp/out")"
+for method in auto separable pyramid dual; do
+  ok gauss "$scene" "$tmp/g_$method.exr" --sigma 5 --method "$method"
+  expect_file "$tmp/g_$method.exr"
+  grep -q '^method: ' "$tmp/out" || fail "glint gauss --method $method printed no method"
+  grep -q 'expected relative L2 error' "$tmp/out" || fail "glint gauss --method $method printed no error"
+done
+ok gauss "$scene" "$tmp/g_lin.exr" --sigma 1.5 --method separable --linear --fp32
+bad blur "$scene" "$tmp/bp" --sigmas 1,2
+bad blur "$scene" "$tmp/bp" --sigmas 1,2,9
+bad blur "$scene" "$tmp/bp" --sigmas a,b,c
+bad blur "$tmp/missing.exr" "$tmp/bp"
+bad blur "$scene" "$tmp/no/such/dir/bp"
+bad gauss "$scene" "$tmp/g.exr"
+bad gauss "$scene" "$tmp/g.exr" --sigma 0.1
+bad gauss "$scene" "$tmp/g.exr" --sigma 100
+bad gauss "$scene" "$tmp/g.exr" --sigma nan
+bad gauss "$scene" "$tmp/g.exr" --sigma 2 --method box
+bad gauss "$scene" "$tmp/g.exr" --sigma 2 --max-error 0
+bad gauss "$scene" "$tmp/g.exr" --sigma 2 --method dual --linear
+bad gauss "$tmp/noise.exr" "$tmp/g.exr" --sigma 2
+
 # glint lod: every row comes back with a lod column; the level of a 256x256 tile seen at 4 texels
 # per pixel is 2 (log2 4), whatever the atlas.
 printf 'dudx,dvdx,dudy,dvdy,tex_w,tex_h,off_x,off_y\n0.015625,0,0,0.015625,256,256,0,0\n0.015625,0,0,0.015625,256,256,3840,3840\n' >"$tmp/q.csv"

@@ -23,6 +23,8 @@ Command add_devices_command(CLI::App& app);
 Command add_bloom_command(CLI::App& app);
 Command add_demo_command(CLI::App& app);
 Command add_lod_command(CLI::App& app);
+Command add_blur_command(CLI::App& app);
+Command add_gauss_command(CLI::App& app);
 
 // ---- helpers shared by the commands (common.cpp) ----
 

@@ -1,11 +1,11 @@
 #include "core/pipeline.h"
 
-#include "core/context_state.h"
-#include "core/kernel_table.h"
-
 #include <cstdio>
 #include <cstdlib>
 #include <utility>
+
+#include "core/context_state.h"
+#include "core/kernel_table.h"
 
 namespace glint::detail {
 
@@ -35,7 +35,8 @@ ComputePipeline::ComputePipeline(const Context& context, const PipelineDesc& des
   bindings_ = desc.bindings;
   auto& s = context.state();
   const KernelBinary* bin = find_kernel(desc.kernel_id.c_str());
-  if (!bin) throw Error(ErrorCode::vulkan_failure, concat("kernel '", desc.kernel_id, "' is not embedded in this build"));
+  if (!bin)
+    throw Error(ErrorCode::vulkan_failure, concat("kernel '", desc.kernel_id, "' is not embedded in this build"));
 
   VkShaderModule module = VK_NULL_HANDLE;
   try {
@@ -76,7 +77,8 @@ ComputePipeline::ComputePipeline(const Context& context, const PipelineDesc& des
     cp.stage.pName = "main";
     cp.stage.pSpecializationInfo = &spec;
     cp.layout = layout_;
-    vk_check(vkCreateComputePipelines(device_, VK_NULL_HANDLE, 1, &cp, nullptr, &pipeline_), "vkCreateComputePipelines");
+    vk_check(vkCreateComputePipelines(device_, VK_NULL_HANDLE, 1, &cp, nullptr, &pipeline_),
+             "vkCreateComputePipelines");
     s.count_object();
     vkDestroyShaderModule(device_, module, nullptr);
   } catch (...) {
@@ -170,7 +172,8 @@ VkDescriptorSet DescriptorArena::make_set(const ComputePipeline& pipeline, const
   VkDescriptorSet set = allocate(pipeline);
   const auto& types = pipeline.bindings();
   if (images.size() != types.size()) {
-    throw Error(ErrorCode::invalid_argument, concat("descriptor set: ", images.size(), " images for ", types.size(), " bindings"));
+    throw Error(ErrorCode::invalid_argument,
+                concat("descriptor set: ", images.size(), " images for ", types.size(), " bindings"));
   }
   std::vector<VkDescriptorImageInfo> infos(images.size());
   std::vector<VkWriteDescriptorSet> writes(images.size());
@@ -190,7 +193,8 @@ VkDescriptorSet DescriptorArena::make_set(const ComputePipeline& pipeline, const
 VkDescriptorSet DescriptorArena::make_buffer_set(const ComputePipeline& pipeline, const std::vector<Buffer>& buffers) {
   const auto& types = pipeline.bindings();
   if (buffers.size() != types.size()) {
-    throw Error(ErrorCode::invalid_argument, concat("descriptor set: ", buffers.size(), " buffers for ", types.size(), " bindings"));
+    throw Error(ErrorCode::invalid_argument,
+                concat("descriptor set: ", buffers.size(), " buffers for ", types.size(), " bindings"));
   }
   VkDescriptorSet set = allocate(pipeline);
   std::vector<VkDescriptorBufferInfo> infos(buffers.size());
@@ -203,6 +207,36 @@ VkDescriptorSet DescriptorArena::make_buffer_set(const ComputePipeline& pipeline
     writes[i].descriptorCount = 1;
     writes[i].descriptorType = types[i];
     writes[i].pBufferInfo = &infos[i];
+  }
+  vkUpdateDescriptorSets(context_->device(), static_cast<uint32_t>(writes.size()), writes.data(), 0, nullptr);
+  return set;
+}
+
+VkDescriptorSet DescriptorArena::make_any_set(const ComputePipeline& pipeline,
+                                              const std::vector<SetBinding>& bindings) {
+  const auto& types = pipeline.bindings();
+  if (bindings.size() != types.size()) {
+    throw Error(ErrorCode::invalid_argument,
+                concat("descriptor set: ", bindings.size(), " bindings for ", types.size()));
+  }
+  VkDescriptorSet set = allocate(pipeline);
+  std::vector<VkDescriptorImageInfo> images(bindings.size());
+  std::vector<VkDescriptorBufferInfo> buffers(bindings.size());
+  std::vector<VkWriteDescriptorSet> writes(bindings.size());
+  for (uint32_t i = 0; i < bindings.size(); ++i) {
+    const SetBinding& b = bindings[i];
+    writes[i] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+    writes[i].dstSet = set;
+    writes[i].dstBinding = i;
+    writes[i].descriptorCount = 1;
+    writes[i].descriptorType = types[i];
+    if (types[i] == VK_DESCRIPTOR_TYPE_STORAGE_BUFFER || types[i] == VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER) {
+      buffers[i] = {b.buffer, b.offset, b.range};
+      writes[i].pBufferInfo = &buffers[i];
+    } else {
+      images[i] = {b.sampler, b.view, b.layout};
+      writes[i].pImageInfo = &images[i];
+    }
   }
   vkUpdateDescriptorSets(context_->device(), static_cast<uint32_t>(writes.size()), writes.data(), 0, nullptr);
   return set;

@@ -18,11 +18,11 @@ struct Workgroup2D {
 Workgroup2D choose_workgroup_2d(const DeviceInfo& info);
 
 struct PipelineDesc {
-  std::string kernel_id;                        //!< e.g. "bloom_down_rgba16f"
-  std::vector<VkDescriptorType> bindings;       //!< binding i has type bindings[i]
+  std::string kernel_id;                   //!< e.g. "bloom_down_rgba16f"
+  std::vector<VkDescriptorType> bindings;  //!< binding i has type bindings[i]
   uint32_t push_constant_bytes = 0;
-  Workgroup2D workgroup;                        //!< constant_id 0 and 1 (local_size_x_id/y_id)
-  std::vector<uint32_t> specialization;         //!< constant_id 2, 3, ...
+  Workgroup2D workgroup;                 //!< constant_id 0 and 1 (local_size_x_id/y_id)
+  std::vector<uint32_t> specialization;  //!< constant_id 2, 3, ...
 };
 
 class ComputePipeline {
@@ -47,8 +47,8 @@ class ComputePipeline {
   }
 
  private:
-  void dispatch_raw(VkCommandBuffer cmd, VkDescriptorSet set, const void* push, uint32_t bytes,
-                    uint32_t width, uint32_t height) const;
+  void dispatch_raw(VkCommandBuffer cmd, VkDescriptorSet set, const void* push, uint32_t bytes, uint32_t width,
+                    uint32_t height) const;
   VkDevice device_ = VK_NULL_HANDLE;
   std::string id_;
   VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
@@ -79,6 +79,19 @@ class DescriptorArena {
   VkDescriptorSet make_set(const ComputePipeline& pipeline, const std::vector<ImageBinding>& images);
   /// The same for pipelines whose bindings are all storage buffers.
   VkDescriptorSet make_buffer_set(const ComputePipeline& pipeline, const std::vector<Buffer>& buffers);
+
+  /// One binding of any kind the pipeline declares: an image view (sampled, storage, or combined
+  /// with `sampler`) or a buffer range.
+  struct SetBinding {
+    VkImageView view = VK_NULL_HANDLE;
+    VkImageLayout layout = VK_IMAGE_LAYOUT_UNDEFINED;
+    VkSampler sampler = VK_NULL_HANDLE;
+    VkBuffer buffer = VK_NULL_HANDLE;
+    VkDeviceSize offset = 0;
+    VkDeviceSize range = VK_WHOLE_SIZE;
+  };
+  /// Allocates a set for `pipeline` and writes each binding by the type the pipeline declares.
+  VkDescriptorSet make_any_set(const ComputePipeline& pipeline, const std::vector<SetBinding>& bindings);
 
  private:
   VkDescriptorSet allocate(const ComputePipeline& pipeline);

@@ -17,12 +17,6 @@ enum class BloomFilter : uint32_t {
   gauss9 = 2,  //!< area downsample + the seed's separable 9-tap Gaussian per level.
 };
 
-/// Storage precision of the pyramid.
-enum class Precision : uint32_t {
-  fp16 = 0,  //!< RGBA16F intermediates (default)
-  fp32 = 1,  //!< RGBA32F intermediates
-};
-
 /// Bloom settings. Defaults are seed 001's; ranges are checked by validate(), which throws.
 /// Shape fields (iterations, filter, precision) decide images and pipelines: changing them through
 /// Bloom::set_config() rebuilds those. The other fields are per-frame push constants.
@@ -40,12 +34,6 @@ struct BloomConfig {
 
   /// Throws Error(invalid_argument) naming the first field that is out of range or NaN.
   void validate() const;
-};
-
-/// Size of one pyramid level.
-struct LevelSize {
-  uint32_t width = 0;
-  uint32_t height = 0;
 };
 
 /// The mip chain a bloom of `input` size with `iterations` uses (docs/BLOOM.md, "Mip chain").

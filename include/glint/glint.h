@@ -145,6 +145,18 @@ class Context {
 /// Lists the Vulkan physical devices (creates and destroys a temporary instance).
 std::vector<DeviceDescription> list_devices();
 
+/// Storage precision of an effect's intermediate images.
+enum class Precision : uint32_t {
+  fp16 = 0,  //!< RGBA16F intermediates (default)
+  fp32 = 1,  //!< RGBA32F intermediates
+};
+
+/// Size of one pyramid level.
+struct LevelSize {
+  uint32_t width = 0;
+  uint32_t height = 0;
+};
+
 /// A view of a caller's 2D image that an effect reads or writes. The caller keeps ownership.
 /// `layout`, `stage` and `access` describe the caller's last use of the image, so the effect can
 /// write the right barrier; after record() they describe the effect's last use, which the caller's

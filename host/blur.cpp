@@ -1,0 +1,683 @@
+// Blur drivers (docs/BLUR.md): BlurPyramid (seed 003) and GaussianBlur. Both are a list of
+// steps planned once per size (pipeline, descriptor set, push constants, image in, image out)
+// that record() walks, writing the barriers between them.
+#include <glint/blur.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <cstring>
+#include <map>
+#include <utility>
+
+#include "blur_params.h"
+#include "blur_plan.h"
+#include "core/barriers.h"
+#include "core/check.h"
+#include "core/context_state.h"
+#include "core/pipeline.h"
+#include "core/resources.h"
+
+namespace glint {
+
+using detail::check_range;
+using detail::concat;
+
+static_assert(sizeof(BlurPush) == 96, "BlurPush layout changed: update kernels/common/blur_params.h users");
+static_assert(offsetof(BlurPush, max_value) == 16);
+static_assert(offsetof(BlurPush, tap_count) == 28);
+static_assert(offsetof(BlurPush, weights) == 32);
+static_assert(static_cast<uint32_t>(BlurMethod::separable) - 1 == static_cast<uint32_t>(blur_plan::Method::separable));
+static_assert(static_cast<uint32_t>(BlurMethod::pyramid) == static_cast<uint32_t>(blur_plan::Method::pyramid));
+static_assert(static_cast<uint32_t>(BlurMethod::dual) == static_cast<uint32_t>(blur_plan::Method::dual));
+
+const char* to_string(BlurMethod method) {
+  switch (method) {
+    case BlurMethod::automatic:
+      return "auto";
+    case BlurMethod::separable:
+      return "separable";
+    case BlurMethod::pyramid:
+      return "pyramid";
+    case BlurMethod::dual:
+      return "dual";
+  }
+  return "unknown";
+}
+
+void BlurPyramidConfig::validate() const {
+  const char* names[3] = {"BlurPyramidConfig::sigma_texels[0]", "BlurPyramidConfig::sigma_texels[1]",
+                          "BlurPyramidConfig::sigma_texels[2]"};
+  for (int k = 0; k < 3; ++k) check_range(names[k], sigma_texels[k], 0.3, 4.0);
+  const auto p = static_cast<uint32_t>(precision);
+  if (p > 1) {
+    throw Error(ErrorCode::invalid_argument,
+                concat("BlurPyramidConfig::precision = ", p, " is not a Precision: accepted fp16, fp32"));
+  }
+}
+
+void GaussianBlurConfig::validate() const {
+  check_range("GaussianBlurConfig::sigma_px", sigma_px, 0.5, 64.0);
+  check_range("GaussianBlurConfig::max_relative_error", max_relative_error, 1e-4, 1.0);
+  const auto m = static_cast<uint32_t>(method);
+  if (m > static_cast<uint32_t>(BlurMethod::dual)) {
+    throw Error(ErrorCode::invalid_argument,
+                concat("GaussianBlurConfig::method = ", m,
+                       " is not a BlurMethod: accepted automatic, separable, pyramid, dual"));
+  }
+  const auto p = static_cast<uint32_t>(precision);
+  if (p > 1) {
+    throw Error(ErrorCode::invalid_argument,
+                concat("GaussianBlurConfig::precision = ", p, " is not a Precision: accepted fp16, fp32"));
+  }
+  if (linear_sampling && method != BlurMethod::separable) {
+    throw Error(ErrorCode::invalid_argument,
+                concat("GaussianBlurConfig::linear_sampling = true needs method separable, not ", to_string(method)));
+  }
+}
+
+namespace {
+
+constexpr VkPipelineStageFlags2 kCompute = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
+constexpr VkAccessFlags2 kSampled = VK_ACCESS_2_SHADER_SAMPLED_READ_BIT;
+constexpr VkAccessFlags2 kStorageWrite = VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT;
+constexpr VkImageLayout kGeneral = VK_IMAGE_LAYOUT_GENERAL;
+constexpr VkImageLayout kReadOnly = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+constexpr uint32_t kLineSegment = 256;  // blur_line.comp: outputs per workgroup along the line
+constexpr uint32_t kFusedMaxRadius = 12;
+
+VkFormat precision_format(Precision p) {
+  return p == Precision::fp32 ? VK_FORMAT_R32G32B32A32_SFLOAT : VK_FORMAT_R16G16B16A16_SFLOAT;
+}
+const char* variant(VkFormat f) { return f == VK_FORMAT_R32G32B32A32_SFLOAT ? "rgba32f" : "rgba16f"; }
+bool is_float_rgba(VkFormat f) { return f == VK_FORMAT_R16G16B16A16_SFLOAT || f == VK_FORMAT_R32G32B32A32_SFLOAT; }
+
+// The fused kernel's tile: workgroup (x, y) with `rows` outputs per invocation along y.
+struct FusedShape {
+  detail::Workgroup2D workgroup{8, 8};
+  uint32_t rows = 1;
+};
+
+uint32_t fused_shared_bytes(FusedShape s, uint32_t radius) {
+  const uint32_t w = s.workgroup.x, h = s.workgroup.y * s.rows;
+  return 16 * ((w + 2 * radius) * (h + 2 * radius) + w * (h + 2 * radius));
+}
+
+// The largest tile whose shared memory fits the device (STYLE rule 3): larger tiles re-read less
+// apron. CPU devices (lavapipe) get 8-row-high tiles, which keep their per-thread groups small.
+FusedShape fused_shape(const DeviceInfo& info, uint32_t radius) {
+  static const FusedShape gpu[] = {{{32, 8}, 4}, {{32, 8}, 2}, {{32, 8}, 1}, {{16, 8}, 2}, {{16, 8}, 1}, {{8, 8}, 1}};
+  static const FusedShape cpu[] = {{{16, 8}, 1}, {{8, 8}, 1}};
+  const bool is_cpu = info.type == VK_PHYSICAL_DEVICE_TYPE_CPU;
+  const FusedShape* begin = is_cpu ? cpu : gpu;
+  const FusedShape* end = is_cpu ? cpu + 2 : gpu + 6;
+  for (const FusedShape* s = begin; s != end; ++s) {
+    if (s->workgroup.x * s->workgroup.y <= info.max_workgroup_invocations &&
+        fused_shared_bytes(*s, radius) <= info.max_shared_memory_bytes) {
+      return *s;
+    }
+  }
+  throw Error(ErrorCode::no_device,
+              concat("blur radius ", radius, " needs ", fused_shared_bytes({{8, 8}, 1}, radius),
+                     " bytes of shared memory; device '", info.name, "' has ", info.max_shared_memory_bytes));
+}
+
+// Largest value a texel may hold so that every image of the chain stays finite (docs/BLUR.md).
+float max_value_for(VkFormat a, VkFormat b) {
+  return (a == VK_FORMAT_R16G16B16A16_SFLOAT || b == VK_FORMAT_R16G16B16A16_SFLOAT) ? 65504.0f : 3.0e38f;
+}
+
+void check_extent(const Context& context, VkExtent2D e, const char* where) {
+  const uint32_t max_dim = context.info().max_image_dimension_2d;
+  if (e.width == 0 || e.height == 0 || e.width > max_dim || e.height > max_dim) {
+    throw Error(ErrorCode::unsupported_size, concat(where, ": extent ", e.width, "x", e.height,
+                                                    " is out of range: accepted 1 to ", max_dim, " on each side"));
+  }
+}
+
+void check_image(const Context& context, const Image& img, const char* where, const char* role, VkImageUsageFlags need,
+                 const char* need_name) {
+  if (!img.image || !img.view)
+    throw Error(ErrorCode::invalid_argument, concat(where, ": ", role, " image and view must be non-null"));
+  if (!is_float_rgba(img.format)) {
+    throw Error(ErrorCode::unsupported_format,
+                concat(where, ": ", role, " format is ", detail::format_name(img.format),
+                       "; accepted VK_FORMAT_R16G16B16A16_SFLOAT or VK_FORMAT_R32G32B32A32_SFLOAT"));
+  }
+  check_extent(context, img.extent, concat(where, ": ", role).c_str());
+  if ((img.usage & need) != need)
+    throw Error(ErrorCode::missing_usage, concat(where, ": ", role, " image lacks ", need_name, " usage"));
+}
+
+// A sampler for the linear-sampling variant: bilinear, clamp to edge, one level.
+class LinearSampler {
+ public:
+  LinearSampler() = default;
+  explicit LinearSampler(const Context& context) : device_(context.device()) {
+    VkSamplerCreateInfo si{VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO};
+    si.magFilter = si.minFilter = VK_FILTER_LINEAR;
+    si.mipmapMode = VK_SAMPLER_MIPMAP_MODE_NEAREST;
+    si.addressModeU = si.addressModeV = si.addressModeW = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
+    si.maxLod = 0.0f;
+    detail::vk_check(vkCreateSampler(device_, &si, nullptr, &sampler_), "vkCreateSampler");
+    context.state().count_object();
+  }
+  LinearSampler(LinearSampler&& o) noexcept { *this = std::move(o); }
+  LinearSampler& operator=(LinearSampler&& o) noexcept {
+    if (this != &o) {
+      reset();
+      device_ = std::exchange(o.device_, VK_NULL_HANDLE);
+      sampler_ = std::exchange(o.sampler_, VK_NULL_HANDLE);
+    }
+    return *this;
+  }
+  ~LinearSampler() { reset(); }
+  void reset() {
+    if (sampler_) vkDestroySampler(device_, sampler_, nullptr);
+    sampler_ = VK_NULL_HANDLE;
+  }
+  VkSampler get() const { return sampler_; }
+
+ private:
+  VkDevice device_ = VK_NULL_HANDLE;
+  VkSampler sampler_ = VK_NULL_HANDLE;
+};
+
+// Which image a step reads or writes: the caller's input or output, or an owned image.
+constexpr int kInput = -1;
+constexpr int kOutput = -2;
+
+struct Step {
+  const detail::ComputePipeline* pipeline = nullptr;
+  int src = kInput;
+  int dst = kOutput;
+  BlurPush push{};
+  uint32_t invocations_x = 0;  // dispatch covers these (the pipeline divides by its workgroup)
+  uint32_t invocations_y = 0;
+  bool sampler = false;                       // binding 0 is a combined image sampler
+  const detail::OwnedBuffer* taps = nullptr;  // binding 2
+  VkDescriptorSet set = VK_NULL_HANDLE;       // when neither src nor dst is a caller image
+  std::string label;
+};
+
+// Owned pipelines keyed by what specializes them, owned images, steps, and the descriptor sets.
+struct StepProgram {
+  const Context* context = nullptr;
+  std::map<std::string, detail::ComputePipeline> pipelines;
+  std::vector<detail::OwnedImage> images;
+  std::vector<detail::OwnedBuffer> tap_buffers;
+  std::vector<Step> steps;
+  LinearSampler sampler;
+  detail::DescriptorArena internal_sets;
+  std::map<std::pair<VkImageView, VkImageView>, std::vector<VkDescriptorSet>> caller_sets;
+  std::vector<detail::DescriptorArena> caller_arenas;
+
+  void clear_size() {
+    steps.clear();
+    caller_sets.clear();
+    caller_arenas.clear();
+    internal_sets.reset();
+    images.clear();
+    tap_buffers.clear();
+  }
+
+  const detail::ComputePipeline& pipeline(const std::string& kernel, VkFormat dst_format, detail::Workgroup2D wg,
+                                          std::vector<uint32_t> spec, std::vector<VkDescriptorType> bindings) {
+    std::string key = concat(kernel, "_", variant(dst_format), "/", wg.x, "x", wg.y);
+    for (uint32_t v : spec) key += concat("/", v);
+    auto it = pipelines.find(key);
+    if (it != pipelines.end()) return it->second;
+    detail::PipelineDesc d;
+    d.kernel_id = concat(kernel, "_", variant(dst_format));
+    d.bindings = std::move(bindings);
+    d.push_constant_bytes = sizeof(BlurPush);
+    d.workgroup = wg;
+    d.specialization = std::move(spec);
+    return pipelines.emplace(key, detail::ComputePipeline(*context, d)).first->second;
+  }
+
+  // Owned images can also be copied from (BlurPyramid hands its levels to the caller).
+  int add_image(VkExtent2D e, VkFormat f) {
+    images.emplace_back(*context, e, f,
+                        VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT);
+    return static_cast<int>(images.size()) - 1;
+  }
+
+  const detail::OwnedBuffer* add_taps(const std::vector<float>& values) {
+    tap_buffers.emplace_back(*context, values.size() * sizeof(float), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, true);
+    std::memcpy(tap_buffers.back().mapped(), values.data(), values.size() * sizeof(float));
+    tap_buffers.back().flush();
+    return &tap_buffers.back();
+  }
+
+  std::vector<detail::DescriptorArena::SetBinding> bindings_of(const Step& s, VkImageView in, VkImageView out) const {
+    VkImageView src = s.src == kInput ? in : images[s.src].state.view;
+    VkImageView dst = s.dst == kOutput ? out : images[s.dst].state.view;
+    std::vector<detail::DescriptorArena::SetBinding> b(2);
+    b[0].view = src;
+    b[0].layout = s.src == kInput ? kReadOnly : kGeneral;
+    b[0].sampler = s.sampler ? sampler.get() : VK_NULL_HANDLE;
+    b[1].view = dst;
+    b[1].layout = kGeneral;
+    if (s.taps) {
+      b.emplace_back();
+      b[2].buffer = s.taps->buffer();
+    }
+    return b;
+  }
+
+  // After the steps of a size are planned: descriptor sets for the steps between owned images.
+  void make_internal_sets() {
+    uint32_t n = 0;
+    for (const Step& s : steps) n += (s.src >= 0 && s.dst >= 0);
+    internal_sets = detail::DescriptorArena(*context, std::max(1u, n));
+    for (Step& s : steps) {
+      if (s.src >= 0 && s.dst >= 0)
+        s.set = internal_sets.make_any_set(*s.pipeline, bindings_of(s, VK_NULL_HANDLE, VK_NULL_HANDLE));
+    }
+  }
+
+  // Sets for the steps that name caller images, once per (input view, output view).
+  const std::vector<VkDescriptorSet>& sets_for(VkImageView in, VkImageView out) {
+    auto key = std::make_pair(in, out);
+    auto it = caller_sets.find(key);
+    if (it != caller_sets.end()) return it->second;
+    uint32_t n = 0;
+    for (const Step& s : steps) n += (s.src < 0 || s.dst < 0);
+    caller_arenas.emplace_back(*context, std::max(1u, n));
+    std::vector<VkDescriptorSet> sets(steps.size(), VK_NULL_HANDLE);
+    for (size_t i = 0; i < steps.size(); ++i) {
+      const Step& s = steps[i];
+      sets[i] =
+          (s.src < 0 || s.dst < 0) ? caller_arenas.back().make_any_set(*s.pipeline, bindings_of(s, in, out)) : s.set;
+    }
+    return caller_sets.emplace(key, std::move(sets)).first->second;
+  }
+
+  void record(VkCommandBuffer cmd, Image& input, Image* output, Profiler* profiler) {
+    const std::vector<VkDescriptorSet>& sets = sets_for(input.view, output ? output->view : VK_NULL_HANDLE);
+    detail::Barriers b;
+    for (size_t i = 0; i < steps.size(); ++i) {
+      const Step& s = steps[i];
+      Image& src = s.src == kInput ? input : images[s.src].state;
+      Image& dst = s.dst == kOutput ? *output : images[s.dst].state;
+      b.use(src, s.src == kInput ? kReadOnly : kGeneral, kCompute, kSampled);
+      b.use(dst, kGeneral, kCompute, kStorageWrite);
+      b.flush(cmd);
+      s.pipeline->dispatch(cmd, sets[i], s.push, s.invocations_x, s.invocations_y);
+      if (profiler) profiler->mark(cmd, s.label);
+    }
+  }
+};
+
+BlurPush make_push(VkExtent2D src, VkExtent2D dst, uint32_t flags, float max_value) {
+  BlurPush p{};
+  p.src_width = static_cast<int32_t>(src.width);
+  p.src_height = static_cast<int32_t>(src.height);
+  p.dst_width = static_cast<int32_t>(dst.width);
+  p.dst_height = static_cast<int32_t>(dst.height);
+  p.max_value = max_value;
+  p.flags = flags;
+  p.offset = 1.0f;
+  return p;
+}
+
+VkExtent2D half_extent(VkExtent2D e) { return {blur_plan::half_size(e.width), blur_plan::half_size(e.height)}; }
+
+// A fused level-blur step B(src -> dst, sigma) (docs/BLUR.md); sigma 0 is the area downsample alone.
+// `binomial` picks the pyramid method's downsample over the area average (docs/BLUR.md).
+Step fused_step(StepProgram& prog, const DeviceInfo& info, int src, int dst, VkExtent2D src_size, VkExtent2D dst_size,
+                VkFormat dst_format, double sigma, double truncation, bool binomial, uint32_t flags, float max_value,
+                std::string label) {
+  const std::vector<double> w = blur_plan::gaussian_half_taps(sigma, truncation);
+  const uint32_t radius = static_cast<uint32_t>(w.size()) - 1;
+  if (radius > kFusedMaxRadius)
+    throw Error(ErrorCode::invalid_argument, concat("blur sigma ", sigma, " needs radius ", radius,
+                                                    "; the fused kernel takes at most ", kFusedMaxRadius));
+  const FusedShape shape = fused_shape(info, radius);
+  Step s;
+  s.pipeline = &prog.pipeline("blur_level", dst_format, shape.workgroup, {shape.rows, radius, binomial ? 1u : 0u},
+                              {VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
+  s.src = src;
+  s.dst = dst;
+  s.push = make_push(src_size, dst_size, flags, max_value);
+  for (uint32_t t = 0; t <= radius; ++t) s.push.weights[t] = static_cast<float>(w[t]);
+  s.invocations_x = dst_size.width;
+  s.invocations_y = (dst_size.height + shape.rows - 1) / shape.rows;
+  s.label = std::move(label);
+  return s;
+}
+
+// A plain per-texel step (upsample, dual down/up) with 2D workgroups.
+Step simple_step(StepProgram& prog, const DeviceInfo& info, const char* kernel, int src, int dst, VkExtent2D src_size,
+                 VkExtent2D dst_size, VkFormat dst_format, uint32_t flags, float max_value, std::string label,
+                 std::vector<VkDescriptorType> bindings = {VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE,
+                                                           VK_DESCRIPTOR_TYPE_STORAGE_IMAGE}) {
+  Step s;
+  s.pipeline = &prog.pipeline(kernel, dst_format, detail::choose_workgroup_2d(info), {}, std::move(bindings));
+  s.src = src;
+  s.dst = dst;
+  s.push = make_push(src_size, dst_size, flags, max_value);
+  s.invocations_x = dst_size.width;
+  s.invocations_y = dst_size.height;
+  s.label = std::move(label);
+  return s;
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// BlurPyramid
+
+struct BlurPyramid::Impl {
+  BlurPyramidConfig config;
+  StepProgram prog;
+  VkExtent2D extent{0, 0};
+  std::array<VkExtent2D, 3> sizes{};
+  VkFormat prepared_input_format = VK_FORMAT_UNDEFINED;
+
+  VkFormat level_format() const { return precision_format(config.precision); }
+
+  void make(VkExtent2D size) {
+    prog.clear_size();
+    extent = size;
+    const DeviceInfo& info = prog.context->info();
+    VkExtent2D prev = size;
+    for (int k = 0; k < 3; ++k) {
+      sizes[k] = half_extent(prev);
+      prog.add_image(sizes[k], level_format());
+      prev = sizes[k];
+    }
+    // The input clamp uses the level format: the levels are the only images written.
+    const float max_value = max_value_for(level_format(), level_format());
+    prev = size;
+    for (int k = 0; k < 3; ++k) {
+      prog.steps.push_back(fused_step(prog, info, k == 0 ? kInput : k - 1, k, prev, sizes[k], level_format(),
+                                      config.sigma_texels[k], blur_plan::kPyramidTruncation, false,
+                                      k == 0 ? GLINT_BLUR_FLAG_SANITIZE : 0u, max_value,
+                                      concat("blur pyramid level ", k + 1)));
+      prev = sizes[k];
+    }
+    prog.make_internal_sets();
+  }
+};
+
+BlurPyramid::BlurPyramid(const Context& context, const BlurPyramidConfig& config) : impl_(std::make_unique<Impl>()) {
+  config.validate();
+  impl_->config = config;
+  impl_->prog.context = &context;
+  // Fail now, not at the first record, if the largest radius cannot fit the device.
+  for (float s : config.sigma_texels) {
+    fused_shape(context.info(),
+                static_cast<uint32_t>(blur_plan::gaussian_half_taps(s, blur_plan::kPyramidTruncation).size() - 1));
+  }
+}
+BlurPyramid::BlurPyramid(BlurPyramid&&) noexcept = default;
+BlurPyramid& BlurPyramid::operator=(BlurPyramid&&) noexcept = default;
+BlurPyramid::~BlurPyramid() = default;
+
+void BlurPyramid::set_config(const BlurPyramidConfig& config) {
+  config.validate();
+  impl_->config = config;
+  impl_->prog.pipelines.clear();
+  const VkExtent2D size = impl_->extent;
+  impl_->prog.clear_size();
+  impl_->extent = {0, 0};
+  if (size.width) impl_->make(size);
+}
+const BlurPyramidConfig& BlurPyramid::config() const { return impl_->config; }
+
+void BlurPyramid::prepare(VkExtent2D input_extent) {
+  check_extent(*impl_->prog.context, input_extent, "BlurPyramid::prepare");
+  if (input_extent.width != impl_->extent.width || input_extent.height != impl_->extent.height)
+    impl_->make(input_extent);
+}
+
+void BlurPyramid::record(VkCommandBuffer cmd, Image& input, Profiler* profiler) {
+  check_image(*impl_->prog.context, input, "BlurPyramid::record", "input", VK_IMAGE_USAGE_SAMPLED_BIT,
+              "VK_IMAGE_USAGE_SAMPLED_BIT");
+  prepare(input.extent);
+  impl_->prog.record(cmd, input, nullptr, profiler);
+}
+
+const Image& BlurPyramid::level(uint32_t k) const {
+  if (k < 1 || k > 3)
+    throw Error(ErrorCode::invalid_argument,
+                concat("BlurPyramid::level: k = ", k, " is out of range: accepted 1 to 3"));
+  if (impl_->prog.images.size() != 3)
+    throw Error(ErrorCode::invalid_argument, "BlurPyramid::level: call prepare() or record() first");
+  return impl_->prog.images[k - 1].state;
+}
+
+Image& BlurPyramid::level(uint32_t k) { return const_cast<Image&>(std::as_const(*this).level(k)); }
+
+LevelSize BlurPyramid::level_size(uint32_t k) const {
+  const Image& l = level(k);
+  return {l.extent.width, l.extent.height};
+}
+
+EffectiveSigma BlurPyramid::effective_sigma_px(uint32_t k) const {
+  level(k);  // validates k and that a size is prepared
+  const std::vector<double> s(impl_->config.sigma_texels.begin(), impl_->config.sigma_texels.end());
+  return {blur_plan::pyramid_effective_sigma(impl_->extent.width, s)[k - 1],
+          blur_plan::pyramid_effective_sigma(impl_->extent.height, s)[k - 1]};
+}
+
+uint64_t BlurPyramid::min_bytes_moved(VkFormat input_format) const {
+  const uint64_t in_bytes = detail::texel_bytes(input_format);
+  const uint64_t level_bytes = detail::texel_bytes(impl_->level_format());
+  uint64_t total = uint64_t(impl_->extent.width) * impl_->extent.height * in_bytes;
+  for (int k = 0; k < 3; ++k) {
+    const uint64_t texels = uint64_t(impl_->sizes[k].width) * impl_->sizes[k].height;
+    total += texels * level_bytes * (k < 2 ? 2 : 1);  // written; read by the next level
+  }
+  return total;
+}
+
+// ---------------------------------------------------------------------------------------------
+// GaussianBlur
+
+struct GaussianBlur::Impl {
+  GaussianBlurConfig config;
+  StepProgram prog;
+  VkExtent2D extent{0, 0};
+  VkFormat output_format = VK_FORMAT_UNDEFINED;  // steps writing the output are specialized for it
+  BlurChoice choice;
+  std::vector<std::pair<VkExtent2D, VkFormat>> intermediates;  // for min_bytes_moved
+
+  VkFormat level_format() const { return precision_format(config.precision); }
+
+  void plan(VkExtent2D size) {
+    const double bound = config.max_relative_error;
+    blur_plan::Plan p;
+    switch (config.method) {
+      case BlurMethod::automatic:
+        p = blur_plan::plan_auto(config.sigma_px, size.width, size.height, bound);
+        break;
+      case BlurMethod::separable:
+        p = blur_plan::plan_method(
+            config.linear_sampling ? blur_plan::Method::separable_linear : blur_plan::Method::separable,
+            config.sigma_px, size.width, size.height, bound);
+        break;
+      case BlurMethod::pyramid:
+        p = blur_plan::plan_method(blur_plan::Method::pyramid, config.sigma_px, size.width, size.height, bound);
+        break;
+      case BlurMethod::dual:
+        p = blur_plan::plan_method(blur_plan::Method::dual, config.sigma_px, size.width, size.height, bound);
+        break;
+    }
+    choice = {};
+    choice.linear_sampling = p.method == blur_plan::Method::separable_linear;
+    choice.method = (p.method == blur_plan::Method::separable || choice.linear_sampling) ? BlurMethod::separable
+                    : p.method == blur_plan::Method::pyramid                             ? BlurMethod::pyramid
+                                                                                         : BlurMethod::dual;
+    choice.radius = p.radius;
+    choice.levels = p.levels;
+    choice.level_sigma = p.level_sigma;
+    choice.dual_offset = p.dual_offset;
+    choice.effective_sigma_px = p.effective_sigma_px;
+    choice.expected_relative_error = p.expected_relative_l2;
+  }
+
+  void make(VkExtent2D size, VkFormat out_format) {
+    prog.clear_size();
+    intermediates.clear();
+    extent = size;
+    output_format = out_format;
+    plan(size);
+    const DeviceInfo& info = prog.context->info();
+    const VkFormat lf = level_format();
+    const float max_value = max_value_for(lf, out_format);
+    const uint32_t sanitize = GLINT_BLUR_FLAG_SANITIZE;
+    auto add = [&](VkExtent2D e) {
+      intermediates.emplace_back(e, lf);
+      return prog.add_image(e, lf);
+    };
+    if (choice.method == BlurMethod::separable && choice.linear_sampling) {
+      // Paired taps (docs/BLUR.md): (0, w0), then (offset, weight) per pair, per side.
+      const std::vector<double> w = blur_plan::gaussian_half_taps(config.sigma_px, blur_plan::kGaussTruncation);
+      std::vector<float> taps = {0.0f, static_cast<float>(w[0])};
+      for (size_t t = 1; t < w.size(); t += 2) {
+        const double w1 = w[t], w2 = t + 1 < w.size() ? w[t + 1] : 0.0;
+        taps.push_back(static_cast<float>((t * w1 + (t + 1) * w2) / (w1 + w2)));
+        taps.push_back(static_cast<float>(w1 + w2));
+      }
+      prog.sampler = LinearSampler(*prog.context);
+      const detail::OwnedBuffer* buf = prog.add_taps(taps);
+      const int scratch = add(size);
+      for (int pass = 0; pass < 2; ++pass) {
+        Step s = simple_step(prog, info, "blur_linear", pass == 0 ? kInput : scratch, pass == 0 ? scratch : kOutput,
+                             size, size, pass == 0 ? lf : out_format, pass == 0 ? 0u : GLINT_BLUR_FLAG_VERTICAL,
+                             max_value, pass == 0 ? "gauss linear horizontal" : "gauss linear vertical",
+                             {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
+                              VK_DESCRIPTOR_TYPE_STORAGE_BUFFER});
+        s.sampler = true;
+        s.taps = buf;
+        s.push.tap_count = static_cast<uint32_t>(taps.size() / 2 - 1);
+        prog.steps.push_back(std::move(s));
+      }
+      // The sampler cannot sanitize: NaN or Inf in the input reach the output (documented).
+    } else if (choice.method == BlurMethod::separable && choice.radius <= kFusedMaxRadius) {
+      prog.steps.push_back(fused_step(prog, info, kInput, kOutput, size, size, out_format, config.sigma_px,
+                                      blur_plan::kGaussTruncation, false, sanitize, max_value,
+                                      "gauss separable (fused)"));
+    } else if (choice.method == BlurMethod::separable) {
+      const std::vector<double> w = blur_plan::gaussian_half_taps(config.sigma_px, blur_plan::kGaussTruncation);
+      const detail::OwnedBuffer* buf = prog.add_taps(std::vector<float>(w.begin(), w.end()));
+      const uint32_t radius = static_cast<uint32_t>(w.size()) - 1;
+      const int scratch = add(size);
+      for (int pass = 0; pass < 2; ++pass) {
+        const VkFormat f = pass == 0 ? lf : out_format;
+        Step s;
+        s.pipeline = &prog.pipeline(
+            "blur_line", f, {kLineSegment, 1}, {radius},
+            {VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER});
+        s.src = pass == 0 ? kInput : scratch;
+        s.dst = pass == 0 ? scratch : kOutput;
+        s.push = make_push(size, size, pass == 0 ? sanitize : GLINT_BLUR_FLAG_VERTICAL, max_value);
+        s.push.tap_count = radius;
+        s.taps = buf;
+        s.invocations_x = pass == 0 ? size.width : size.height;  // along the line
+        s.invocations_y = pass == 0 ? size.height : size.width;  // one workgroup row per line
+        s.label = pass == 0 ? "gauss line horizontal" : "gauss line vertical";
+        prog.steps.push_back(std::move(s));
+      }
+    } else if (choice.method == BlurMethod::pyramid) {
+      VkExtent2D prev = size;
+      int src = kInput;
+      for (uint32_t j = 1; j <= choice.levels; ++j) {
+        const VkExtent2D e = half_extent(prev);
+        const int dst = add(e);
+        const bool last = j == choice.levels;
+        prog.steps.push_back(fused_step(prog, info, src, dst, prev, e, lf, last ? choice.level_sigma : 0.0,
+                                        blur_plan::kGaussTruncation, true, src == kInput ? sanitize : 0u, max_value,
+                                        concat("gauss pyramid level ", j, last ? " (blur)" : " (down)")));
+        src = dst;
+        prev = e;
+      }
+      prog.steps.push_back(simple_step(prog, info, "blur_upsample", src, kOutput, prev, size, out_format, 0u, max_value,
+                                       "gauss pyramid upsample"));
+    } else {  // dual
+      std::vector<VkExtent2D> sizes = {size};
+      std::vector<int> ids = {kInput};
+      for (uint32_t j = 1; j <= choice.levels; ++j) {
+        const VkExtent2D e = half_extent(sizes.back());
+        const int dst = add(e);
+        Step s = simple_step(prog, info, "blur_dual_down", ids.back(), dst, sizes.back(), e, lf,
+                             ids.back() == kInput ? sanitize : 0u, max_value, concat("gauss dual down ", j));
+        s.push.offset = static_cast<float>(choice.dual_offset);
+        prog.steps.push_back(std::move(s));
+        sizes.push_back(e);
+        ids.push_back(dst);
+      }
+      // Up: level j is rewritten from level j+1 (its downsampled content is no longer needed).
+      for (uint32_t j = choice.levels; j-- > 0;) {
+        const bool last = j == 0;
+        Step s = simple_step(prog, info, "blur_dual_up", ids[j + 1], last ? kOutput : ids[j], sizes[j + 1], sizes[j],
+                             last ? out_format : lf, 0u, max_value, concat("gauss dual up ", j));
+        s.push.offset = static_cast<float>(choice.dual_offset);
+        prog.steps.push_back(std::move(s));
+      }
+    }
+    choice.dispatches = static_cast<uint32_t>(prog.steps.size());
+    prog.make_internal_sets();
+  }
+};
+
+GaussianBlur::GaussianBlur(const Context& context, const GaussianBlurConfig& config) : impl_(std::make_unique<Impl>()) {
+  config.validate();
+  impl_->config = config;
+  impl_->prog.context = &context;
+}
+GaussianBlur::GaussianBlur(GaussianBlur&&) noexcept = default;
+GaussianBlur& GaussianBlur::operator=(GaussianBlur&&) noexcept = default;
+GaussianBlur::~GaussianBlur() = default;
+
+void GaussianBlur::set_config(const GaussianBlurConfig& config) {
+  config.validate();
+  impl_->config = config;
+  const VkExtent2D size = impl_->extent;
+  const VkFormat out = impl_->output_format;
+  impl_->prog.clear_size();
+  impl_->prog.pipelines.clear();
+  impl_->extent = {0, 0};
+  if (size.width) impl_->make(size, out);
+}
+const GaussianBlurConfig& GaussianBlur::config() const { return impl_->config; }
+
+void GaussianBlur::prepare(VkExtent2D extent) {
+  check_extent(*impl_->prog.context, extent, "GaussianBlur::prepare");
+  const VkFormat out =
+      impl_->output_format == VK_FORMAT_UNDEFINED ? VK_FORMAT_R16G16B16A16_SFLOAT : impl_->output_format;
+  if (extent.width != impl_->extent.width || extent.height != impl_->extent.height) impl_->make(extent, out);
+}
+
+void GaussianBlur::record(VkCommandBuffer cmd, Image& input, Image& output, Profiler* profiler) {
+  const Context& ctx = *impl_->prog.context;
+  check_image(ctx, input, "GaussianBlur::record", "input", VK_IMAGE_USAGE_SAMPLED_BIT, "VK_IMAGE_USAGE_SAMPLED_BIT");
+  check_image(ctx, output, "GaussianBlur::record", "output", VK_IMAGE_USAGE_STORAGE_BIT, "VK_IMAGE_USAGE_STORAGE_BIT");
+  if (input.image == output.image) {
+    throw Error(ErrorCode::invalid_argument, "GaussianBlur::record: input and output must be different images");
+  }
+  if (input.extent.width != output.extent.width || input.extent.height != output.extent.height) {
+    throw Error(ErrorCode::invalid_argument,
+                concat("GaussianBlur::record: output extent ", output.extent.width, "x", output.extent.height,
+                       " differs from input extent ", input.extent.width, "x", input.extent.height));
+  }
+  if (input.extent.width != impl_->extent.width || input.extent.height != impl_->extent.height ||
+      output.format != impl_->output_format) {
+    impl_->make(input.extent, output.format);
+  }
+  impl_->prog.record(cmd, input, &output, profiler);
+}
+
+const BlurChoice& GaussianBlur::choice() const { return impl_->choice; }
+
+uint64_t GaussianBlur::min_bytes_moved(VkFormat input_format, VkFormat output_format) const {
+  const uint64_t texels = uint64_t(impl_->extent.width) * impl_->extent.height;
+  uint64_t total = texels * (detail::texel_bytes(input_format) + detail::texel_bytes(output_format));
+  for (const auto& [e, f] : impl_->intermediates) total += 2 * uint64_t(e.width) * e.height * detail::texel_bytes(f);
+  return total;
+}
+
+}  // namespace glint

@@ -1,0 +1,166 @@
+// glint blur IN.exr OUT_PREFIX [--sigmas a,b,c]: the three blur-pyramid levels as
+// OUT_PREFIX.blur1.exr, .blur2.exr, .blur3.exr at their level sizes.
+// glint gauss IN.exr OUT.exr --sigma S [--method ...]: a same-size Gaussian blur; prints the
+// method chosen and its expected error. Ranges are checked by the configs' validate().
+#include <glint/blur.h>
+
+#include <cstdio>
+#include <memory>
+#include <sstream>
+
+#include "cli/commands.h"
+#include "core/resources.h"
+#include "core/transfer.h"
+#include "io/exr_io.h"
+
+namespace glint::cli {
+namespace {
+
+struct BlurOptions {
+  std::string input;
+  std::string prefix;
+  std::string sigmas;
+  std::string device;
+  bool fp32 = false;
+};
+
+// "a,b,c" -> three floats; anything else is a one-line error naming the option.
+std::array<float, 3> parse_sigmas(const std::string& text) {
+  std::array<float, 3> s{};
+  std::istringstream in(text);
+  char comma1 = 0, comma2 = 0;
+  std::string rest;
+  if (!(in >> s[0] >> comma1 >> s[1] >> comma2 >> s[2]) || comma1 != ',' || comma2 != ',' || (in >> rest)) {
+    throw Error(ErrorCode::invalid_argument,
+                "--sigmas '" + text + "' is not three comma-separated numbers (e.g. 1.2,1.2,1.2)");
+  }
+  return s;
+}
+
+void print_device(const Context& context, const std::string& input, const CpuImage& image) {
+  std::printf("device: %s (%s)\n", context.info().name.c_str(), device_type_name(context.info().type));
+  std::printf("input: %s, %ux%u\n", input.c_str(), image.width, image.height);
+}
+
+void run_blur(const BlurOptions& o) {
+  BlurPyramidConfig config;
+  if (!o.sigmas.empty()) config.sigma_texels = parse_sigmas(o.sigmas);
+  config.precision = o.fp32 ? Precision::fp32 : Precision::fp16;
+  config.validate();
+  const std::string names[3] = {o.prefix + ".blur1.exr", o.prefix + ".blur2.exr", o.prefix + ".blur3.exr"};
+  for (const std::string& n : names) check_output_path(n);
+
+  const CpuImage input = io::read_exr(o.input);
+  ContextOptions options;
+  options.device = o.device;
+  const Context context = Context::create(options);
+  BlurPyramid pyramid(context, config);
+  pyramid.prepare({input.width, input.height});
+  detail::OwnedImage source(context, {input.width, input.height}, VK_FORMAT_R32G32B32A32_SFLOAT,
+                            detail::kToolImageUsage);
+  detail::upload(context, source.image(), input);
+  Profiler profiler(context);
+  context.run_once([&](VkCommandBuffer cmd) {
+    profiler.reset(cmd);
+    profiler.mark(cmd, "start");
+    pyramid.record(cmd, source.image(), &profiler);
+  });
+  print_device(context, o.input, input);
+  print_stages(profiler);
+  for (uint32_t k = 1; k <= 3; ++k) {
+    const CpuImage level = detail::download(context, pyramid.level(k));
+    const EffectiveSigma s = pyramid.effective_sigma_px(k);
+    io::write_exr_half(names[k - 1], level);
+    std::printf("wrote %s (%ux%u, sigma %.3g texels, effective sigma %.3f x %.3f input pixels)\n", names[k - 1].c_str(),
+                level.width, level.height, config.sigma_texels[k - 1], s.x_px, s.y_px);
+  }
+}
+
+struct GaussOptions {
+  std::string input;
+  std::string output;
+  std::string device;
+  std::string method = "auto";
+  bool linear = false;
+  bool fp32 = false;
+  GaussianBlurConfig config;
+};
+
+BlurMethod method_from_name(const std::string& name) {
+  if (name == "separable") return BlurMethod::separable;
+  if (name == "pyramid") return BlurMethod::pyramid;
+  if (name == "dual") return BlurMethod::dual;
+  return BlurMethod::automatic;  // IsMember() has rejected anything else
+}
+
+void run_gauss(GaussOptions& o) {
+  o.config.method = method_from_name(o.method);
+  o.config.linear_sampling = o.linear;
+  o.config.precision = o.fp32 ? Precision::fp32 : Precision::fp16;
+  o.config.validate();
+  check_output_path(o.output);
+
+  const CpuImage input = io::read_exr(o.input);
+  const VkExtent2D extent{input.width, input.height};
+  ContextOptions options;
+  options.device = o.device;
+  const Context context = Context::create(options);
+  GaussianBlur blur(context, o.config);
+  blur.prepare(extent);
+  detail::OwnedImage source(context, extent, VK_FORMAT_R32G32B32A32_SFLOAT, detail::kToolImageUsage);
+  detail::OwnedImage result(context, extent, VK_FORMAT_R16G16B16A16_SFLOAT, detail::kToolImageUsage);
+  detail::upload(context, source.image(), input);
+  Profiler profiler(context);
+  context.run_once([&](VkCommandBuffer cmd) {
+    profiler.reset(cmd);
+    profiler.mark(cmd, "start");
+    blur.record(cmd, source.image(), result.image(), &profiler);
+  });
+  const CpuImage output = detail::download(context, result.image());
+  print_device(context, o.input, input);
+  const BlurChoice& c = blur.choice();
+  std::printf("method: %s%s (asked: %s)", to_string(c.method), c.linear_sampling ? " with linear sampling" : "",
+              to_string(o.config.method));
+  if (c.method == BlurMethod::separable) std::printf(", %u taps", 2 * c.radius + 1);
+  if (c.method == BlurMethod::pyramid)
+    std::printf(", %u levels, sigma %.3f texels at the last", c.levels, c.level_sigma);
+  if (c.method == BlurMethod::dual) std::printf(", %u levels, tap offset %.3f", c.levels, c.dual_offset);
+  std::printf(", %u dispatches\n", c.dispatches);
+  std::printf("sigma: %.3f px asked, %.3f px effective; expected relative L2 error %.2e (bound %.2e)\n",
+              o.config.sigma_px, c.effective_sigma_px, c.expected_relative_error, o.config.max_relative_error);
+  print_stages(profiler);
+  io::write_exr_half(o.output, output);
+  std::printf("wrote %s\n", o.output.c_str());
+}
+
+}  // namespace
+
+Command add_blur_command(CLI::App& app) {
+  auto o = std::make_shared<BlurOptions>();
+  CLI::App* sub = app.add_subcommand("blur", "Blur pyramid of an OpenEXR image: writes PREFIX.blur1/2/3.exr");
+  sub->add_option("input", o->input, "Input OpenEXR file")->required();
+  sub->add_option("output_prefix", o->prefix, "Output prefix (PREFIX.blur1.exr ...)")->required();
+  sub->add_option("--sigmas", o->sigmas,
+                  "Sigma of each level in texels of that level, a,b,c (each 0.3 to 4; default 1.2,1.2,1.2)");
+  sub->add_flag("--fp32", o->fp32, "Keep the levels in RGBA32F instead of RGBA16F");
+  add_device_option(*sub, o->device);
+  return {sub, [o] { run_blur(*o); }};
+}
+
+Command add_gauss_command(CLI::App& app) {
+  auto o = std::make_shared<GaussOptions>();
+  CLI::App* sub = app.add_subcommand("gauss", "Gaussian blur of an OpenEXR image; write RGBA half EXR");
+  sub->add_option("input", o->input, "Input OpenEXR file")->required();
+  sub->add_option("output", o->output, "Output OpenEXR file (RGBA half)")->required();
+  sub->add_option("--sigma", o->config.sigma_px, "Standard deviation in pixels (0.5 to 64)")->required();
+  sub->add_option("--method", o->method, "auto, separable, pyramid or dual")
+      ->check(CLI::IsMember({"auto", "separable", "pyramid", "dual"}));
+  sub->add_option("--max-error", o->config.max_relative_error,
+                  "auto/pyramid: bound on the modelled relative L2 error (1e-4 to 1)");
+  sub->add_flag("--linear", o->linear, "separable: pair taps into bilinear sampler fetches (9 taps in 5)");
+  sub->add_flag("--fp32", o->fp32, "RGBA32F intermediates instead of RGBA16F");
+  add_device_option(*sub, o->device);
+  return {sub, [o] { run_gauss(*o); }};
+}
+
+}  // namespace glint::cli

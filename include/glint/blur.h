@@ -1,0 +1,167 @@
+// The blur family (issue 3, seed 003): a three-level cumulative blur pyramid whose levels are
+// handed to the caller's shaders, and a Gaussian blur of any sigma with a choice of methods.
+// The exact algorithms are in docs/BLUR.md; host/reference/blur_reference.h implements them in
+// float64.
+#pragma once
+
+#include <glint/glint.h>
+
+#include <array>
+#include <memory>
+
+namespace glint {
+
+/// Settings of a BlurPyramid. All fields are shape fields: set_config() rebuilds what they decide.
+struct BlurPyramidConfig {
+  /// Gaussian sigma of each level's blur, in texels of that level (0.3 to 4; taps
+  /// 2 ceil(3 sigma) + 1, so the default 1.2 gives 9 taps). Level k reads level k-1, so the
+  /// effective sigma in input pixels grows as the square root of the sum of squares, scaled by
+  /// the level size (effective_sigma_px()).
+  std::array<float, 3> sigma_texels{1.2f, 1.2f, 1.2f};
+  Precision precision = Precision::fp16;  //!< storage of the three levels
+
+  /// Throws Error(invalid_argument) naming the first field that is out of range or NaN.
+  void validate() const;
+};
+
+/// Effective standard deviation of a blur, per axis, in input pixels.
+struct EffectiveSigma {
+  double x_px = 0;
+  double y_px = 0;
+};
+
+/// Blur1, Blur2 and Blur3 of seed 003: level k (1 to 3) is level k-1 (level 0 = the input)
+/// area-downsampled to half size (floor, at least 1) and blurred by one separable Gaussian, in
+/// one dispatch per level (docs/BLUR.md, "Blur pyramid").
+///
+/// Input: RGBA16F or RGBA32F with SAMPLED usage; after record() it is in SHADER_READ_ONLY_OPTIMAL,
+/// last read by the compute stage. The levels are images the pyramid owns, with SAMPLED, STORAGE
+/// and TRANSFER_SRC usage; after record() they are in GENERAL, last written by the compute stage (so the
+/// caller's next barrier starts from level(k).stage/access). A shader samples all three with the
+/// same normalized UV as the input.
+///
+/// Per input size, images, pipelines and descriptor sets are made once (prepare(), or the first
+/// record() at that size); record() at a prepared size with a seen input view creates no Vulkan
+/// object.
+class BlurPyramid {
+ public:
+  /// Throws Error(invalid_argument) if config is invalid, Error(no_device) if the device's shared
+  /// memory cannot hold the tile of the largest sigma.
+  BlurPyramid(const Context& context, const BlurPyramidConfig& config = {});
+  BlurPyramid(const BlurPyramid&) = delete;
+  BlurPyramid& operator=(const BlurPyramid&) = delete;
+  BlurPyramid(BlurPyramid&&) noexcept;
+  BlurPyramid& operator=(BlurPyramid&&) noexcept;
+  ~BlurPyramid();
+
+  /// Replaces the config; rebuilds pipelines and levels at the next record() or here if prepared.
+  /// No frame using this pyramid may be in flight.
+  void set_config(const BlurPyramidConfig& config);
+  const BlurPyramidConfig& config() const;
+
+  /// Makes everything a frame of this input size needs. Throws Error(unsupported_size) for a zero
+  /// extent or one above the device's maximum.
+  void prepare(VkExtent2D input_extent);
+
+  /// Records the three levels of `input` into `cmd`. Throws before recording anything if the
+  /// image has the wrong format, usage or extent. `profiler` (may be null) gets a mark per level.
+  void record(VkCommandBuffer cmd, Image& input, Profiler* profiler = nullptr);
+
+  /// Level k = 1, 2, 3 (Blur1 .. Blur3) with its current state. Valid after prepare()/record().
+  /// Throws Error(invalid_argument) for another k. A caller that transitions or uses a level
+  /// updates its layout/stage/access here (as for its own images), so the next record() starts
+  /// its barrier from there.
+  Image& level(uint32_t k);
+  const Image& level(uint32_t k) const;
+  LevelSize level_size(uint32_t k) const;
+  /// Effective sigma of level k in input pixels (docs/BLUR.md variance bookkeeping).
+  EffectiveSigma effective_sigma_px(uint32_t k) const;
+
+  /// Bytes the GPU must move at least per frame at the prepared size (input read once, each
+  /// level written once and read once by the next).
+  uint64_t min_bytes_moved(VkFormat input_format) const;
+
+  struct Impl;
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
+/// How GaussianBlur computes the blur (docs/BLUR.md, "Gaussian blur of any sigma").
+enum class BlurMethod : uint32_t {
+  automatic = 0,  //!< the fastest method whose modelled error is under max_relative_error
+  separable = 1,  //!< direct separable Gaussian in shared memory (the accurate one)
+  pyramid = 2,    //!< area downsample k levels, blur there, bilinear back up
+  dual = 3,       //!< dual filter down/up (Bjørge 2015), tap offset tuned to the sigma
+};
+
+/// Settings of a GaussianBlur. All fields are shape fields (they decide levels and taps).
+struct GaussianBlurConfig {
+  float sigma_px = 4.0f;                      //!< standard deviation in input pixels (0.5 to 64)
+  BlurMethod method = BlurMethod::automatic;  //!< see BlurMethod
+  float max_relative_error = 1e-2f;           //!< automatic and pyramid: bound on the modelled relative L2
+                                              //!< error against the exact Gaussian (1e-4 to 1)
+  bool linear_sampling = false;               //!< separable only: two passes that pair taps into bilinear
+                                              //!< fetches through the sampler (9 taps in 5 fetches)
+  Precision precision = Precision::fp16;      //!< intermediate images
+
+  /// Throws Error(invalid_argument) naming the first field that is out of range or NaN.
+  void validate() const;
+};
+
+/// What GaussianBlur decided for the current size (valid after prepare()/record()).
+struct BlurChoice {
+  BlurMethod method = BlurMethod::separable;  //!< never automatic
+  bool linear_sampling = false;
+  uint32_t radius = 0;                 //!< separable: taps 2 radius + 1
+  uint32_t levels = 0;                 //!< pyramid, dual: levels below the input
+  double level_sigma = 0;              //!< pyramid: sigma in texels of the smallest level
+  double dual_offset = 0;              //!< dual: tap offset o in texels
+  double effective_sigma_px = 0;       //!< sigma of the method's impulse response, input pixels
+  double expected_relative_error = 0;  //!< modelled relative L2 against the exact Gaussian
+  uint32_t dispatches = 0;
+};
+
+/// A same-size Gaussian blur of input into output.
+///
+/// Input: RGBA16F or RGBA32F with SAMPLED usage, left in SHADER_READ_ONLY_OPTIMAL. Output:
+/// RGBA16F or RGBA32F with STORAGE usage, same extent, a different image, left in GENERAL; both
+/// last used by the compute stage. Per size, everything is made once; record() at a prepared size
+/// with seen image views creates no Vulkan object.
+class GaussianBlur {
+ public:
+  /// Throws Error(invalid_argument) if config is invalid.
+  GaussianBlur(const Context& context, const GaussianBlurConfig& config = {});
+  GaussianBlur(const GaussianBlur&) = delete;
+  GaussianBlur& operator=(const GaussianBlur&) = delete;
+  GaussianBlur(GaussianBlur&&) noexcept;
+  GaussianBlur& operator=(GaussianBlur&&) noexcept;
+  ~GaussianBlur();
+
+  void set_config(const GaussianBlurConfig& config);
+  const GaussianBlurConfig& config() const;
+
+  /// Plans the method for this size and makes its images and pipelines. Throws
+  /// Error(unsupported_size) for a zero extent or one above the device's maximum.
+  void prepare(VkExtent2D extent);
+
+  /// Records the blur. Throws before recording anything on a wrong format, usage or extent, or
+  /// when input and output are the same image.
+  void record(VkCommandBuffer cmd, Image& input, Image& output, Profiler* profiler = nullptr);
+
+  const BlurChoice& choice() const;
+
+  /// Bytes the GPU must move at least per frame (input read once, output written once, each
+  /// intermediate written and read once).
+  uint64_t min_bytes_moved(VkFormat input_format, VkFormat output_format) const;
+
+  struct Impl;
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
+/// Name of a method ("auto", "separable", "pyramid", "dual").
+const char* to_string(BlurMethod method);
+
+}  // namespace glint

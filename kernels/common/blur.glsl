@@ -1,0 +1,75 @@
+// Source access shared by the blur kernels (docs/BLUR.md): the sanitize rule for the caller's
+// input and the exact area downsample. Requires `src` (texture2D) and the push block `p`
+// (BlurPush) to be declared first.
+#extension GL_EXT_samplerless_texture_functions : require
+
+// NaN -> 0, then clamp to +-max_value (so +-Inf become finite): only for the caller's input.
+vec4 sanitize(vec4 v) {
+  if ((p.flags & GLINT_BLUR_FLAG_SANITIZE) == 0u) return v;
+  v = mix(v, vec4(0.0), isnan(v));
+  return clamp(v, vec4(-p.max_value), vec4(p.max_value));
+}
+
+vec4 src_texel(ivec2 ij) {
+  return sanitize(texelFetch(src, clamp(ij, ivec2(0), ivec2(p.src_width, p.src_height) - 1), 0));
+}
+
+vec4 src_bilinear(vec2 q) {
+  vec2 f = floor(q);
+  vec2 w = q - f;
+  ivec2 i0 = ivec2(f);
+  vec4 a = src_texel(i0);
+  vec4 b = src_texel(i0 + ivec2(1, 0));
+  vec4 c = src_texel(i0 + ivec2(0, 1));
+  vec4 d = src_texel(i0 + ivec2(1, 1));
+  return mix(mix(a, b, w.x), mix(c, d, w.x), w.y);
+}
+
+// Area downsample A(src) at destination texel xy (docs/BLUR.md "Area downsample"); the identity
+// along an axis whose sizes match. Integer arithmetic in units of 1/dst places the interval ends
+// exactly: destination texel x covers [x*ws, (x+1)*ws) and source texel i covers [i*wd, (i+1)*wd).
+vec4 area_sample(ivec2 xy) {
+  ivec2 ws = ivec2(p.src_width, p.src_height);
+  ivec2 wd = ivec2(p.dst_width, p.dst_height);
+  if (ws == wd) return src_texel(xy);
+  if (ws == 2 * wd) {  // exact 2:1: the mean of a 2x2 block
+    ivec2 s = 2 * xy;
+    return 0.25 * (src_texel(s) + src_texel(s + ivec2(1, 0)) + src_texel(s + ivec2(0, 1)) + src_texel(s + ivec2(1, 1)));
+  }
+  ivec2 lo = xy * ws;
+  ivec2 hi = lo + ws;
+  ivec2 i0 = lo / wd;
+  ivec2 i1 = (hi - 1) / wd;
+  vec4 sum = vec4(0.0);
+  for (int j = i0.y; j <= i1.y; ++j) {
+    float wy = float(min(hi.y, (j + 1) * wd.y) - max(lo.y, j * wd.y));
+    vec4 row = vec4(0.0);
+    for (int i = i0.x; i <= i1.x; ++i) {
+      float wx = float(min(hi.x, (i + 1) * wd.x) - max(lo.x, i * wd.x));
+      row += wx * src_texel(ivec2(i, j));
+    }
+    sum += wy * row;
+  }
+  return sum / float(ws.x * ws.y);
+}
+
+// Binomial downsample (docs/BLUR.md, "pyramid"): [1 3 3 1] / 8 per axis on an exact 2:1
+// reduction, as the mean of four bilinear reads at the mapped position +-0.375 * ratio; the
+// identity along an axis whose sizes match. Its stopband is far better than the 2x2 box's, which
+// lets too much above the level's Nyquist frequency alias into the blur.
+vec4 binomial_sample(ivec2 xy) {
+  ivec2 ws = ivec2(p.src_width, p.src_height);
+  ivec2 wd = ivec2(p.dst_width, p.dst_height);
+  vec2 ratio = vec2(ws) / vec2(wd);
+  vec2 c = (vec2(xy) + 0.5) * ratio - 0.5;
+  vec2 o = mix(0.375 * ratio, vec2(0.0), equal(ws, wd));
+  return 0.25 * (src_bilinear(c + vec2(-o.x, -o.y)) + src_bilinear(c + vec2(o.x, -o.y)) +
+                 src_bilinear(c + vec2(-o.x, o.y)) + src_bilinear(c + vec2(o.x, o.y)));
+}
+
+// Uniform cubic B-spline weights for the four texels around a position with fraction t.
+vec4 bspline_weights(float t) {
+  float s = 1.0 - t;
+  return vec4(s * s * s, 3.0 * t * t * t - 6.0 * t * t + 4.0, -3.0 * t * t * t + 3.0 * t * t + 3.0 * t + 1.0,
+              t * t * t) / 6.0;
+}

@@ -1,0 +1,26 @@
+// Push constants of the blur kernels (kernels/blur_*.comp), shared with host/blur.cpp
+// (STYLE rule 2). The algorithms are in docs/BLUR.md.
+#ifndef GLINT_BLUR_PARAMS_H
+#define GLINT_BLUR_PARAMS_H
+#include "glint_types.h"
+
+// BlurPush::flags bits.
+#define GLINT_BLUR_FLAG_SANITIZE 1u  // the source is the caller's input: NaN -> 0, clamp to +-max_value
+#define GLINT_BLUR_FLAG_VERTICAL 2u  // line / linear kernels: filter along y
+
+// Largest radius whose half-taps fit BlurPush::weights (the fused kernel's taps).
+#define GLINT_BLUR_PUSH_TAPS 16
+
+struct BlurPush {
+  GLINT_INT src_width;   // size of the image read
+  GLINT_INT src_height;
+  GLINT_INT dst_width;   // size of the image written
+  GLINT_INT dst_height;
+  GLINT_FLOAT max_value; // sanitize clamp
+  GLINT_UINT flags;
+  GLINT_FLOAT offset;    // dual: tap offset o
+  GLINT_UINT tap_count;  // line: radius R (weights in the tap buffer); linear: fetches per side
+  GLINT_FLOAT weights[GLINT_BLUR_PUSH_TAPS];  // fused: w[0..R]
+};
+
+#endif
