@@ -2,7 +2,8 @@
 
 namespace glint::detail {
 
-void Barriers::use(Image& image, VkImageLayout layout, VkPipelineStageFlags2 stage, VkAccessFlags2 access) {
+void Barriers::use(Image& image, VkImageLayout layout, VkPipelineStageFlags2 stage, VkAccessFlags2 access,
+                   uint32_t level_count) {
   const bool was_write = (image.access & kWriteAccess) != 0;
   const bool is_write = (access & kWriteAccess) != 0;
   if (!was_write && !is_write && image.layout == layout && image.layout != VK_IMAGE_LAYOUT_UNDEFINED) {
@@ -20,7 +21,9 @@ void Barriers::use(Image& image, VkImageLayout layout, VkPipelineStageFlags2 sta
   b.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
   b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
   b.image = image.image;
-  b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+  const VkImageAspectFlags aspect =
+      image.format == VK_FORMAT_D32_SFLOAT ? VK_IMAGE_ASPECT_DEPTH_BIT : VK_IMAGE_ASPECT_COLOR_BIT;
+  b.subresourceRange = {aspect, 0, level_count, 0, 1};
   // The same image twice in one batch (in-place use) merges into one barrier.
   for (auto& p : pending_) {
     if (p.image == image.image) {

@@ -208,4 +208,32 @@ VkDescriptorSet DescriptorArena::make_buffer_set(const ComputePipeline& pipeline
   return set;
 }
 
+VkDescriptorSet DescriptorArena::make_mixed_set(const ComputePipeline& pipeline,
+                                                const std::vector<AnyBinding>& bindings) {
+  const auto& types = pipeline.bindings();
+  if (bindings.size() != types.size()) {
+    throw Error(ErrorCode::invalid_argument, concat("descriptor set: ", bindings.size(), " bindings for ", types.size()));
+  }
+  VkDescriptorSet set = allocate(pipeline);
+  std::vector<VkDescriptorImageInfo> images(bindings.size());
+  std::vector<VkDescriptorBufferInfo> buffers(bindings.size());
+  std::vector<VkWriteDescriptorSet> writes(bindings.size());
+  for (uint32_t i = 0; i < bindings.size(); ++i) {
+    writes[i] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+    writes[i].dstSet = set;
+    writes[i].dstBinding = i;
+    writes[i].descriptorCount = 1;
+    writes[i].descriptorType = types[i];
+    if (bindings[i].buffer.buffer) {
+      buffers[i] = {bindings[i].buffer.buffer, bindings[i].buffer.offset, bindings[i].buffer.size};
+      writes[i].pBufferInfo = &buffers[i];
+    } else {
+      images[i] = {VK_NULL_HANDLE, bindings[i].image.view, bindings[i].image.layout};
+      writes[i].pImageInfo = &images[i];
+    }
+  }
+  vkUpdateDescriptorSets(context_->device(), static_cast<uint32_t>(writes.size()), writes.data(), 0, nullptr);
+  return set;
+}
+
 }  // namespace glint::detail

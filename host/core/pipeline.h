@@ -79,6 +79,13 @@ class DescriptorArena {
   VkDescriptorSet make_set(const ComputePipeline& pipeline, const std::vector<ImageBinding>& images);
   /// The same for pipelines whose bindings are all storage buffers.
   VkDescriptorSet make_buffer_set(const ComputePipeline& pipeline, const std::vector<Buffer>& buffers);
+  /// One binding of a set that mixes images and buffers: `buffer.buffer` set means a buffer.
+  struct AnyBinding {
+    ImageBinding image{VK_NULL_HANDLE, VK_IMAGE_LAYOUT_UNDEFINED};
+    Buffer buffer{};
+  };
+  /// Allocates a set for `pipeline` and writes one image or buffer per binding, in binding order.
+  VkDescriptorSet make_mixed_set(const ComputePipeline& pipeline, const std::vector<AnyBinding>& bindings);
 
  private:
   VkDescriptorSet allocate(const ComputePipeline& pipeline);
