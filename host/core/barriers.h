@@ -23,6 +23,8 @@ class Barriers {
   void flush(VkCommandBuffer cmd);
 
  private:
+  void queue_read_chain(VkPipelineStageFlags2 readers, VkPipelineStageFlags2 stage, VkAccessFlags2 access,
+                        const Image* image, const Buffer* buffer);
   std::vector<VkImageMemoryBarrier2> pending_;
   std::vector<VkBufferMemoryBarrier2> pending_buffers_;
 };

@@ -113,8 +113,7 @@ void ComputePipeline::reset() {
   set_layout_ = VK_NULL_HANDLE;
 }
 
-void ComputePipeline::dispatch_raw(VkCommandBuffer cmd, VkDescriptorSet set, const void* push, uint32_t bytes,
-                                   uint32_t width, uint32_t height) const {
+void ComputePipeline::bind_and_push(VkCommandBuffer cmd, VkDescriptorSet set, const void* push, uint32_t bytes) const {
   if (bytes != push_bytes_) {
     throw Error(ErrorCode::invalid_argument,
                 concat("kernel ", id_, ": push constants are ", bytes, " bytes, pipeline expects ", push_bytes_));
@@ -122,6 +121,11 @@ void ComputePipeline::dispatch_raw(VkCommandBuffer cmd, VkDescriptorSet set, con
   vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_);
   vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, layout_, 0, 1, &set, 0, nullptr);
   if (bytes) vkCmdPushConstants(cmd, layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, bytes, push);
+}
+
+void ComputePipeline::dispatch_raw(VkCommandBuffer cmd, VkDescriptorSet set, const void* push, uint32_t bytes,
+                                   uint32_t width, uint32_t height) const {
+  bind_and_push(cmd, set, push, bytes);
   vkCmdDispatch(cmd, (width + workgroup_.x - 1) / workgroup_.x, (height + workgroup_.y - 1) / workgroup_.y, 1);
 }
 

@@ -46,7 +46,18 @@ class ComputePipeline {
     dispatch_raw(cmd, set, &push, sizeof(Push), width, height);
   }
 
+  /// Binds the pipeline and `set`, pushes `push` and records vkCmdDispatchIndirect reading a
+  /// VkDispatchIndirectCommand at `offset` in `args` (which needs INDIRECT_BUFFER usage and a
+  /// barrier to DRAW_INDIRECT / INDIRECT_COMMAND_READ after whatever wrote it).
+  template <typename Push>
+  void dispatch_indirect(VkCommandBuffer cmd, VkDescriptorSet set, const Push& push, VkBuffer args,
+                         VkDeviceSize offset) const {
+    bind_and_push(cmd, set, &push, sizeof(Push));
+    vkCmdDispatchIndirect(cmd, args, offset);
+  }
+
  private:
+  void bind_and_push(VkCommandBuffer cmd, VkDescriptorSet set, const void* push, uint32_t bytes) const;
   void dispatch_raw(VkCommandBuffer cmd, VkDescriptorSet set, const void* push, uint32_t bytes,
                     uint32_t width, uint32_t height) const;
   VkDevice device_ = VK_NULL_HANDLE;
