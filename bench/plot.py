@@ -19,6 +19,13 @@ repetitions are used when the file has them, single runs otherwise.
 
     python3 bench/plot.py --chart blur --size 3840x2160 \
         "H100=docs/perf/blur_h100.json" "lavapipe=docs/perf/blur_lavapipe.json"
+
+--chart occlusion draws the lens-flare occlusion chart instead: one point per grid size N
+of BM_LightCull at --lights lights (automatic path, no per-light results, Hi-Z not timed): median
+GPU time (x) against the mean |visible fraction - brute force| (y).
+
+    python3 bench/plot.py --chart occlusion --lights 1000000 --out docs/charts/occlusion_pareto.svg \
+        "H100=docs/perf/occlusion_h100.json"
 """
 import argparse
 import json
@@ -106,18 +113,60 @@ def plot_blur(args):
     print("wrote", args.out)
 
 
+def occlusion_points(path, lights):
+    """(label, median_us, mean_abs_error) for every BM_LightCull grid size at `lights` lights.
+
+    Medians of repetitions are used when present, else the single runs."""
+    rows = json.load(open(path))["benchmarks"]
+    has_medians = any(b.get("aggregate_name") == "median" for b in rows)
+    out = []
+    for b in rows:
+        if not b["name"].startswith("BM_LightCull/"):
+            continue
+        if has_medians and b.get("aggregate_name") != "median":
+            continue
+        if not has_medians and b.get("run_type") == "aggregate":
+            continue
+        m = re.search(r"n:(\d+)/grid:(\d+)/path:0/results:0/hiz:0", b["name"])
+        if not m or int(m.group(1)) != lights:
+            continue
+        out.append((f"N={m.group(2)}", b["median_us"], b["mean_abs_error_vs_brute_force"]))
+    return sorted(out, key=lambda p: int(p[0][2:]))
+
+
+def main_occlusion(args):
+    fig, axes = plt.subplots(1, len(args.inputs), figsize=(5.5 * len(args.inputs), 4.2), squeeze=False)
+    for ax, spec in zip(axes[0], args.inputs):
+        device, path = spec.split("=", 1)
+        pts = occlusion_points(path, args.lights)
+        ax.plot([p[1] for p in pts], [p[2] for p in pts], "-o", alpha=0.6)
+        for label, us, err in pts:
+            ax.annotate(label, (us, err), textcoords="offset points", xytext=(5, 4), fontsize=8)
+        ax.set_xscale("log")
+        ax.set_xlabel("median GPU time of the cull, us (log)")
+        ax.set_ylabel("mean |visible fraction - brute force|")
+        ax.set_title(f"occlusion grid, {args.lights} lights, 1920x1080, on {device}")
+        ax.grid(True, alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(args.out)
+    print("wrote", args.out)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("inputs", nargs="+", help="DEVICE=results.json")
-    ap.add_argument("--chart", choices=["bloom", "blur"], default="bloom")
+    ap.add_argument("--chart", choices=["bloom", "blur", "occlusion"], default="bloom")
     ap.add_argument("--size", default=None, help="WxH (bloom default 1920x1080; blur default: all sizes)")
     ap.add_argument("--out", default=None, help="default docs/charts/<chart>_pareto.svg")
+    ap.add_argument("--lights", type=int, default=1000000, help="light count of the occlusion chart")
     args = ap.parse_args()
     if args.out is None:
         args.out = f"docs/charts/{args.chart}_pareto.svg"
     if args.chart == "blur":
         plot_blur(args)
         return
+    if args.chart == "occlusion":
+        return main_occlusion(args)
     if args.size is None:
         args.size = "1920x1080"
     fig, axes = plt.subplots(1, len(args.inputs), figsize=(5.5 * len(args.inputs), 4.2), squeeze=False)

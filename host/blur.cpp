@@ -250,18 +250,16 @@ struct StepProgram {
     return &tap_buffers.back();
   }
 
-  std::vector<detail::DescriptorArena::SetBinding> bindings_of(const Step& s, VkImageView in, VkImageView out) const {
+  std::vector<detail::DescriptorArena::AnyBinding> bindings_of(const Step& s, VkImageView in, VkImageView out) const {
     VkImageView src = s.src == kInput ? in : images[s.src].state.view;
     VkImageView dst = s.dst == kOutput ? out : images[s.dst].state.view;
-    std::vector<detail::DescriptorArena::SetBinding> b(2);
-    b[0].view = src;
-    b[0].layout = s.src == kInput ? kReadOnly : kGeneral;
+    std::vector<detail::DescriptorArena::AnyBinding> b(2);
+    b[0].image = {src, s.src == kInput ? kReadOnly : kGeneral};
     b[0].sampler = s.sampler ? sampler.get() : VK_NULL_HANDLE;
-    b[1].view = dst;
-    b[1].layout = kGeneral;
+    b[1].image = {dst, kGeneral};
     if (s.taps) {
       b.emplace_back();
-      b[2].buffer = s.taps->buffer();
+      b[2].buffer.buffer = s.taps->buffer();
     }
     return b;
   }
@@ -273,7 +271,7 @@ struct StepProgram {
     internal_sets = detail::DescriptorArena(*context, std::max(1u, n));
     for (Step& s : steps) {
       if (s.src >= 0 && s.dst >= 0)
-        s.set = internal_sets.make_any_set(*s.pipeline, bindings_of(s, VK_NULL_HANDLE, VK_NULL_HANDLE));
+        s.set = internal_sets.make_mixed_set(*s.pipeline, bindings_of(s, VK_NULL_HANDLE, VK_NULL_HANDLE));
     }
   }
 
@@ -289,7 +287,7 @@ struct StepProgram {
     for (size_t i = 0; i < steps.size(); ++i) {
       const Step& s = steps[i];
       sets[i] =
-          (s.src < 0 || s.dst < 0) ? caller_arenas.back().make_any_set(*s.pipeline, bindings_of(s, in, out)) : s.set;
+          (s.src < 0 || s.dst < 0) ? caller_arenas.back().make_mixed_set(*s.pipeline, bindings_of(s, in, out)) : s.set;
     }
     return caller_sets.emplace(key, std::move(sets)).first->second;
   }

@@ -2,10 +2,15 @@
 
 namespace glint::detail {
 
-void Barriers::use(Image& image, VkImageLayout layout, VkPipelineStageFlags2 stage, VkAccessFlags2 access) {
+void Barriers::use(Image& image, VkImageLayout layout, VkPipelineStageFlags2 stage, VkAccessFlags2 access,
+                   uint32_t level_count) {
   const bool was_write = (image.access & kWriteAccess) != 0;
   const bool is_write = (access & kWriteAccess) != 0;
   if (!was_write && !is_write && image.layout == layout && image.layout != VK_IMAGE_LAYOUT_UNDEFINED) {
+    // Read after read. A stage that the earlier barrier did not cover still needs the last write
+    // made visible to it: chain an execution dependency from the earlier readers (whose barrier
+    // made the write available) to the new stage.
+    if ((stage & ~image.stage) != 0) queue_read_chain(image.stage, stage, access, &image, nullptr);
     image.stage |= stage;
     image.access |= access;
     return;
@@ -20,7 +25,9 @@ void Barriers::use(Image& image, VkImageLayout layout, VkPipelineStageFlags2 sta
   b.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
   b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
   b.image = image.image;
-  b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+  const VkImageAspectFlags aspect =
+      image.format == VK_FORMAT_D32_SFLOAT ? VK_IMAGE_ASPECT_DEPTH_BIT : VK_IMAGE_ASPECT_COLOR_BIT;
+  b.subresourceRange = {aspect, 0, level_count, 0, 1};
   // The same image twice in one batch (in-place use) merges into one barrier.
   for (auto& p : pending_) {
     if (p.image == image.image) {
@@ -42,7 +49,8 @@ void Barriers::use(Image& image, VkImageLayout layout, VkPipelineStageFlags2 sta
 void Barriers::use(Buffer& buffer, VkPipelineStageFlags2 stage, VkAccessFlags2 access) {
   const bool was_write = (buffer.access & kWriteAccess) != 0;
   const bool is_write = (access & kWriteAccess) != 0;
-  if (!was_write && !is_write) {  // read after read
+  if (!was_write && !is_write) {  // read after read (see the image case)
+    if ((stage & ~buffer.stage) != 0) queue_read_chain(buffer.stage, stage, access, nullptr, &buffer);
     buffer.stage |= stage;
     buffer.access |= access;
     return;
@@ -60,6 +68,35 @@ void Barriers::use(Buffer& buffer, VkPipelineStageFlags2 stage, VkAccessFlags2 a
   pending_buffers_.push_back(b);
   buffer.stage = stage;
   buffer.access = access;
+}
+
+void Barriers::queue_read_chain(VkPipelineStageFlags2 readers, VkPipelineStageFlags2 stage, VkAccessFlags2 access,
+                                const Image* image, const Buffer* buffer) {
+  if (readers == VK_PIPELINE_STAGE_2_NONE) return;  // never written or read in this command buffer's view
+  if (image) {
+    VkImageMemoryBarrier2 b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
+    b.srcStageMask = readers;
+    b.dstStageMask = stage;
+    b.dstAccessMask = access;
+    b.oldLayout = image->layout;
+    b.newLayout = image->layout;
+    b.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    b.image = image->image;
+    b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, VK_REMAINING_MIP_LEVELS, 0, 1};
+    pending_.push_back(b);
+  } else {
+    VkBufferMemoryBarrier2 b{VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER_2};
+    b.srcStageMask = readers;
+    b.dstStageMask = stage;
+    b.dstAccessMask = access;
+    b.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    b.buffer = buffer->buffer;
+    b.offset = buffer->offset;
+    b.size = buffer->size;
+    pending_buffers_.push_back(b);
+  }
 }
 
 void Barriers::flush(VkCommandBuffer cmd) {

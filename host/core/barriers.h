@@ -12,13 +12,19 @@ class Barriers {
  public:
   /// Declares that `image` is next used with (layout, stage, access). Read-after-read in the same
   /// layout needs no barrier and only widens the tracked use; anything else queues one.
-  void use(Image& image, VkImageLayout layout, VkPipelineStageFlags2 stage, VkAccessFlags2 access);
+  /// `level_count` mip levels from level 0 are covered (glint-owned mip chains such as the Hi-Z
+  /// pyramid; caller images are views of level 0). The aspect follows the format (depth for
+  /// VK_FORMAT_D32_SFLOAT, colour otherwise).
+  void use(Image& image, VkImageLayout layout, VkPipelineStageFlags2 stage, VkAccessFlags2 access,
+           uint32_t level_count = 1);
   /// The same for a buffer range (no layouts).
   void use(Buffer& buffer, VkPipelineStageFlags2 stage, VkAccessFlags2 access);
   /// Records every queued barrier in one vkCmdPipelineBarrier2 (nothing if none are queued).
   void flush(VkCommandBuffer cmd);
 
  private:
+  void queue_read_chain(VkPipelineStageFlags2 readers, VkPipelineStageFlags2 stage, VkAccessFlags2 access,
+                        const Image* image, const Buffer* buffer);
   std::vector<VkImageMemoryBarrier2> pending_;
   std::vector<VkBufferMemoryBarrier2> pending_buffers_;
 };

@@ -219,7 +219,30 @@ void fill_info(ContextState& s) {
   std::vector<VkQueueFamilyProperties> families(n);
   vkGetPhysicalDeviceQueueFamilyProperties(s.physical_device, &n, families.data());
   s.info.timestamps_supported = s.queue_family < n && families[s.queue_family].timestampValidBits > 0;
+  s.graphics_queue = s.queue_family < n && (families[s.queue_family].queueFlags & VK_QUEUE_GRAPHICS_BIT) != 0;
   vkGetPhysicalDeviceMemoryProperties(s.physical_device, &s.memory);
+}
+
+// dynamicRendering of an adopted device: from the engine's vkCreateDevice feature chain when it
+// gives one (the feature is off unless a struct in the chain turns it on), else the physical
+// device's support, which the AdoptInfo contract asks the engine to have enabled.
+bool adopted_dynamic_rendering(const AdoptInfo& a) {
+  if (a.enabled_features) {
+    bool on = false;
+    for (auto* p = static_cast<const VkBaseInStructure*>(a.enabled_features); p; p = p->pNext) {
+      if (p->sType == VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES) {
+        on = on || reinterpret_cast<const VkPhysicalDeviceVulkan13Features*>(p)->dynamicRendering == VK_TRUE;
+      } else if (p->sType == VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DYNAMIC_RENDERING_FEATURES) {
+        on = on || reinterpret_cast<const VkPhysicalDeviceDynamicRenderingFeatures*>(p)->dynamicRendering == VK_TRUE;
+      }
+    }
+    return on;
+  }
+  VkPhysicalDeviceVulkan13Features f13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
+  VkPhysicalDeviceFeatures2 supported{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
+  supported.pNext = &f13;
+  vkGetPhysicalDeviceFeatures2(a.physical_device, &supported);
+  return f13.dynamicRendering == VK_TRUE;
 }
 
 }  // namespace
@@ -293,7 +316,7 @@ Context Context::create(const ContextOptions& options) {
 
   VkPhysicalDeviceVulkan13Features e13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
   e13.synchronization2 = VK_TRUE;
-  e13.dynamicRendering = f13.dynamicRendering;
+  e13.dynamicRendering = f13.dynamicRendering;  // a Vulkan 1.3 requirement; LensFlare draws with it
   e13.subgroupSizeControl = f13.subgroupSizeControl;
   e13.computeFullSubgroups = f13.computeFullSubgroups;
   e13.maintenance4 = f13.maintenance4;
@@ -326,6 +349,7 @@ Context Context::create(const ContextOptions& options) {
   VkFenceCreateInfo fence{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
   vk_check(vkCreateFence(s.device, &fence, nullptr, &s.fence), "vkCreateFence");
   detail::fill_info(s);
+  s.dynamic_rendering = f13.dynamicRendering == VK_TRUE;
   guard.done = true;
   return Context(std::move(state));
 }
@@ -357,6 +381,7 @@ Context Context::adopt(const AdoptInfo& a) {
   state->queue_family = a.queue_family_index;
   state->adopted = true;
   detail::fill_info(*state);
+  state->dynamic_rendering = detail::adopted_dynamic_rendering(a);
   return Context(std::move(state));
 }
 

@@ -21,6 +21,11 @@ struct ContextState {
   VkQueue queue = VK_NULL_HANDLE;  // standalone only
   bool adopted = false;
   DeviceInfo info;
+  // Whether the device was created with dynamicRendering (standalone: enabled when supported;
+  // adopted: read from AdoptInfo::enabled_features, else the physical device's support), and
+  // whether the queue family can draw. LensFlare's raster path needs both.
+  bool dynamic_rendering = false;
+  bool graphics_queue = false;
   VkPhysicalDeviceMemoryProperties memory{};
 
   // Standalone helpers for run_once().

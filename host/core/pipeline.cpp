@@ -115,8 +115,7 @@ void ComputePipeline::reset() {
   set_layout_ = VK_NULL_HANDLE;
 }
 
-void ComputePipeline::dispatch_raw(VkCommandBuffer cmd, VkDescriptorSet set, const void* push, uint32_t bytes,
-                                   uint32_t width, uint32_t height) const {
+void ComputePipeline::bind_and_push(VkCommandBuffer cmd, VkDescriptorSet set, const void* push, uint32_t bytes) const {
   if (bytes != push_bytes_) {
     throw Error(ErrorCode::invalid_argument,
                 concat("kernel ", id_, ": push constants are ", bytes, " bytes, pipeline expects ", push_bytes_));
@@ -124,6 +123,11 @@ void ComputePipeline::dispatch_raw(VkCommandBuffer cmd, VkDescriptorSet set, con
   vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_);
   vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, layout_, 0, 1, &set, 0, nullptr);
   if (bytes) vkCmdPushConstants(cmd, layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, bytes, push);
+}
+
+void ComputePipeline::dispatch_raw(VkCommandBuffer cmd, VkDescriptorSet set, const void* push, uint32_t bytes,
+                                   uint32_t width, uint32_t height) const {
+  bind_and_push(cmd, set, push, bytes);
   vkCmdDispatch(cmd, (width + workgroup_.x - 1) / workgroup_.x, (height + workgroup_.y - 1) / workgroup_.y, 1);
 }
 
@@ -212,29 +216,27 @@ VkDescriptorSet DescriptorArena::make_buffer_set(const ComputePipeline& pipeline
   return set;
 }
 
-VkDescriptorSet DescriptorArena::make_any_set(const ComputePipeline& pipeline,
-                                              const std::vector<SetBinding>& bindings) {
+VkDescriptorSet DescriptorArena::make_mixed_set(const ComputePipeline& pipeline,
+                                                const std::vector<AnyBinding>& bindings) {
   const auto& types = pipeline.bindings();
   if (bindings.size() != types.size()) {
-    throw Error(ErrorCode::invalid_argument,
-                concat("descriptor set: ", bindings.size(), " bindings for ", types.size()));
+    throw Error(ErrorCode::invalid_argument, concat("descriptor set: ", bindings.size(), " bindings for ", types.size()));
   }
   VkDescriptorSet set = allocate(pipeline);
   std::vector<VkDescriptorImageInfo> images(bindings.size());
   std::vector<VkDescriptorBufferInfo> buffers(bindings.size());
   std::vector<VkWriteDescriptorSet> writes(bindings.size());
   for (uint32_t i = 0; i < bindings.size(); ++i) {
-    const SetBinding& b = bindings[i];
     writes[i] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
     writes[i].dstSet = set;
     writes[i].dstBinding = i;
     writes[i].descriptorCount = 1;
     writes[i].descriptorType = types[i];
-    if (types[i] == VK_DESCRIPTOR_TYPE_STORAGE_BUFFER || types[i] == VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER) {
-      buffers[i] = {b.buffer, b.offset, b.range};
+    if (bindings[i].buffer.buffer) {
+      buffers[i] = {bindings[i].buffer.buffer, bindings[i].buffer.offset, bindings[i].buffer.size};
       writes[i].pBufferInfo = &buffers[i];
     } else {
-      images[i] = {b.sampler, b.view, b.layout};
+      images[i] = {bindings[i].sampler, bindings[i].image.view, bindings[i].image.layout};
       writes[i].pImageInfo = &images[i];
     }
   }

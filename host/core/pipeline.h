@@ -46,9 +46,20 @@ class ComputePipeline {
     dispatch_raw(cmd, set, &push, sizeof(Push), width, height);
   }
 
+  /// Binds the pipeline and `set`, pushes `push` and records vkCmdDispatchIndirect reading a
+  /// VkDispatchIndirectCommand at `offset` in `args` (which needs INDIRECT_BUFFER usage and a
+  /// barrier to DRAW_INDIRECT / INDIRECT_COMMAND_READ after whatever wrote it).
+  template <typename Push>
+  void dispatch_indirect(VkCommandBuffer cmd, VkDescriptorSet set, const Push& push, VkBuffer args,
+                         VkDeviceSize offset) const {
+    bind_and_push(cmd, set, &push, sizeof(Push));
+    vkCmdDispatchIndirect(cmd, args, offset);
+  }
+
  private:
-  void dispatch_raw(VkCommandBuffer cmd, VkDescriptorSet set, const void* push, uint32_t bytes, uint32_t width,
-                    uint32_t height) const;
+  void bind_and_push(VkCommandBuffer cmd, VkDescriptorSet set, const void* push, uint32_t bytes) const;
+  void dispatch_raw(VkCommandBuffer cmd, VkDescriptorSet set, const void* push, uint32_t bytes,
+                    uint32_t width, uint32_t height) const;
   VkDevice device_ = VK_NULL_HANDLE;
   std::string id_;
   VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
@@ -79,19 +90,16 @@ class DescriptorArena {
   VkDescriptorSet make_set(const ComputePipeline& pipeline, const std::vector<ImageBinding>& images);
   /// The same for pipelines whose bindings are all storage buffers.
   VkDescriptorSet make_buffer_set(const ComputePipeline& pipeline, const std::vector<Buffer>& buffers);
-
-  /// One binding of any kind the pipeline declares: an image view (sampled, storage, or combined
-  /// with `sampler`) or a buffer range.
-  struct SetBinding {
-    VkImageView view = VK_NULL_HANDLE;
-    VkImageLayout layout = VK_IMAGE_LAYOUT_UNDEFINED;
+  /// One binding of a set that mixes images and buffers: `buffer.buffer` set means a buffer;
+  /// `sampler` goes with the image of a combined image sampler binding.
+  struct AnyBinding {
+    ImageBinding image{VK_NULL_HANDLE, VK_IMAGE_LAYOUT_UNDEFINED};
+    Buffer buffer{};
     VkSampler sampler = VK_NULL_HANDLE;
-    VkBuffer buffer = VK_NULL_HANDLE;
-    VkDeviceSize offset = 0;
-    VkDeviceSize range = VK_WHOLE_SIZE;
   };
-  /// Allocates a set for `pipeline` and writes each binding by the type the pipeline declares.
-  VkDescriptorSet make_any_set(const ComputePipeline& pipeline, const std::vector<SetBinding>& bindings);
+  /// Allocates a set for `pipeline` and writes one image or buffer per binding, in binding order.
+  VkDescriptorSet make_mixed_set(const ComputePipeline& pipeline, const std::vector<AnyBinding>& bindings);
+
 
  private:
   VkDescriptorSet allocate(const ComputePipeline& pipeline);

@@ -84,6 +84,59 @@ CpuImage download(const Context& context, Image& image) {
   return out;
 }
 
+void upload_r32(const Context& context, Image& image, const std::vector<float>& values) {
+  if (image.format != VK_FORMAT_D32_SFLOAT && image.format != VK_FORMAT_R32_SFLOAT) {
+    throw Error(ErrorCode::unsupported_format,
+                concat("upload_r32: ", format_name(image.format), " is not D32_SFLOAT or R32_SFLOAT"));
+  }
+  const size_t texels = size_t(image.extent.width) * image.extent.height;
+  if (values.size() != texels) {
+    throw Error(ErrorCode::invalid_argument, concat("upload_r32: ", values.size(), " values for ", texels, " texels"));
+  }
+  OwnedBuffer staging(context, texels * 4, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, true);
+  std::memcpy(staging.mapped(), values.data(), texels * 4);
+  staging.flush();
+  context.run_once([&](VkCommandBuffer cmd) {
+    Barriers b;
+    b.use(image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);
+    b.flush(cmd);
+    VkBufferImageCopy region = whole(image);
+    if (image.format == VK_FORMAT_D32_SFLOAT) region.imageSubresource.aspectMask = VK_IMAGE_ASPECT_DEPTH_BIT;
+    vkCmdCopyBufferToImage(cmd, staging.buffer(), image.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
+  });
+}
+
+std::vector<float> download_r32(const Context& context, Image& image, uint32_t level, VkExtent2D extent,
+                                uint32_t level_count) {
+  const size_t texels = size_t(extent.width) * extent.height;
+  OwnedBuffer staging(context, texels * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true);
+  context.run_once([&](VkCommandBuffer cmd) {
+    Barriers b;
+    b.use(image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT,
+          level_count);
+    b.flush(cmd);
+    VkBufferImageCopy region{};
+    const bool depth = image.format == VK_FORMAT_D32_SFLOAT;
+    region.imageSubresource = {static_cast<VkImageAspectFlags>(depth ? VK_IMAGE_ASPECT_DEPTH_BIT : VK_IMAGE_ASPECT_COLOR_BIT),
+                               level, 0, 1};
+    region.imageExtent = {extent.width, extent.height, 1};
+    vkCmdCopyImageToBuffer(cmd, image.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, staging.buffer(), 1, &region);
+    VkMemoryBarrier2 host{VK_STRUCTURE_TYPE_MEMORY_BARRIER_2};
+    host.srcStageMask = VK_PIPELINE_STAGE_2_COPY_BIT;
+    host.srcAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;
+    host.dstStageMask = VK_PIPELINE_STAGE_2_HOST_BIT;
+    host.dstAccessMask = VK_ACCESS_2_HOST_READ_BIT;
+    VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+    dep.memoryBarrierCount = 1;
+    dep.pMemoryBarriers = &host;
+    vkCmdPipelineBarrier2(cmd, &dep);
+  });
+  staging.invalidate();
+  std::vector<float> out(texels);
+  std::memcpy(out.data(), staging.mapped(), texels * 4);
+  return out;
+}
+
 void record_fill(VkCommandBuffer cmd, Image& image, float value) {
   Barriers b;
   b.use(image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_PIPELINE_STAGE_2_CLEAR_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);

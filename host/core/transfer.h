@@ -7,6 +7,8 @@
 #include "core/cpu_image.h"
 #include "core/resources.h"
 
+#include <vector>
+
 namespace glint::detail {
 
 /// Usage that test and tool images get: sampled, storage, transfer source and destination.
@@ -19,6 +21,15 @@ void upload(const Context& context, Image& image, const CpuImage& pixels);
 
 /// Reads `image` back as RGBA float (from any state; the state is updated).
 CpuImage download(const Context& context, Image& image);
+
+/// Copies one float per texel into a D32_SFLOAT or R32_SFLOAT `image` (depth buffers, Hi-Z
+/// inputs), leaving it in TRANSFER_DST_OPTIMAL, last written by a transfer.
+void upload_r32(const Context& context, Image& image, const std::vector<float>& values);
+
+/// Reads mip `level` (of size `extent`) of an R32_SFLOAT or D32_SFLOAT image back, from any state
+/// of its first `level_count` mips (the state is updated and covers them all).
+std::vector<float> download_r32(const Context& context, Image& image, uint32_t level, VkExtent2D extent,
+                                uint32_t level_count = 1);
 
 /// Fills `image` with `value` in every channel (NaN poisons: an unwritten texel stays NaN).
 void fill(const Context& context, Image& image, float value);

@@ -80,7 +80,15 @@ struct AdoptInfo {
                                                      //!< both; kernels size their workgroups by
                                                      //!< specialization, which needs maintenance4)
   uint32_t queue_family_index = 0;                   //!< family the command buffers come from;
-                                                     //!< must support compute
+                                                     //!< must support compute (and graphics for
+                                                     //!< LensFlare::record_raster)
+  /// Optional: the pNext chain the engine passed to vkCreateDevice (a VkPhysicalDeviceFeatures2,
+  /// VkPhysicalDeviceVulkan13Features or VkPhysicalDeviceDynamicRenderingFeatures, walked through
+  /// pNext). When given, glint reads which optional features are enabled from it: LensFlare's
+  /// raster path needs dynamicRendering and reports a clear error if the chain says it is off.
+  /// When null, glint checks that the physical device supports the feature and trusts the engine
+  /// to have enabled it (Vulkan cannot be asked which features a device was created with).
+  const void* enabled_features = nullptr;
 };
 
 /// Facts about the device that kernels are tuned by (rule: chosen per device, never assumed).

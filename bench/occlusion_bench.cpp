@@ -1,0 +1,237 @@
+// Lens-flare visibility benchmarks (issue 5 speed targets): the Hi-Z build of a D32 depth buffer,
+// and the cull + occlusion grid + compaction of a light list, on device-local resources. GPU time
+// from timestamps as manual time (median of the frames of one command buffer), bytes/s over the
+// bytes each stage must move, and error counters against the float64 references:
+// - BM_HiZBuild: texels that differ from the reference pyramid (must be 0);
+// - BM_LightCull: mean |grid fraction - brute force| over the first 2000 tested lights of the
+//   fixed scene (the occlusion error of docs/charts/occlusion_pareto.svg), and how often the
+//   documented bound or the conservative rule is broken (must be 0).
+#include <benchmark/benchmark.h>
+#include <glint/occlusion.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <memory>
+
+#include "bench_support.h"
+#include "core/barriers.h"
+#include "core/resources.h"
+#include "core/transfer.h"
+#include "reference/occlusion_reference.h"
+
+namespace glint::bench {
+namespace {
+
+// Frames per timed command buffer: fewer on CPU devices (lavapipe), where 1M lights take seconds.
+int frames_for(const Context& ctx, uint64_t work) {
+  if (ctx.info().type == VK_PHYSICAL_DEVICE_TYPE_CPU && work > 100000) return 2;
+  return 16;
+}
+
+detail::OwnedImage make_depth(const Context& ctx, const reference::DepthImage& d) {
+  detail::OwnedImage img(ctx, {d.width, d.height}, VK_FORMAT_D32_SFLOAT,
+                         VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT);
+  detail::upload_r32(ctx, img.state, d.depth);
+  return img;
+}
+
+// A depth buffer of sloped boxes over the far plane (the same generator as the tests).
+reference::Scene scene_for(uint32_t w, uint32_t h, uint32_t lights, double max_size) {
+  return reference::random_scene(w, h, lights, 2024, false, max_size);
+}
+
+void BM_HiZBuild(benchmark::State& state) {
+  const auto w = static_cast<uint32_t>(state.range(0));
+  const auto h = static_cast<uint32_t>(state.range(1));
+  const Context& ctx = context();
+  const auto scene = scene_for(w, h, 0, 1);
+  auto depth = make_depth(ctx, scene.depth);
+  HiZConfig config;
+  config.extent = {w, h};
+  HiZPyramid hiz(ctx, config);
+  const int frames = frames_for(ctx, uint64_t(w) * h / 64);
+  Profiler profiler(ctx, frames + 1);
+  std::vector<double> all;
+  for (auto _ : state) {
+    const double ms =
+        median_frame_ms(ctx, profiler, frames, [&](VkCommandBuffer cmd) { hiz.record(cmd, depth.state); });
+    all.push_back(ms);
+    state.SetIterationTime(ms * 1e-3);
+  }
+  // Exactness of the benchmarked pyramid.
+  const auto ref = reference::hiz_pyramid(scene.depth, false, hiz.levels());
+  uint64_t mismatches = 0;
+  for (uint32_t k = 1; k <= hiz.levels(); ++k) {
+    const auto& r = ref[k - 1];
+    const auto gpu = detail::download_r32(ctx, hiz.image(), k - 1, {r.width, r.height}, hiz.levels());
+    for (size_t i = 0; i < gpu.size(); ++i) mismatches += std::memcmp(&gpu[i], &r.depth[i], 4) != 0;
+  }
+  const double bytes = double(hiz.min_bytes_moved());
+  state.counters["bytes_per_second"] = benchmark::Counter(bytes, benchmark::Counter::kIsIterationInvariantRate);
+  state.counters["median_us"] = median_of(all) * 1e3;
+  state.counters["floor_bytes"] = bytes;
+  state.counters["levels"] = hiz.levels();
+  state.counters["mismatches_vs_f64"] = double(mismatches);
+  state.SetLabel("D32 on " + ctx.info().name);
+}
+
+BENCHMARK(BM_HiZBuild)
+    ->Args({1920, 1080})
+    ->Args({3840, 2160})
+    ->ArgNames({"w", "h"})
+    ->UseManualTime()
+    ->Unit(benchmark::kMicrosecond);
+
+// Device-local copy of host data.
+detail::OwnedBuffer device_buffer(const Context& ctx, const void* data, VkDeviceSize bytes, VkBufferUsageFlags usage) {
+  detail::OwnedBuffer buf(ctx, std::max<VkDeviceSize>(bytes, 16), usage | VK_BUFFER_USAGE_TRANSFER_DST_BIT, false);
+  if (data && bytes) {
+    detail::OwnedBuffer staging(ctx, bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, true);
+    std::memcpy(staging.mapped(), data, bytes);
+    staging.flush();
+    ctx.run_once([&](VkCommandBuffer cmd) {
+      VkBufferCopy region{0, 0, bytes};
+      vkCmdCopyBuffer(cmd, staging.buffer(), buf.buffer(), 1, &region);
+    });
+  }
+  return buf;
+}
+
+Buffer view(const detail::OwnedBuffer& b, VkBufferUsageFlags usage, bool after_copy) {
+  Buffer v{b.buffer(),      0, b.size(), usage | VK_BUFFER_USAGE_TRANSFER_DST_BIT, VK_PIPELINE_STAGE_2_NONE,
+           VK_ACCESS_2_NONE};
+  if (after_copy) {
+    v.stage = VK_PIPELINE_STAGE_2_COPY_BIT;
+    v.access = VK_ACCESS_2_TRANSFER_WRITE_BIT;
+  }
+  return v;
+}
+
+// Args: lights, grid N, compaction path (0 automatic = ballot where supported, 2 shared),
+// per-light results (0/1), and whether the Hi-Z build is timed with the cull (0/1).
+void BM_LightCull(benchmark::State& state) {
+  const auto n = static_cast<uint32_t>(state.range(0));
+  const auto grid = static_cast<uint32_t>(state.range(1));
+  const auto path = static_cast<CompactionPath>(state.range(2));
+  const bool with_results = state.range(3) != 0;
+  const bool with_hiz = state.range(4) != 0;
+  const Context& ctx = context();
+  const uint32_t w = 1920, h = 1080;
+  // Flares of 8 to 128 pixels (the seed's default is 100).
+  const auto scene = scene_for(w, h, n, 128.0);
+  auto depth = make_depth(ctx, scene.depth);
+  HiZConfig hc;
+  hc.extent = {w, h};
+  HiZPyramid hiz(ctx, hc);
+  LightCullConfig cc;
+  cc.capacity = std::max(n, 1u);
+  cc.grid = grid;
+  cc.path = path;
+  cc.max_lights = std::max(n, 1u);
+  LightCuller culler(ctx, cc);
+  const VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT;
+  auto lights = device_buffer(ctx, scene.lights.data(), VkDeviceSize(n) * sizeof(GlintFlareLight), storage);
+  auto instances = device_buffer(ctx, nullptr, VkDeviceSize(cc.capacity) * sizeof(GlintFlareInstance), storage);
+  auto indirect =
+      device_buffer(ctx, nullptr, sizeof(GlintFlareIndirect), storage | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT);
+  auto stats = device_buffer(ctx, nullptr, sizeof(GlintFlareStats), storage);
+  auto results = device_buffer(ctx, nullptr, VkDeviceSize(n) * sizeof(GlintFlareLightResult), storage);
+  Buffer lv = view(lights, storage, true);
+  LightCullOutputs out{view(instances, storage, false),
+                       view(indirect, storage | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT, false),
+                       view(stats, storage, false), with_results ? view(results, storage, false) : Buffer{}};
+  LightCullFrame frame;
+  for (int i = 0; i < 16; ++i) frame.view_proj[i] = static_cast<float>(scene.view_proj[i]);
+  ctx.run_once([&](VkCommandBuffer cmd) { hiz.record(cmd, depth.state); });
+
+  const int frames = frames_for(ctx, uint64_t(n) * grid * grid);
+  Profiler profiler(ctx, frames + 1);
+  std::vector<double> all;
+  for (auto _ : state) {
+    const double ms = median_frame_ms(ctx, profiler, frames, [&](VkCommandBuffer cmd) {
+      if (with_hiz) hiz.record(cmd, depth.state);
+      culler.record(cmd, hiz, depth.state, lv, n, frame, out);
+    });
+    all.push_back(ms);
+    state.SetIterationTime(ms * 1e-3);
+  }
+
+  // Read the per-light results and statistics back (results are written in a separate frame when
+  // the timed one had none).
+  Buffer rv = view(results, storage, false);
+  LightCullOutputs check{out.instances, out.indirect, out.stats, rv};
+  detail::OwnedBuffer readback(ctx, VkDeviceSize(n) * 8 + sizeof(GlintFlareStats) + 16,
+                               VK_BUFFER_USAGE_TRANSFER_DST_BIT, true);
+  ctx.run_once([&](VkCommandBuffer cmd) {
+    culler.record(cmd, hiz, depth.state, lv, n, frame, check);
+    detail::Barriers b;
+    b.use(check.results, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
+    b.use(check.stats, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
+    b.flush(cmd);
+    VkBufferCopy r1{0, 0, VkDeviceSize(n) * 8};
+    if (n) vkCmdCopyBuffer(cmd, results.buffer(), readback.buffer(), 1, &r1);
+    VkBufferCopy r2{0, VkDeviceSize(n) * 8, sizeof(GlintFlareStats)};
+    vkCmdCopyBuffer(cmd, stats.buffer(), readback.buffer(), 1, &r2);
+    Buffer rb{readback.buffer(), 0, readback.size(), 0, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT};
+    b.use(rb, VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
+    b.flush(cmd);
+  });
+  readback.invalidate();
+  const auto* res = static_cast<const GlintFlareLightResult*>(readback.mapped());
+  GlintFlareStats st;
+  std::memcpy(&st, static_cast<const char*>(readback.mapped()) + VkDeviceSize(n) * 8, sizeof(st));
+
+  // Occlusion error against brute force on the first 2000 lights that reach the grid test.
+  reference::CullSettings s;
+  std::copy(scene.view_proj, scene.view_proj + 16, s.view_proj);
+  s.grid = grid;
+  s.levels = hiz.levels();
+  const auto pyramid = reference::hiz_pyramid(scene.depth, false, hiz.levels());
+  double error_sum = 0.0;
+  uint32_t tested = 0, broken = 0;
+  for (uint32_t i = 0; i < n && tested < 2000; ++i) {
+    const auto ref = reference::cull_light(scene.lights[i], s, scene.depth, pyramid);
+    if (ref.ambiguous || (ref.culled != GLINT_FLARE_VISIBLE && ref.culled != GLINT_FLARE_OCCLUDED)) continue;
+    const double gpu = res[i].culled == GLINT_FLARE_VISIBLE ? res[i].visible_fraction : 0.0;
+    const double err = gpu - ref.brute_force;
+    if (err < -1e-6 || err > ref.mixed_cells / double(grid * grid) + 1e-6 ||
+        std::fabs(gpu - ref.grid_fraction) > 1e-6) {
+      ++broken;
+    }
+    error_sum += std::fabs(err);
+    ++tested;
+  }
+  const double bytes = double(n) * (sizeof(GlintFlareLight) + (with_results ? 8 : 0)) +
+                       double(std::min(st.visible, cc.capacity)) * sizeof(GlintFlareInstance);
+  state.counters["lights_per_second"] = benchmark::Counter(n, benchmark::Counter::kIsIterationInvariantRate);
+  state.counters["bytes_per_second"] = benchmark::Counter(bytes, benchmark::Counter::kIsIterationInvariantRate);
+  state.counters["median_us"] = median_of(all) * 1e3;
+  state.counters["visible"] = st.visible;
+  state.counters["occluded"] = st.occluded;
+  state.counters["frustum_culled"] = st.frustum_culled;
+  state.counters["mean_abs_error_vs_brute_force"] = tested ? error_sum / tested : 0.0;
+  state.counters["bound_or_exactness_violations"] = broken;
+  state.SetLabel(std::string(culler.path() == CompactionPath::ballot ? "ballot" : "shared") +
+                 (with_hiz ? " + Hi-Z" : "") + " on " + ctx.info().name);
+}
+
+BENCHMARK(BM_LightCull)
+    ->Args({10, 4, 0, 0, 0})
+    ->Args({1000, 4, 0, 0, 0})
+    ->Args({1000000, 4, 0, 0, 0})
+    ->Args({1000000, 4, 2, 0, 0})
+    ->Args({1000000, 4, 0, 1, 0})
+    ->Args({1000000, 1, 0, 0, 0})
+    ->Args({1000000, 8, 0, 0, 0})
+    ->Args({1000000, 16, 0, 0, 0})
+    ->Args({10, 4, 0, 0, 1})
+    ->Args({1000, 1, 0, 0, 0})
+    ->Args({1000, 8, 0, 0, 0})
+    ->Args({1000, 16, 0, 0, 0})
+    ->ArgNames({"n", "grid", "path", "results", "hiz"})
+    ->UseManualTime()
+    ->Unit(benchmark::kMicrosecond);
+
+}  // namespace
+}  // namespace glint::bench

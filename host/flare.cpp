@@ -1,0 +1,698 @@
+// Lens-flare driver (issue 5, drawing half): validates, generates the element atlas, owns the
+// raster and compute pipelines, and records either path. docs/FLARE.md explains the choices.
+#include <glint/flare.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <map>
+#include <string>
+#include <tuple>
+#include <utility>
+#include <vector>
+
+#include "core/barriers.h"
+#include "core/check.h"
+#include "core/context_state.h"
+#include "core/kernel_table.h"
+#include "core/pipeline.h"
+#include "core/resources.h"
+#include "flare_params.h"
+#include "flare_types.h"
+
+namespace glint {
+
+using detail::check_range;
+using detail::concat;
+
+static_assert(sizeof(GlintFlarePush) == 88,
+              "GlintFlarePush layout changed: update kernels/common/flare_params.h users");
+static_assert(offsetof(GlintFlarePush, ghost_pos0) == 52);
+static_assert(offsetof(GlintFlarePush, groups_per_instance) == 72);
+static_assert(sizeof(GlintFlareAtlasPush) == 12);
+static_assert(sizeof(GlintFlareInstance) == 48 && sizeof(GlintFlareIndirect) == 32);
+static_assert(LensFlare::vertices_per_instance() == GLINT_FLARE_SPRITES * GLINT_FLARE_VERTICES_PER_SPRITE);
+// Tiles and the atlas must be aligned to the coarsest level so no mip texel straddles two tiles.
+static_assert(GLINT_FLARE_ATLAS_WIDTH % (1u << (GLINT_FLARE_ATLAS_LEVELS - 1)) == 0);
+static_assert(GLINT_FLARE_ATLAS_HEIGHT % (1u << (GLINT_FLARE_ATLAS_LEVELS - 1)) == 0);
+static_assert(GLINT_FLARE_TILE_GHOST_W % (1u << (GLINT_FLARE_ATLAS_LEVELS - 1)) == 0);
+static_assert(GLINT_FLARE_ATLAS_PADDING % (1u << (GLINT_FLARE_ATLAS_LEVELS - 1)) == 0);
+
+FlareConfig FlareConfig::preset(FlarePreset preset) {
+  FlareConfig c;
+  switch (preset) {
+    case FlarePreset::retro_subtle:
+      c.anamorphic_ratio = 1.8f;
+      c.intensity = 0.6f;
+      break;
+    case FlarePreset::retro_intense:
+      c.anamorphic_ratio = 2.5f;
+      c.intensity = 1.2f;
+      break;
+    case FlarePreset::cinematic:
+      c.anamorphic_ratio = 2.0f;
+      c.intensity = 0.8f;
+      break;
+    case FlarePreset::disabled:
+      c.enabled = false;
+      c.anamorphic_ratio = 1.0f;
+      c.intensity = 0.0f;
+      break;
+    default:
+      throw Error(ErrorCode::invalid_argument,
+                  concat("FlarePreset = ", static_cast<uint32_t>(preset),
+                         " is not a preset: accepted retro_subtle, retro_intense, cinematic, disabled"));
+  }
+  return c;
+}
+
+void FlareConfig::validate() const {
+  check_range("FlareConfig::anamorphic_ratio", anamorphic_ratio, 1.0, 3.0);
+  check_range("FlareConfig::intensity", intensity, 0.0, 2.0);
+  check_range("FlareConfig::main_weight", main_weight, 0.0, 10.0);
+  check_range("FlareConfig::streak_weight", streak_weight, 0.0, 10.0);
+  check_range("FlareConfig::streak_length", streak_length, 1.0, 10.0);
+  check_range("FlareConfig::halo_weight", halo_weight, 0.0, 10.0);
+  check_range("FlareConfig::starburst_weight", starburst_weight, 0.0, 10.0);
+  check_range("FlareConfig::ghost_weight", ghost_weight, 0.0, 10.0);
+  for (size_t i = 0; i < ghost_positions.size(); ++i) {
+    check_range(concat("FlareConfig::ghost_positions[", i, "]").c_str(), ghost_positions[i], -2.0, 3.0);
+  }
+  for (size_t i = 0; i < tint_color.size(); ++i) {
+    check_range(concat("FlareConfig::tint_color[", i, "]").c_str(), tint_color[i], 0.0, 1.0);
+  }
+}
+
+namespace {
+
+constexpr VkPipelineStageFlags2 kCompute = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
+constexpr VkPipelineStageFlags2 kIndirect = VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT;
+constexpr VkAccessFlags2 kStorageRW = VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT;
+
+// Workgroups per instance in the splat: one per sprite and chunk. GPUs get 8 chunks so a large
+// sprite is spread over 8 workgroups; CPU devices (lavapipe) have few cores and get 1.
+uint32_t splat_chunks(const DeviceInfo& info) { return info.type == VK_PHYSICAL_DEVICE_TYPE_CPU ? 1u : 8u; }
+
+bool is_float_rgba(VkFormat f) { return f == VK_FORMAT_R16G16B16A16_SFLOAT || f == VK_FORMAT_R32G32B32A32_SFLOAT; }
+
+// Descriptor pools for sets whose bindings mix buffers and images (DescriptorArena writes one kind).
+class SetPool {
+ public:
+  explicit SetPool(const Context& c) : context_(&c) {}
+  SetPool(const SetPool&) = delete;
+  SetPool& operator=(const SetPool&) = delete;
+  ~SetPool() {
+    for (VkDescriptorPool p : pools_) vkDestroyDescriptorPool(context_->device(), p, nullptr);
+  }
+  VkDescriptorSet allocate(VkDescriptorSetLayout layout) {
+    if (left_ == 0) {
+      constexpr uint32_t kSets = 16;
+      VkDescriptorPoolSize sizes[] = {{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kSets * 3},
+                                      {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, kSets},
+                                      {VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, kSets}};
+      VkDescriptorPoolCreateInfo info{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+      info.maxSets = kSets;
+      info.poolSizeCount = 3;
+      info.pPoolSizes = sizes;
+      VkDescriptorPool pool = VK_NULL_HANDLE;
+      detail::vk_check(vkCreateDescriptorPool(context_->device(), &info, nullptr, &pool), "vkCreateDescriptorPool");
+      context_->state().count_object();
+      pools_.push_back(pool);
+      left_ = kSets;
+    }
+    --left_;
+    VkDescriptorSetAllocateInfo alloc{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
+    alloc.descriptorPool = pools_.back();
+    alloc.descriptorSetCount = 1;
+    alloc.pSetLayouts = &layout;
+    VkDescriptorSet set = VK_NULL_HANDLE;
+    detail::vk_check(vkAllocateDescriptorSets(context_->device(), &alloc, &set), "vkAllocateDescriptorSets");
+    context_->state().count_object();
+    return set;
+  }
+
+ private:
+  const Context* context_;
+  std::vector<VkDescriptorPool> pools_;
+  uint32_t left_ = 0;
+};
+
+// One binding of a descriptor write: a buffer range, a storage image or a combined image sampler.
+struct Write {
+  VkDescriptorType type;
+  VkDescriptorBufferInfo buffer;
+  VkDescriptorImageInfo image;
+};
+Write buffer_write(const Buffer& b) { return {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, {b.buffer, b.offset, b.size}, {}}; }
+
+void write_set(VkDevice device, VkDescriptorSet set, const std::vector<Write>& bindings) {
+  std::vector<VkWriteDescriptorSet> writes(bindings.size());
+  for (uint32_t i = 0; i < bindings.size(); ++i) {
+    writes[i] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+    writes[i].dstSet = set;
+    writes[i].dstBinding = i;
+    writes[i].descriptorCount = 1;
+    writes[i].descriptorType = bindings[i].type;
+    if (bindings[i].type == VK_DESCRIPTOR_TYPE_STORAGE_BUFFER) {
+      writes[i].pBufferInfo = &bindings[i].buffer;
+    } else {
+      writes[i].pImageInfo = &bindings[i].image;
+    }
+  }
+  vkUpdateDescriptorSets(device, static_cast<uint32_t>(writes.size()), writes.data(), 0, nullptr);
+}
+
+using BufferKey = std::tuple<VkBuffer, VkDeviceSize, VkDeviceSize>;
+BufferKey key_of(const Buffer& b) { return {b.buffer, b.offset, b.size}; }
+
+}  // namespace
+
+struct LensFlare::Impl {
+  const Context* context = nullptr;
+  VkDevice device = VK_NULL_HANDLE;
+  VkFormat format = VK_FORMAT_UNDEFINED;
+  VkExtent2D extent{0, 0};
+  uint32_t chunks = 1;
+  uint32_t max_group_count_x = 65535;
+  detail::Workgroup2D tile;  // the resolve's workgroup, and the tile of the touched-tile flags
+
+  // Atlas: one image with every level, a view of all levels (sampling) and one per level (storage).
+  Image atlas;  // state tracks all levels together
+  VkDeviceMemory atlas_memory = VK_NULL_HANDLE;
+  std::vector<VkImageView> level_views;
+  VkSampler sampler = VK_NULL_HANDLE;
+  bool atlas_generated = false;
+  detail::ComputePipeline atlas_pipeline;
+  detail::DescriptorArena atlas_sets_arena;
+  std::vector<VkDescriptorSet> atlas_sets;
+
+  // Raster path (absent when the device cannot draw into `format` with blending).
+  std::string raster_unavailable;  // empty when the raster path is available
+  VkDescriptorSetLayout raster_set_layout = VK_NULL_HANDLE;
+  VkPipelineLayout raster_layout = VK_NULL_HANDLE;
+  VkPipeline raster_pipeline = VK_NULL_HANDLE;
+
+  // Compute path.
+  detail::ComputePipeline splat, resolve;
+  detail::OwnedBuffer accum_buffer, flags_buffer;
+  Buffer accum, flags;  // views of the two with their last use
+  bool accum_needs_clear = false;
+  uint32_t tiles_x = 0, tiles_y = 0;
+
+  std::unique_ptr<SetPool> sets;
+  std::map<BufferKey, VkDescriptorSet> raster_sets, splat_sets;
+  std::map<VkImageView, VkDescriptorSet> resolve_sets;
+
+  ~Impl() {
+    if (!device) return;
+    if (raster_pipeline) vkDestroyPipeline(device, raster_pipeline, nullptr);
+    if (raster_layout) vkDestroyPipelineLayout(device, raster_layout, nullptr);
+    if (raster_set_layout) vkDestroyDescriptorSetLayout(device, raster_set_layout, nullptr);
+    sets.reset();
+    if (sampler) vkDestroySampler(device, sampler, nullptr);
+    for (VkImageView v : level_views) vkDestroyImageView(device, v, nullptr);
+    if (atlas.view) vkDestroyImageView(device, atlas.view, nullptr);
+    if (atlas.image) vkDestroyImage(device, atlas.image, nullptr);
+    if (atlas_memory) vkFreeMemory(device, atlas_memory, nullptr);
+  }
+
+  void make_atlas();
+  void make_raster_pipeline();
+  void make_compute_pipelines();
+  void make_accumulation();
+  void record_setup(VkCommandBuffer cmd);
+  GlintFlarePush push(const FlareConfig& c) const;
+  void check_inputs(const char* fn, const Image& color, VkImageUsageFlags usage, const char* usage_name,
+                    const Buffer& instances, const Buffer& indirect, const FlareConfig& config) const;
+};
+
+void LensFlare::Impl::make_atlas() {
+  auto& s = context->state();
+  const uint32_t levels = GLINT_FLARE_ATLAS_LEVELS;
+  atlas.format = VK_FORMAT_R16G16B16A16_SFLOAT;  // HDR tiles scaled by bright lights: 8 bits would band
+  atlas.extent = {GLINT_FLARE_ATLAS_WIDTH, GLINT_FLARE_ATLAS_HEIGHT};
+  // TRANSFER_SRC and _DST: tests read every level back and poison it before generation.
+  atlas.usage = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT |
+                VK_IMAGE_USAGE_TRANSFER_DST_BIT;
+  VkImageCreateInfo info{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
+  info.imageType = VK_IMAGE_TYPE_2D;
+  info.format = atlas.format;
+  info.extent = {atlas.extent.width, atlas.extent.height, 1};
+  info.mipLevels = levels;
+  info.arrayLayers = 1;
+  info.samples = VK_SAMPLE_COUNT_1_BIT;
+  info.tiling = VK_IMAGE_TILING_OPTIMAL;
+  info.usage = atlas.usage;
+  info.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+  detail::vk_check(vkCreateImage(device, &info, nullptr, &atlas.image), "vkCreateImage (flare atlas)");
+  s.count_object();
+  VkMemoryRequirements req;
+  vkGetImageMemoryRequirements(device, atlas.image, &req);
+  VkMemoryAllocateInfo alloc{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+  alloc.allocationSize = req.size;
+  alloc.memoryTypeIndex = s.memory_type(req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+  detail::vk_check(vkAllocateMemory(device, &alloc, nullptr, &atlas_memory), "vkAllocateMemory (flare atlas)");
+  s.count_object();
+  detail::vk_check(vkBindImageMemory(device, atlas.image, atlas_memory, 0), "vkBindImageMemory");
+  VkImageViewCreateInfo view{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
+  view.image = atlas.image;
+  view.viewType = VK_IMAGE_VIEW_TYPE_2D;
+  view.format = atlas.format;
+  view.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, levels, 0, 1};
+  detail::vk_check(vkCreateImageView(device, &view, nullptr, &atlas.view), "vkCreateImageView");
+  s.count_object();
+  for (uint32_t k = 0; k < levels; ++k) {
+    view.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, k, 1, 0, 1};
+    VkImageView v = VK_NULL_HANDLE;
+    detail::vk_check(vkCreateImageView(device, &view, nullptr, &v), "vkCreateImageView");
+    s.count_object();
+    level_views.push_back(v);
+  }
+  // Trilinear, clamp to edge (the atlas border is padding), no anisotropy: the level comes from the
+  // shader's explicit atlas-aware LOD (textureLod), identical in both paths.
+  VkSamplerCreateInfo si{VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO};
+  si.magFilter = VK_FILTER_LINEAR;
+  si.minFilter = VK_FILTER_LINEAR;
+  si.mipmapMode = VK_SAMPLER_MIPMAP_MODE_LINEAR;
+  si.addressModeU = si.addressModeV = si.addressModeW = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
+  si.minLod = 0.0f;
+  si.maxLod = float(levels - 1);
+  detail::vk_check(vkCreateSampler(device, &si, nullptr, &sampler), "vkCreateSampler");
+  s.count_object();
+
+  detail::PipelineDesc d;
+  d.kernel_id = "flare_atlas_main";
+  d.bindings = {VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE};
+  d.push_constant_bytes = sizeof(GlintFlareAtlasPush);
+  d.workgroup = detail::choose_workgroup_2d(context->info());
+  atlas_pipeline = detail::ComputePipeline(*context, d);
+  atlas_sets_arena = detail::DescriptorArena(*context, levels);
+  const VkImageLayout G = VK_IMAGE_LAYOUT_GENERAL;
+  for (uint32_t k = 0; k < levels; ++k) {
+    atlas_sets.push_back(
+        atlas_sets_arena.make_set(atlas_pipeline, {{level_views[k == 0 ? 0 : k - 1], G}, {level_views[k], G}}));
+  }
+}
+
+void LensFlare::Impl::record_setup(VkCommandBuffer cmd) {
+  if (atlas_generated) return;
+  const uint32_t levels = GLINT_FLARE_ATLAS_LEVELS;
+  detail::Barriers b;
+  const VkImageLayout G = VK_IMAGE_LAYOUT_GENERAL;
+  for (uint32_t k = 0; k < levels; ++k) {
+    b.use(atlas, G, kCompute, kStorageRW, levels);  // level k - 1 written -> read; level k written
+    b.flush(cmd);
+    GlintFlareAtlasPush p{k, std::max(1u, atlas.extent.width >> k), std::max(1u, atlas.extent.height >> k)};
+    atlas_pipeline.dispatch(cmd, atlas_sets[k], p, p.width, p.height);
+  }
+  b.use(atlas, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+        VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+        VK_ACCESS_2_SHADER_SAMPLED_READ_BIT, levels);
+  b.flush(cmd);
+  atlas_generated = true;
+}
+
+void LensFlare::Impl::make_raster_pipeline() {
+  if (!context->state().dynamic_rendering) {
+    raster_unavailable = "the device was created without dynamicRendering (VkPhysicalDeviceVulkan13Features)";
+    return;
+  }
+  if (!context->state().graphics_queue) {
+    raster_unavailable = concat("queue family ", context->queue_family_index(), " has no graphics capability");
+    return;
+  }
+  VkFormatProperties fp;
+  vkGetPhysicalDeviceFormatProperties(context->physical_device(), format, &fp);
+  if (!(fp.optimalTilingFeatures & VK_FORMAT_FEATURE_COLOR_ATTACHMENT_BLEND_BIT)) {
+    raster_unavailable = concat("the device cannot blend into ", detail::format_name(format));
+    return;
+  }
+  auto& s = context->state();
+  VkDescriptorSetLayoutBinding b[2] = {
+      {0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_VERTEX_BIT, nullptr},
+      {1, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, VK_SHADER_STAGE_FRAGMENT_BIT, nullptr},
+  };
+  VkDescriptorSetLayoutCreateInfo sl{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
+  sl.bindingCount = 2;
+  sl.pBindings = b;
+  detail::vk_check(vkCreateDescriptorSetLayout(device, &sl, nullptr, &raster_set_layout),
+                   "vkCreateDescriptorSetLayout");
+  s.count_object();
+  VkPushConstantRange range{VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof(GlintFlarePush)};
+  VkPipelineLayoutCreateInfo pl{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+  pl.setLayoutCount = 1;
+  pl.pSetLayouts = &raster_set_layout;
+  pl.pushConstantRangeCount = 1;
+  pl.pPushConstantRanges = &range;
+  detail::vk_check(vkCreatePipelineLayout(device, &pl, nullptr, &raster_layout), "vkCreatePipelineLayout");
+  s.count_object();
+
+  VkShaderModule modules[2] = {VK_NULL_HANDLE, VK_NULL_HANDLE};
+  const char* ids[2] = {"flare_vert_main", "flare_frag_main"};
+  try {
+    for (int i = 0; i < 2; ++i) {
+      const detail::KernelBinary* bin = detail::find_kernel(ids[i]);
+      if (!bin) throw Error(ErrorCode::vulkan_failure, concat("kernel '", ids[i], "' is not embedded in this build"));
+      VkShaderModuleCreateInfo sm{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
+      sm.codeSize = bin->size_bytes;
+      sm.pCode = bin->code;
+      detail::vk_check(vkCreateShaderModule(device, &sm, nullptr, &modules[i]), "vkCreateShaderModule");
+    }
+    VkPipelineShaderStageCreateInfo stages[2] = {{VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO},
+                                                 {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO}};
+    stages[0].stage = VK_SHADER_STAGE_VERTEX_BIT;
+    stages[0].module = modules[0];
+    stages[0].pName = "main";
+    stages[1].stage = VK_SHADER_STAGE_FRAGMENT_BIT;
+    stages[1].module = modules[1];
+    stages[1].pName = "main";
+    VkPipelineVertexInputStateCreateInfo vertex_input{VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO};
+    VkPipelineInputAssemblyStateCreateInfo assembly{VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO};
+    assembly.topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST;
+    VkPipelineViewportStateCreateInfo viewport{VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO};
+    viewport.viewportCount = 1;
+    viewport.scissorCount = 1;
+    VkPipelineRasterizationStateCreateInfo raster{VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO};
+    raster.polygonMode = VK_POLYGON_MODE_FILL;
+    raster.cullMode = VK_CULL_MODE_NONE;  // billboards: both windings
+    raster.lineWidth = 1.0f;
+    VkPipelineMultisampleStateCreateInfo ms{VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO};
+    ms.rasterizationSamples = VK_SAMPLE_COUNT_1_BIT;
+    // Premultiplied colour, additive: dst.rgb += src.rgb (ONE, ONE). Alpha is not written: flares
+    // add light and leave whatever the image keeps in alpha.
+    VkPipelineColorBlendAttachmentState blend{};
+    blend.blendEnable = VK_TRUE;
+    blend.srcColorBlendFactor = VK_BLEND_FACTOR_ONE;
+    blend.dstColorBlendFactor = VK_BLEND_FACTOR_ONE;
+    blend.colorBlendOp = VK_BLEND_OP_ADD;
+    blend.srcAlphaBlendFactor = VK_BLEND_FACTOR_ZERO;
+    blend.dstAlphaBlendFactor = VK_BLEND_FACTOR_ONE;
+    blend.alphaBlendOp = VK_BLEND_OP_ADD;
+    blend.colorWriteMask = VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT | VK_COLOR_COMPONENT_B_BIT;
+    VkPipelineColorBlendStateCreateInfo cb{VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO};
+    cb.attachmentCount = 1;
+    cb.pAttachments = &blend;
+    VkDynamicState dyn[2] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
+    VkPipelineDynamicStateCreateInfo dynamic{VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO};
+    dynamic.dynamicStateCount = 2;
+    dynamic.pDynamicStates = dyn;
+    VkPipelineRenderingCreateInfo rendering{VK_STRUCTURE_TYPE_PIPELINE_RENDERING_CREATE_INFO};
+    rendering.colorAttachmentCount = 1;
+    rendering.pColorAttachmentFormats = &format;
+    VkGraphicsPipelineCreateInfo gp{VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO};
+    gp.pNext = &rendering;
+    gp.stageCount = 2;
+    gp.pStages = stages;
+    gp.pVertexInputState = &vertex_input;
+    gp.pInputAssemblyState = &assembly;
+    gp.pViewportState = &viewport;
+    gp.pRasterizationState = &raster;
+    gp.pMultisampleState = &ms;
+    gp.pColorBlendState = &cb;
+    gp.pDynamicState = &dynamic;
+    gp.layout = raster_layout;
+    detail::vk_check(vkCreateGraphicsPipelines(device, VK_NULL_HANDLE, 1, &gp, nullptr, &raster_pipeline),
+                     "vkCreateGraphicsPipelines (flare)");
+    s.count_object();
+  } catch (...) {
+    for (VkShaderModule m : modules) {
+      if (m) vkDestroyShaderModule(device, m, nullptr);
+    }
+    throw;
+  }
+  for (VkShaderModule m : modules) vkDestroyShaderModule(device, m, nullptr);
+}
+
+void LensFlare::Impl::make_compute_pipelines() {
+  const auto SB = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+  detail::PipelineDesc d;
+  d.kernel_id = "flare_splat_main";
+  d.bindings = {SB, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, SB, SB};
+  d.push_constant_bytes = sizeof(GlintFlarePush);
+  d.workgroup = {64, 1};
+  splat = detail::ComputePipeline(*context, d);
+  d.kernel_id = format == VK_FORMAT_R32G32B32A32_SFLOAT ? "flare_resolve_rgba32f" : "flare_resolve_rgba16f";
+  d.bindings = {SB, SB, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE};
+  d.workgroup = tile;
+  resolve = detail::ComputePipeline(*context, d);
+}
+
+void LensFlare::Impl::make_accumulation() {
+  if (accum_buffer.buffer()) return;
+  const VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+  accum_buffer =
+      detail::OwnedBuffer(*context, VkDeviceSize(extent.width) * extent.height * 3 * sizeof(float), usage, false);
+  flags_buffer = detail::OwnedBuffer(*context, VkDeviceSize(tiles_x) * tiles_y * sizeof(uint32_t), usage, false);
+  accum = {accum_buffer.buffer(), 0, accum_buffer.size(), usage, VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE};
+  flags = {flags_buffer.buffer(), 0, flags_buffer.size(), usage, VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE};
+  accum_needs_clear = true;
+}
+
+GlintFlarePush LensFlare::Impl::push(const FlareConfig& c) const {
+  GlintFlarePush p{};
+  p.viewport_w = float(extent.width);
+  p.viewport_h = float(extent.height);
+  p.anamorphic_ratio = c.anamorphic_ratio;
+  p.intensity = c.intensity;
+  p.weight_main = c.main_weight;
+  p.weight_streak = c.streak_weight;
+  p.weight_halo = c.halo_weight;
+  p.weight_starburst = c.starburst_weight;
+  p.weight_ghost = c.ghost_weight;
+  p.streak_length = c.streak_length;
+  p.tint_r = c.tint ? c.tint_color[0] : 1.0f;
+  p.tint_g = c.tint ? c.tint_color[1] : 1.0f;
+  p.tint_b = c.tint ? c.tint_color[2] : 1.0f;
+  p.ghost_pos0 = c.ghost_positions[0];
+  p.ghost_pos1 = c.ghost_positions[1];
+  p.ghost_pos2 = c.ghost_positions[2];
+  p.ghost_pos3 = c.ghost_positions[3];
+  p.ghost_pos4 = c.ghost_positions[4];
+  p.groups_per_instance = GLINT_FLARE_SPRITES * chunks;
+  p.tile_w = tile.x;
+  p.tile_h = tile.y;
+  p.tiles_x = tiles_x;
+  return p;
+}
+
+void LensFlare::Impl::check_inputs(const char* fn, const Image& color, VkImageUsageFlags usage, const char* usage_name,
+                                   const Buffer& instances, const Buffer& indirect, const FlareConfig& config) const {
+  config.validate();
+  if (!color.image || !color.view)
+    throw Error(ErrorCode::invalid_argument, concat(fn, ": color image and view must be non-null"));
+  if (color.format != format) {
+    throw Error(ErrorCode::unsupported_format, concat(fn, ": color format is ", detail::format_name(color.format),
+                                                      "; this LensFlare was made for ", detail::format_name(format)));
+  }
+  if (color.extent.width != extent.width || color.extent.height != extent.height) {
+    throw Error(ErrorCode::invalid_argument,
+                concat(fn, ": color extent ", color.extent.width, "x", color.extent.height,
+                       " differs from the LensFlare's ", extent.width, "x", extent.height));
+  }
+  if ((color.usage & usage) != usage)
+    throw Error(ErrorCode::missing_usage, concat(fn, ": color image lacks ", usage_name, " usage"));
+  if (!instances.buffer) throw Error(ErrorCode::invalid_argument, concat(fn, ": instances buffer is null"));
+  if (!(instances.usage & VK_BUFFER_USAGE_STORAGE_BUFFER_BIT)) {
+    throw Error(ErrorCode::missing_usage,
+                concat(fn, ": instances buffer lacks VK_BUFFER_USAGE_STORAGE_BUFFER_BIT usage"));
+  }
+  if (instances.size != VK_WHOLE_SIZE && instances.size < sizeof(GlintFlareInstance)) {
+    throw Error(ErrorCode::invalid_argument, concat(fn, ": instances buffer holds ", instances.size,
+                                                    " bytes; at least one GlintFlareInstance (48 bytes) is needed"));
+  }
+  if (!indirect.buffer) throw Error(ErrorCode::invalid_argument, concat(fn, ": indirect buffer is null"));
+  if (!(indirect.usage & VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT)) {
+    throw Error(ErrorCode::missing_usage,
+                concat(fn, ": indirect buffer lacks VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT usage"));
+  }
+  if (indirect.offset % 4 != 0) {
+    throw Error(ErrorCode::invalid_argument,
+                concat(fn, ": indirect offset = ", indirect.offset, " is not a multiple of 4"));
+  }
+  if (indirect.size != VK_WHOLE_SIZE && indirect.size < sizeof(GlintFlareIndirect)) {
+    throw Error(ErrorCode::invalid_argument,
+                concat(fn, ": indirect buffer holds ", indirect.size, " bytes; a GlintFlareIndirect needs 32"));
+  }
+}
+
+LensFlare::LensFlare(const Context& context, VkFormat color_format, VkExtent2D extent)
+    : impl_(std::make_unique<Impl>()) {
+  if (!is_float_rgba(color_format)) {
+    throw Error(ErrorCode::unsupported_format,
+                concat("LensFlare: color format is ", detail::format_name(color_format),
+                       "; accepted VK_FORMAT_R16G16B16A16_SFLOAT or VK_FORMAT_R32G32B32A32_SFLOAT"));
+  }
+  const uint32_t max_dim = context.info().max_image_dimension_2d;
+  if (extent.width == 0 || extent.height == 0 || extent.width > max_dim || extent.height > max_dim) {
+    throw Error(ErrorCode::unsupported_size, concat("LensFlare: extent ", extent.width, "x", extent.height,
+                                                    " is out of range: accepted 1 to ", max_dim, " on each side"));
+  }
+  Impl& m = *impl_;
+  m.context = &context;
+  m.device = context.device();
+  m.format = color_format;
+  m.extent = extent;
+  m.chunks = splat_chunks(context.info());
+  VkPhysicalDeviceProperties props;
+  vkGetPhysicalDeviceProperties(context.physical_device(), &props);
+  m.max_group_count_x = props.limits.maxComputeWorkGroupCount[0];
+  m.tile = detail::choose_workgroup_2d(context.info());
+  m.tiles_x = (extent.width + m.tile.x - 1) / m.tile.x;
+  m.tiles_y = (extent.height + m.tile.y - 1) / m.tile.y;
+  m.sets = std::make_unique<SetPool>(context);
+  m.make_atlas();
+  m.make_raster_pipeline();
+  m.make_compute_pipelines();
+  if (!context.is_adopted()) context.run_once([&](VkCommandBuffer cmd) { m.record_setup(cmd); });
+}
+
+LensFlare::LensFlare(LensFlare&&) noexcept = default;
+LensFlare& LensFlare::operator=(LensFlare&&) noexcept = default;
+LensFlare::~LensFlare() = default;
+
+uint32_t LensFlare::groups_per_instance() const { return GLINT_FLARE_SPRITES * impl_->chunks; }
+uint32_t LensFlare::max_compute_instances() const { return impl_->max_group_count_x / groups_per_instance(); }
+void LensFlare::record_setup(VkCommandBuffer cmd) { impl_->record_setup(cmd); }
+void LensFlare::prepare_compute() { impl_->make_accumulation(); }
+VkFormat LensFlare::color_format() const { return impl_->format; }
+VkExtent2D LensFlare::extent() const { return impl_->extent; }
+
+FlareAtlasInfo LensFlare::atlas() const {
+  FlareAtlasInfo a;
+  a.image = impl_->atlas.image;
+  a.view = impl_->atlas.view;
+  a.format = impl_->atlas.format;
+  a.width = impl_->atlas.extent.width;
+  a.height = impl_->atlas.extent.height;
+  a.levels = GLINT_FLARE_ATLAS_LEVELS;
+  a.padding_texels = GLINT_FLARE_ATLAS_PADDING;
+  a.generated = impl_->atlas_generated;
+  return a;
+}
+
+void LensFlare::record_raster(VkCommandBuffer cmd, Image& color, Buffer& instances, Buffer& indirect,
+                              const FlareConfig& config, Profiler* profiler) {
+  Impl& m = *impl_;
+  m.check_inputs("LensFlare::record_raster", color, VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT,
+                 "VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT", instances, indirect, config);
+  if (!m.raster_unavailable.empty()) {
+    throw Error(
+        m.raster_unavailable.find("blend") != std::string::npos ? ErrorCode::unsupported_format : ErrorCode::no_device,
+        concat("LensFlare::record_raster: ", m.raster_unavailable, "; use record_compute"));
+  }
+  if (!config.enabled || config.intensity == 0.0f) return;  // adds nothing: record nothing
+  m.record_setup(cmd);
+
+  VkDescriptorSet set;
+  if (auto it = m.raster_sets.find(key_of(instances)); it != m.raster_sets.end()) {
+    set = it->second;
+  } else {
+    set = m.sets->allocate(m.raster_set_layout);
+    Write img{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+              {},
+              {m.sampler, m.atlas.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL}};
+    write_set(m.device, set, {buffer_write(instances), img});
+    m.raster_sets.emplace(key_of(instances), set);
+  }
+
+  detail::Barriers b;
+  b.use(instances, VK_PIPELINE_STAGE_2_VERTEX_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
+  b.use(indirect, kIndirect, VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT);
+  b.use(m.atlas, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
+        VK_ACCESS_2_SHADER_SAMPLED_READ_BIT, GLINT_FLARE_ATLAS_LEVELS);
+  b.use(color, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+        VK_ACCESS_2_COLOR_ATTACHMENT_READ_BIT | VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT);
+  b.flush(cmd);
+
+  VkRenderingAttachmentInfo attachment{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
+  attachment.imageView = color.view;
+  attachment.imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
+  attachment.loadOp = VK_ATTACHMENT_LOAD_OP_LOAD;
+  attachment.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
+  VkRenderingInfo rendering{VK_STRUCTURE_TYPE_RENDERING_INFO};
+  rendering.renderArea = {{0, 0}, m.extent};
+  rendering.layerCount = 1;
+  rendering.colorAttachmentCount = 1;
+  rendering.pColorAttachments = &attachment;
+  vkCmdBeginRendering(cmd, &rendering);
+  vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, m.raster_pipeline);
+  VkViewport viewport{0.0f, 0.0f, float(m.extent.width), float(m.extent.height), 0.0f, 1.0f};
+  VkRect2D scissor{{0, 0}, m.extent};
+  vkCmdSetViewport(cmd, 0, 1, &viewport);
+  vkCmdSetScissor(cmd, 0, 1, &scissor);
+  vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, m.raster_layout, 0, 1, &set, 0, nullptr);
+  const GlintFlarePush p = m.push(config);
+  vkCmdPushConstants(cmd, m.raster_layout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof(p), &p);
+  vkCmdDrawIndirect(cmd, indirect.buffer, indirect.offset + offsetof(GlintFlareIndirect, vertex_count), 1,
+                    sizeof(VkDrawIndirectCommand));
+  vkCmdEndRendering(cmd);
+  if (profiler) profiler->mark(cmd, "flare raster");
+}
+
+void LensFlare::record_compute(VkCommandBuffer cmd, Image& color, Buffer& instances, Buffer& indirect,
+                               const FlareConfig& config, Profiler* profiler) {
+  Impl& m = *impl_;
+  m.check_inputs("LensFlare::record_compute", color, VK_IMAGE_USAGE_STORAGE_BIT, "VK_IMAGE_USAGE_STORAGE_BIT",
+                 instances, indirect, config);
+  if (instances.size != VK_WHOLE_SIZE && instances.size / sizeof(GlintFlareInstance) > max_compute_instances()) {
+    throw Error(
+        ErrorCode::invalid_argument,
+        concat("LensFlare::record_compute: the instances buffer holds ", instances.size / sizeof(GlintFlareInstance),
+               " instances; the device dispatches at most ", max_compute_instances(), " (", m.max_group_count_x,
+               " workgroups / ", groups_per_instance(), " per instance)"));
+  }
+  if (!config.enabled || config.intensity == 0.0f) return;  // adds nothing: record nothing
+  m.record_setup(cmd);
+  m.make_accumulation();  // first use only
+  detail::Barriers b;
+  if (m.accum_needs_clear) {  // once: later frames find both zeroed by flare_resolve
+    b.use(m.accum, VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);  // vkCmdFillBuffer
+    b.use(m.flags, VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);
+    b.flush(cmd);
+    vkCmdFillBuffer(cmd, m.accum.buffer, 0, VK_WHOLE_SIZE, 0);
+    vkCmdFillBuffer(cmd, m.flags.buffer, 0, VK_WHOLE_SIZE, 0);
+    m.accum_needs_clear = false;
+  }
+
+  VkDescriptorSet splat_set;
+  if (auto it = m.splat_sets.find(key_of(instances)); it != m.splat_sets.end()) {
+    splat_set = it->second;
+  } else {
+    splat_set = m.sets->allocate(m.splat.set_layout());
+    Write img{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+              {},
+              {m.sampler, m.atlas.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL}};
+    write_set(m.device, splat_set, {buffer_write(instances), img, buffer_write(m.accum), buffer_write(m.flags)});
+    m.splat_sets.emplace(key_of(instances), splat_set);
+  }
+  VkDescriptorSet resolve_set;
+  if (auto it = m.resolve_sets.find(color.view); it != m.resolve_sets.end()) {
+    resolve_set = it->second;
+  } else {
+    resolve_set = m.sets->allocate(m.resolve.set_layout());
+    Write img{VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, {}, {VK_NULL_HANDLE, color.view, VK_IMAGE_LAYOUT_GENERAL}};
+    write_set(m.device, resolve_set, {buffer_write(m.accum), buffer_write(m.flags), img});
+    m.resolve_sets.emplace(color.view, resolve_set);
+  }
+
+  const GlintFlarePush p = m.push(config);
+  b.use(instances, kCompute, VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
+  b.use(indirect, kIndirect, VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT);
+  b.use(m.atlas, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, kCompute, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT,
+        GLINT_FLARE_ATLAS_LEVELS);
+  b.use(m.accum, kCompute, kStorageRW);
+  b.use(m.flags, kCompute, kStorageRW);
+  b.flush(cmd);
+  m.splat.dispatch_indirect(cmd, splat_set, p, indirect.buffer,
+                            indirect.offset + offsetof(GlintFlareIndirect, group_count_x));
+  if (profiler) profiler->mark(cmd, "flare splat");
+
+  b.use(m.accum, kCompute, kStorageRW);
+  b.use(m.flags, kCompute, kStorageRW);
+  b.use(color, VK_IMAGE_LAYOUT_GENERAL, kCompute, kStorageRW);
+  b.flush(cmd);
+  m.resolve.dispatch(cmd, resolve_set, p, m.extent.width, m.extent.height);
+  if (profiler) profiler->mark(cmd, "flare resolve");
+}
+
+}  // namespace glint

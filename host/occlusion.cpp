@@ -1,0 +1,548 @@
+// Visibility driver for lens flares: the Hi-Z pyramid and the light culler (docs/OCCLUSION.md).
+#include "occlusion.h"
+
+#include <glint/occlusion.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <map>
+#include <utility>
+#include <vector>
+
+#include "core/barriers.h"
+#include "core/check.h"
+#include "core/context_state.h"
+#include "core/pipeline.h"
+#include "core/resources.h"
+#include "flare_types.h"
+
+namespace glint {
+
+using detail::check_range;
+using detail::concat;
+
+// The GLSL push-constant blocks must match byte for byte (STYLE rule 2).
+static_assert(sizeof(GlintHiZPush) == 32);
+static_assert(offsetof(GlintHiZPush, counter_index) == 24);
+static_assert(sizeof(GlintCullPush) == 112);
+static_assert(offsetof(GlintCullPush, width) == 64);
+static_assert(offsetof(GlintCullPush, flags) == 88);
+static_assert(offsetof(GlintCullPush, depth_bias) == 96);
+static_assert(sizeof(GlintCullFinalizePush) == 16);
+static_assert(sizeof(LightCullFrame::view_proj) == sizeof(GlintCullPush::view_proj));
+
+namespace {
+
+constexpr VkPipelineStageFlags2 kCompute = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
+constexpr VkAccessFlags2 kSampled = VK_ACCESS_2_SHADER_SAMPLED_READ_BIT;
+constexpr VkAccessFlags2 kStorageRead = VK_ACCESS_2_SHADER_STORAGE_READ_BIT;
+constexpr VkAccessFlags2 kStorageWrite = VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT;
+constexpr uint32_t kCullGroup = 64;      // lights per workgroup
+constexpr uint32_t kMaxGroupsX = 65535;  // guaranteed maxComputeWorkGroupCount[0]
+
+uint32_t floor_log2(uint32_t v) {
+  uint32_t k = 0;
+  while (v >>= 1) ++k;
+  return k;
+}
+
+uint32_t ceil_log2(uint32_t v) {
+  uint32_t k = floor_log2(v);
+  return (1u << k) < v ? k + 1 : k;
+}
+
+// A glint-made buffer described as a glint::Buffer with its last use.
+Buffer view_of(const detail::OwnedBuffer& b, VkBufferUsageFlags usage) {
+  Buffer v;
+  v.buffer = b.buffer();
+  v.size = b.size();
+  v.usage = usage;
+  return v;
+}
+
+// Integer range check whose message prints the values exactly (check_range formats doubles).
+void check_uint(const char* name, uint64_t value, uint64_t lo, uint64_t hi) {
+  if (value < lo || value > hi) {
+    throw Error(ErrorCode::invalid_argument, concat(name, " = ", value, " is out of range: accepted ", lo, " to ", hi));
+  }
+}
+
+void check_buffer(const char* where, const char* role, const Buffer& b, VkDeviceSize need, VkBufferUsageFlags usage) {
+  if (!b.buffer) throw Error(ErrorCode::invalid_argument, concat(where, ": ", role, " buffer is null"));
+  if ((b.usage & usage) != usage) {
+    throw Error(ErrorCode::missing_usage,
+                concat(where, ": ", role, " buffer lacks usage 0x", std::hex, usage & ~b.usage, std::dec,
+                       (usage & VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT ? " (needs STORAGE_BUFFER | INDIRECT_BUFFER)"
+                                                                    : " (needs STORAGE_BUFFER)")));
+  }
+  if (b.size != VK_WHOLE_SIZE && b.size < need) {
+    throw Error(ErrorCode::invalid_argument,
+                concat(where, ": ", role, " buffer holds ", b.size, " bytes; ", need, " needed"));
+  }
+  if (b.offset % 4 != 0) {
+    throw Error(ErrorCode::invalid_argument,
+                concat(where, ": ", role, " buffer offset = ", b.offset, " is not a multiple of 4"));
+  }
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// HiZPyramid
+
+void HiZConfig::validate() const {
+  check_uint("HiZConfig::extent.width", extent.width, 1, 16384);
+  check_uint("HiZConfig::extent.height", extent.height, 1, 16384);
+  if (format != VK_FORMAT_D32_SFLOAT && format != VK_FORMAT_R32_SFLOAT) {
+    throw Error(ErrorCode::unsupported_format,
+                concat("HiZConfig::format = ", detail::format_name(format),
+                       " is not accepted: VK_FORMAT_D32_SFLOAT or VK_FORMAT_R32_SFLOAT"));
+  }
+  if (max_cell_px != 0) check_uint("HiZConfig::max_cell_px", max_cell_px, 1, 16384);
+}
+
+uint32_t hiz_level_count(const HiZConfig& config) {
+  config.validate();
+  uint32_t levels = floor_log2(std::max(config.extent.width, config.extent.height));
+  if (config.max_cell_px != 0) levels = std::min(levels, ceil_log2(config.max_cell_px));
+  return levels;
+}
+
+struct HiZPyramid::Impl {
+  const Context* context = nullptr;
+  HiZConfig config;
+  uint32_t levels = 0;
+  // The pyramid: one R32F image with max(1, levels) mips, a sampling view of all mips and a storage
+  // view per mip.
+  VkImage image = VK_NULL_HANDLE;
+  VkDeviceMemory memory = VK_NULL_HANDLE;
+  std::vector<VkImageView> level_views;
+  Image state;
+  detail::OwnedBuffer counters;  // one word per dispatch
+  Buffer counter_state;
+  bool counters_cleared = false;
+  detail::ComputePipeline pipeline;
+  // One descriptor set per caller depth view (each set holds 14 storage images).
+  std::map<VkImageView, std::pair<detail::DescriptorArena, VkDescriptorSet>> sets;
+
+  struct Pass {
+    GlintHiZPush push;
+    uint32_t groups_x, groups_y;
+  };
+  std::vector<Pass> passes;
+
+  ~Impl() { release(); }
+
+  void release() {
+    sets.clear();
+    VkDevice device = context ? context->device() : VK_NULL_HANDLE;
+    if (!device) return;
+    for (VkImageView v : level_views) vkDestroyImageView(device, v, nullptr);
+    level_views.clear();
+    if (state.view) vkDestroyImageView(device, state.view, nullptr);
+    if (image) vkDestroyImage(device, image, nullptr);
+    if (memory) vkFreeMemory(device, memory, nullptr);
+    state = Image{};
+    image = VK_NULL_HANDLE;
+    memory = VK_NULL_HANDLE;
+  }
+
+  void make_image() {
+    auto& s = context->state();
+    VkDevice device = context->device();
+    const uint32_t mips = std::max(1u, levels);
+    const VkExtent2D e0{std::max(1u, config.extent.width >> 1), std::max(1u, config.extent.height >> 1)};
+    VkImageCreateInfo info{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
+    info.imageType = VK_IMAGE_TYPE_2D;
+    info.format = VK_FORMAT_R32_SFLOAT;
+    info.extent = {e0.width, e0.height, 1};
+    info.mipLevels = mips;
+    info.arrayLayers = 1;
+    info.samples = VK_SAMPLE_COUNT_1_BIT;
+    info.tiling = VK_IMAGE_TILING_OPTIMAL;
+    // Transfer usage lets tools read the pyramid back and tests poison it.
+    info.usage = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT |
+                 VK_IMAGE_USAGE_TRANSFER_DST_BIT;
+    info.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+    detail::vk_check(vkCreateImage(device, &info, nullptr, &image), "vkCreateImage (Hi-Z pyramid)");
+    s.count_object();
+    VkMemoryRequirements req;
+    vkGetImageMemoryRequirements(device, image, &req);
+    VkMemoryAllocateInfo alloc{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+    alloc.allocationSize = req.size;
+    alloc.memoryTypeIndex = s.memory_type(req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+    detail::vk_check(vkAllocateMemory(device, &alloc, nullptr, &memory), "vkAllocateMemory (Hi-Z pyramid)");
+    s.count_object();
+    detail::vk_check(vkBindImageMemory(device, image, memory, 0), "vkBindImageMemory");
+    VkImageViewCreateInfo view{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
+    view.image = image;
+    view.viewType = VK_IMAGE_VIEW_TYPE_2D;
+    view.format = VK_FORMAT_R32_SFLOAT;
+    view.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, mips, 0, 1};
+    detail::vk_check(vkCreateImageView(device, &view, nullptr, &state.view), "vkCreateImageView (Hi-Z)");
+    s.count_object();
+    for (uint32_t m = 0; m < mips; ++m) {
+      view.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, m, 1, 0, 1};
+      VkImageView v = VK_NULL_HANDLE;
+      detail::vk_check(vkCreateImageView(device, &view, nullptr, &v), "vkCreateImageView (Hi-Z level)");
+      s.count_object();
+      level_views.push_back(v);
+    }
+    state.image = image;
+    state.format = VK_FORMAT_R32_SFLOAT;
+    state.extent = e0;
+    state.usage = info.usage;
+  }
+
+  // The dispatches that build `levels` levels: each reduces its base through up to 6 levels by
+  // tiles, and its last workgroup through up to 6 more when the tile result fits 64x64.
+  void plan() {
+    uint32_t base = 0;
+    uint32_t counter = 0;
+    while (base < levels) {
+      const uint32_t bw = std::max(1u, config.extent.width >> base);
+      const uint32_t bh = std::max(1u, config.extent.height >> base);
+      Pass p{};
+      p.push.base_width = static_cast<int32_t>(bw);
+      p.push.base_height = static_cast<int32_t>(bh);
+      p.push.base_level = base;
+      p.push.tile_levels = std::min(GLINT_HIZ_TILE_LEVELS, levels - base);
+      p.groups_x = std::max(1u, bw >> 6);
+      p.groups_y = std::max(1u, bh >> 6);
+      const uint32_t after_tiles = base + p.push.tile_levels;
+      const bool tail_fits = p.groups_x <= GLINT_HIZ_TILE && p.groups_y <= GLINT_HIZ_TILE;
+      p.push.tail_levels = tail_fits ? std::min(GLINT_HIZ_TILE_LEVELS, levels - after_tiles) : 0u;
+      p.push.reversed_z = config.reversed_z ? 1u : 0u;
+      p.push.counter_index = counter++;
+      passes.push_back(p);
+      base = after_tiles + p.push.tail_levels;
+    }
+  }
+
+  VkDescriptorSet set_for(const Image& depth) {
+    auto it = sets.find(depth.view);
+    if (it != sets.end()) return it->second.second;
+    // 14 storage images per set; the arena's pool holds 4 of each type per set.
+    detail::DescriptorArena arena(*context, 4);
+    std::vector<detail::DescriptorArena::AnyBinding> b(GLINT_HIZ_MAX_LEVELS + 2);
+    b[0].image = {depth.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+    for (uint32_t k = 1; k <= GLINT_HIZ_MAX_LEVELS; ++k) {
+      // Levels not built bind the last built one: never accessed, but every binding needs a view.
+      const uint32_t m = std::min(k, std::max(1u, levels)) - 1;
+      b[k].image = {level_views[m], VK_IMAGE_LAYOUT_GENERAL};
+    }
+    b[GLINT_HIZ_MAX_LEVELS + 1].buffer = counter_state;
+    VkDescriptorSet set = arena.make_mixed_set(pipeline, b);
+    sets.emplace(depth.view, std::make_pair(std::move(arena), set));
+    return set;
+  }
+};
+
+HiZPyramid::HiZPyramid(const Context& context, const HiZConfig& config) : impl_(std::make_unique<Impl>()) {
+  config.validate();
+  const uint32_t limit = context.info().max_image_dimension_2d;
+  if (config.extent.width > limit || config.extent.height > limit) {
+    throw Error(ErrorCode::unsupported_size,
+                concat("HiZConfig::extent = ", config.extent.width, "x", config.extent.height,
+                       " is above the device's maxImageDimension2D = ", limit));
+  }
+  Impl& m = *impl_;
+  m.context = &context;
+  m.config = config;
+  m.levels = hiz_level_count(config);
+  m.make_image();
+  m.plan();
+  const VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+  m.counters = detail::OwnedBuffer(context, 16, usage, false);
+  m.counter_state = view_of(m.counters, usage);
+  detail::PipelineDesc d;
+  d.kernel_id = "hiz_build_main";
+  d.bindings.push_back(VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE);
+  for (uint32_t k = 0; k < GLINT_HIZ_MAX_LEVELS; ++k) d.bindings.push_back(VK_DESCRIPTOR_TYPE_STORAGE_IMAGE);
+  d.bindings.push_back(VK_DESCRIPTOR_TYPE_STORAGE_BUFFER);
+  d.push_constant_bytes = sizeof(GlintHiZPush);
+  d.workgroup = {256, 1};  // the kernel's local size is fixed at 256 (64x64 tiles)
+  m.pipeline = detail::ComputePipeline(context, d);
+}
+
+HiZPyramid::HiZPyramid(HiZPyramid&&) noexcept = default;
+HiZPyramid& HiZPyramid::operator=(HiZPyramid&&) noexcept = default;
+HiZPyramid::~HiZPyramid() = default;
+
+const HiZConfig& HiZPyramid::config() const { return impl_->config; }
+uint32_t HiZPyramid::levels() const { return impl_->levels; }
+Image& HiZPyramid::image() { return impl_->state; }
+const Image& HiZPyramid::image() const { return impl_->state; }
+
+uint64_t HiZPyramid::min_bytes_moved() const {
+  const auto& c = impl_->config;
+  uint64_t bytes = uint64_t(c.extent.width) * c.extent.height * 4;
+  for (uint32_t k = 1; k <= impl_->levels; ++k) {
+    bytes += uint64_t(std::max(1u, c.extent.width >> k)) * std::max(1u, c.extent.height >> k) * 4;
+  }
+  return bytes;
+}
+
+void HiZPyramid::record(VkCommandBuffer cmd, Image& depth, Profiler* profiler) {
+  Impl& m = *impl_;
+  const char* where = "HiZPyramid::record";
+  if (!depth.image || !depth.view)
+    throw Error(ErrorCode::invalid_argument, concat(where, ": depth image or view is null"));
+  if (depth.format != m.config.format) {
+    throw Error(ErrorCode::unsupported_format,
+                concat(where, ": depth format ", detail::format_name(depth.format),
+                       " differs from HiZConfig::format = ", detail::format_name(m.config.format)));
+  }
+  if (depth.extent.width != m.config.extent.width || depth.extent.height != m.config.extent.height) {
+    throw Error(ErrorCode::unsupported_size,
+                concat(where, ": depth is ", depth.extent.width, "x", depth.extent.height, "; HiZConfig::extent is ",
+                       m.config.extent.width, "x", m.config.extent.height));
+  }
+  if (!(depth.usage & VK_IMAGE_USAGE_SAMPLED_BIT)) {
+    throw Error(ErrorCode::missing_usage, concat(where, ": depth image lacks VK_IMAGE_USAGE_SAMPLED_BIT usage"));
+  }
+  if (m.levels == 0) {  // 1x1: level 0 is the whole pyramid; only leave the depth readable
+    detail::Barriers b;
+    b.use(depth, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, kCompute, kSampled);
+    b.flush(cmd);
+    if (profiler) profiler->mark(cmd, "hi-z");
+    return;
+  }
+  VkDescriptorSet set = m.set_for(depth);
+  detail::Barriers b;
+  if (!m.counters_cleared) {  // once per object: the kernel resets the counter after each use
+    b.use(m.counter_state, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);  // fill = "transfer"
+    b.flush(cmd);
+    vkCmdFillBuffer(cmd, m.counters.buffer(), 0, VK_WHOLE_SIZE, 0);
+    m.counters_cleared = true;
+  }
+  b.use(depth, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, kCompute, kSampled);
+  b.use(m.state, VK_IMAGE_LAYOUT_GENERAL, kCompute, kStorageRead | kStorageWrite, std::max(1u, m.levels));
+  b.use(m.counter_state, kCompute, kStorageRead | kStorageWrite);
+  b.flush(cmd);
+  for (size_t i = 0; i < m.passes.size(); ++i) {
+    if (i > 0) {  // the next pass reads the level the previous one wrote
+      b.use(m.state, VK_IMAGE_LAYOUT_GENERAL, kCompute, kStorageRead | kStorageWrite, std::max(1u, m.levels));
+      b.flush(cmd);
+    }
+    const auto& p = m.passes[i];
+    m.pipeline.dispatch(cmd, set, p.push, p.groups_x * 256, p.groups_y);
+  }
+  if (profiler) profiler->mark(cmd, "hi-z");
+}
+
+// ---------------------------------------------------------------------------------------------
+// LightCuller
+
+void LightCullConfig::validate() const {
+  check_uint("LightCullConfig::capacity", capacity, 1, 16777216);
+  check_uint("LightCullConfig::grid", grid, 1, 16);
+  check_range("LightCullConfig::margin_ndc", margin_ndc, 1.0, 8.0);
+  check_range("LightCullConfig::depth_bias", depth_bias, 0.0, 0.1);
+  check_uint("LightCullConfig::max_lights", max_lights, 1, uint64_t(kMaxGroupsX) * kCullGroup);
+  const auto p = static_cast<uint32_t>(path);
+  if (p > 2) {
+    throw Error(ErrorCode::invalid_argument,
+                concat("LightCullConfig::path = ", p, " is not a CompactionPath: accepted automatic, ballot, shared"));
+  }
+}
+
+struct LightCuller::Impl {
+  const Context* context = nullptr;
+  LightCullConfig config;
+  CompactionPath path = CompactionPath::shared;
+  uint32_t max_groups_x = kMaxGroupsX;
+  detail::ComputePipeline cull, finalize;
+  detail::OwnedBuffer counters;
+  Buffer counter_state;
+  bool counters_cleared = false;
+  // Descriptor sets per distinct set of caller resources, made on first use and kept.
+  std::map<std::vector<uint64_t>, VkDescriptorSet> sets;
+  std::vector<detail::DescriptorArena> arenas;
+  uint32_t sets_left = 0;
+  detail::OwnedBuffer dummy_results;  // bound when the caller wants no per-light results
+  Buffer dummy_state;
+
+  VkDescriptorSet allocate(const detail::ComputePipeline& p,
+                           const std::vector<detail::DescriptorArena::AnyBinding>& b) {
+    if (sets_left == 0) {
+      arenas.emplace_back(*context, 16);
+      sets_left = 16;
+    }
+    --sets_left;
+    return arenas.back().make_mixed_set(p, b);
+  }
+
+  static void key_add(std::vector<uint64_t>& key, const Buffer& b) {
+    key.push_back(reinterpret_cast<uint64_t>(b.buffer));
+    key.push_back(b.offset);
+    key.push_back(b.size);
+  }
+};
+
+LightCuller::LightCuller(const Context& context, const LightCullConfig& config) : impl_(std::make_unique<Impl>()) {
+  config.validate();
+  Impl& m = *impl_;
+  m.context = &context;
+  m.config = config;
+  // Subgroup ballot in compute, and the group limit, from the device (STYLE rules 3 and 15).
+  VkPhysicalDeviceSubgroupProperties sub{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES};
+  VkPhysicalDeviceProperties2 props{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
+  props.pNext = &sub;
+  vkGetPhysicalDeviceProperties2(context.physical_device(), &props);
+  m.max_groups_x = props.properties.limits.maxComputeWorkGroupCount[0];
+  const bool ballot = (sub.supportedStages & VK_SHADER_STAGE_COMPUTE_BIT) &&
+                      (sub.supportedOperations & VK_SUBGROUP_FEATURE_BALLOT_BIT) &&
+                      (sub.supportedOperations & VK_SUBGROUP_FEATURE_BASIC_BIT);
+  if (config.path == CompactionPath::ballot && !ballot) {
+    throw Error(ErrorCode::no_device, concat("LightCullConfig::path = ballot, but device '", context.info().name,
+                                             "' lacks subgroup ballot in compute shaders; use automatic or shared"));
+  }
+  m.path = config.path == CompactionPath::automatic ? (ballot ? CompactionPath::ballot : CompactionPath::shared)
+                                                    : config.path;
+  const auto S = VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE;
+  const auto B = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+  detail::PipelineDesc d;
+  d.kernel_id = m.path == CompactionPath::ballot ? "light_cull_ballot" : "light_cull_shared";
+  d.bindings = {S, S, B, B, B, B};
+  d.push_constant_bytes = sizeof(GlintCullPush);
+  d.workgroup = {kCullGroup, 1};
+  m.cull = detail::ComputePipeline(context, d);
+  detail::PipelineDesc f;
+  f.kernel_id = "light_cull_finalize_main";
+  f.bindings = {B, B, B};
+  f.push_constant_bytes = sizeof(GlintCullFinalizePush);
+  f.workgroup = {1, 1};
+  m.finalize = detail::ComputePipeline(context, f);
+  const VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+  m.counters = detail::OwnedBuffer(context, GLINT_CULL_COUNTER_WORDS * 4, usage, false);
+  m.counter_state = view_of(m.counters, usage);
+  m.dummy_results =
+      detail::OwnedBuffer(context, sizeof(GlintFlareLightResult), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, false);
+  m.dummy_state = view_of(m.dummy_results, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+}
+
+LightCuller::LightCuller(LightCuller&&) noexcept = default;
+LightCuller& LightCuller::operator=(LightCuller&&) noexcept = default;
+LightCuller::~LightCuller() = default;
+
+const LightCullConfig& LightCuller::config() const { return impl_->config; }
+CompactionPath LightCuller::path() const { return impl_->path; }
+
+void LightCuller::record(VkCommandBuffer cmd, HiZPyramid& hiz, Image& depth, Buffer& lights, uint32_t count,
+                         const LightCullFrame& frame, LightCullOutputs& out, Profiler* profiler) {
+  Impl& m = *impl_;
+  const char* where = "LightCuller::record";
+  const HiZConfig& hc = hiz.config();
+  // Everything is checked before anything is recorded.
+  check_uint("LightCuller::record: count", count, 0, m.config.max_lights);
+  check_uint("LightCullFrame::vertex_count", frame.vertex_count, 0, 1 << 20);
+  check_uint("LightCullFrame::groups_per_instance", frame.groups_per_instance, 0, 65535);
+  if (uint64_t(m.config.capacity) * frame.groups_per_instance > m.max_groups_x) {
+    throw Error(ErrorCode::invalid_argument,
+                concat("LightCullFrame::groups_per_instance = ", frame.groups_per_instance,
+                       " times LightCullConfig::capacity = ", m.config.capacity,
+                       " exceeds the device's maxComputeWorkGroupCount[0] = ", m.max_groups_x));
+  }
+  for (int i = 0; i < 16; ++i) {
+    if (!std::isfinite(frame.view_proj[i])) {
+      throw Error(ErrorCode::invalid_argument,
+                  concat("LightCullFrame::view_proj[", i, "] = ", frame.view_proj[i], " is not finite"));
+    }
+  }
+  if (!depth.image || !depth.view)
+    throw Error(ErrorCode::invalid_argument, concat(where, ": depth image or view is null"));
+  if (depth.format != hc.format || depth.extent.width != hc.extent.width || depth.extent.height != hc.extent.height) {
+    throw Error(ErrorCode::invalid_argument,
+                concat(where, ": depth (", detail::format_name(depth.format), " ", depth.extent.width, "x",
+                       depth.extent.height, ") does not match the Hi-Z pyramid (", detail::format_name(hc.format), " ",
+                       hc.extent.width, "x", hc.extent.height, ")"));
+  }
+  if (!(depth.usage & VK_IMAGE_USAGE_SAMPLED_BIT)) {
+    throw Error(ErrorCode::missing_usage, concat(where, ": depth image lacks VK_IMAGE_USAGE_SAMPLED_BIT usage"));
+  }
+  const VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+  check_buffer(where, "lights", lights, VkDeviceSize(count) * sizeof(GlintFlareLight), storage);
+  check_buffer(where, "instances", out.instances, VkDeviceSize(m.config.capacity) * sizeof(GlintFlareInstance),
+               storage);
+  check_buffer(where, "indirect", out.indirect, sizeof(GlintFlareIndirect),
+               storage | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT);
+  check_buffer(where, "stats", out.stats, sizeof(GlintFlareStats), storage);
+  const bool want_results = out.results.buffer != VK_NULL_HANDLE;
+  if (want_results) {
+    check_buffer(where, "results", out.results, VkDeviceSize(count) * sizeof(GlintFlareLightResult), storage);
+  }
+  Buffer& results = want_results ? out.results : m.dummy_state;
+
+  // Descriptor sets for these resources (made once, then reused).
+  std::vector<uint64_t> key{reinterpret_cast<uint64_t>(depth.view), reinterpret_cast<uint64_t>(hiz.image().view)};
+  Impl::key_add(key, lights);
+  Impl::key_add(key, out.instances);
+  Impl::key_add(key, results);
+  Impl::key_add(key, out.indirect);
+  Impl::key_add(key, out.stats);
+  VkDescriptorSet cull_set, finalize_set;
+  {
+    auto key_f = key;
+    key_f.push_back(1);
+    auto it = m.sets.find(key);
+    if (it == m.sets.end()) {
+      std::vector<detail::DescriptorArena::AnyBinding> b(6);
+      b[0].image = {depth.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+      b[1].image = {hiz.image().view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+      b[2].buffer = lights;
+      b[3].buffer = out.instances;
+      b[4].buffer = results;
+      b[5].buffer = m.counter_state;
+      it = m.sets.emplace(key, m.allocate(m.cull, b)).first;
+      std::vector<detail::DescriptorArena::AnyBinding> f(3);
+      f[0].buffer = m.counter_state;
+      f[1].buffer = out.indirect;
+      f[2].buffer = out.stats;
+      m.sets.emplace(key_f, m.allocate(m.finalize, f));
+    }
+    cull_set = it->second;
+    finalize_set = m.sets.at(key_f);
+  }
+
+  detail::Barriers b;
+  if (!m.counters_cleared) {  // once per object: the finalize kernel resets them every frame
+    b.use(m.counter_state, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);  // fill = "transfer"
+    b.flush(cmd);
+    vkCmdFillBuffer(cmd, m.counters.buffer(), 0, VK_WHOLE_SIZE, 0);
+    m.counters_cleared = true;
+  }
+  b.use(depth, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, kCompute, kSampled);
+  b.use(hiz.image(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, kCompute, kSampled, std::max(1u, hiz.levels()));
+  b.use(lights, kCompute, kStorageRead);
+  b.use(out.instances, kCompute, kStorageWrite);
+  b.use(results, kCompute, kStorageWrite);
+  b.use(m.counter_state, kCompute, kStorageRead | kStorageWrite);
+  b.flush(cmd);
+  if (count > 0) {
+    GlintCullPush push{};
+    std::copy(frame.view_proj, frame.view_proj + 16, push.view_proj);
+    push.width = static_cast<int32_t>(hc.extent.width);
+    push.height = static_cast<int32_t>(hc.extent.height);
+    push.count = count;
+    push.capacity = m.config.capacity;
+    push.grid = m.config.grid;
+    push.levels = hiz.levels();
+    push.flags = (hc.reversed_z ? GLINT_CULL_REVERSED_Z : 0u) | (want_results ? GLINT_CULL_WRITE_RESULTS : 0u);
+    push.margin_ndc = m.config.margin_ndc;
+    push.depth_bias = m.config.depth_bias;
+    m.cull.dispatch(cmd, cull_set, push, count, 1);
+  }
+  if (profiler) profiler->mark(cmd, "light cull");
+  // The cull's atomics (a write) finish before the finalize reads and resets the counters.
+  b.use(m.counter_state, kCompute, kStorageRead | kStorageWrite);
+  b.use(out.indirect, kCompute, kStorageWrite);
+  b.use(out.stats, kCompute, kStorageWrite);
+  b.flush(cmd);
+  GlintCullFinalizePush fp{count, m.config.capacity, frame.vertex_count, frame.groups_per_instance};
+  m.finalize.dispatch(cmd, finalize_set, fp, 1, 1);
+  if (profiler) profiler->mark(cmd, "cull finalize");
+}
+
+}  // namespace glint

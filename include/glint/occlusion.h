@@ -1,0 +1,159 @@
+// Visibility of lens-flare lights, kept on the GPU (issue 5): a Hi-Z depth pyramid built in one
+// dispatch (HiZPyramid), and one dispatch that projects the lights, culls them against the frustum,
+// tests their occlusion on an N x N grid read from the pyramid, and appends the visible ones to an
+// instance buffer for an indirect draw or dispatch (LightCuller). docs/OCCLUSION.md derives the
+// fold rule, the level choice and the error bound; host/reference/occlusion_reference.h holds the
+// float64 references.
+//
+// Conventions (Vulkan): clip = view_proj * (position, 1); ndc = clip.xyz / clip.w;
+// pixel = (ndc.xy * 0.5 + 0.5) * depth size, so ndc.y = -1 is the first row; depth = ndc.z in
+// [0, 1], 0 near for standard Z, 1 near for reversed Z. A light is occluded where the stored depth
+// is nearer than the light's.
+//
+// A frame:
+//   hiz.record(cmd, depth);                          // after the depth pass
+//   culler.record(cmd, hiz, depth, lights, count, frame, outputs);
+//   ... draw: vkCmdDrawIndirect(outputs.indirect, offset 0) or vkCmdDispatchIndirect(offset 16),
+//       reading outputs.instances; the caller's barrier starts from the state fields record() left.
+#pragma once
+
+#include <glint/glint.h>
+
+#include <cstdint>
+#include <memory>
+
+namespace glint {
+
+/// Creation-time settings of a Hi-Z pyramid. Checked by validate().
+struct HiZConfig {
+  VkExtent2D extent{0, 0};                 //!< depth image size in pixels (1 to 16384 on a side, and at most the
+                                           //!< device's maxImageDimension2D)
+  VkFormat format = VK_FORMAT_D32_SFLOAT;  //!< VK_FORMAT_D32_SFLOAT or VK_FORMAT_R32_SFLOAT
+  bool reversed_z = false;                 //!< true: depth 1 is near, the pyramid keeps the minimum (farthest);
+                                           //!< false: 0 is near, it keeps the maximum
+  /// The largest grid cell (light size_px / grid) that needs one texel per cell, in pixels
+  /// (0 = no limit, else 1 to 16384). Levels coarser than ceil(log2(max_cell_px)) are not built;
+  /// a larger cell reads several texels of the last level instead (still conservative).
+  uint32_t max_cell_px = 0;
+
+  /// Throws Error(invalid_argument / unsupported_format / unsupported_size) naming the field.
+  void validate() const;
+};
+
+/// Number of Hi-Z levels above level 0 (the depth image) that a config builds: floor(log2 of the
+/// larger side), capped by max_cell_px. Level k is max(1, extent >> k) on a side.
+uint32_t hiz_level_count(const HiZConfig& config);
+
+/// The Hi-Z depth pyramid of one depth image size. Owns an R32_SFLOAT image whose mip m holds Hi-Z
+/// level m + 1 (level 0 is the caller's depth image, never copied). Each texel holds the farthest
+/// depth of every source pixel it covers (fold rule in docs/OCCLUSION.md).
+class HiZPyramid {
+ public:
+  /// Throws Error if config is invalid or larger than the device allows.
+  HiZPyramid(const Context& context, const HiZConfig& config);
+  HiZPyramid(const HiZPyramid&) = delete;
+  HiZPyramid& operator=(const HiZPyramid&) = delete;
+  HiZPyramid(HiZPyramid&&) noexcept;
+  HiZPyramid& operator=(HiZPyramid&&) noexcept;
+  ~HiZPyramid();
+
+  /// Records the build of every level from `depth` (one dispatch up to 4096 on a side, two above).
+  /// `depth`: config.format and config.extent, SAMPLED usage, `view` a depth-aspect (D32) or
+  /// colour (R32) view of mip 0. Afterwards `depth` is in SHADER_READ_ONLY_OPTIMAL, last read by
+  /// the compute shader stage, and the pyramid was last written by it. The first record() also
+  /// clears the pyramid's internal counter (once per object); later frames need no clearing.
+  /// `profiler` (may be null) gets one mark. Throws Error before recording on a wrong image.
+  void record(VkCommandBuffer cmd, Image& depth, Profiler* profiler = nullptr);
+
+  const HiZConfig& config() const;
+  /// Levels built above level 0 (0 for a 1x1 depth image).
+  uint32_t levels() const;
+  /// The pyramid image: a view of all its mips (mip m = level m + 1), with its last use. Readers
+  /// outside glint (samplers, other services) transition it through this state with
+  /// `level_count = levels()`; LightCuller does this itself.
+  Image& image();
+  const Image& image() const;
+  /// Bytes one record() reads and writes at least (depth once, every level once).
+  uint64_t min_bytes_moved() const;
+
+  struct Impl;
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
+/// How LightCuller compacts visible lights.
+enum class CompactionPath : uint32_t {
+  automatic = 0,  //!< subgroup ballot where the device supports it in compute, else shared
+  ballot = 1,     //!< one atomic per subgroup (ballot + exclusive bit count); Error if unsupported
+  shared = 2,     //!< one atomic per workgroup through a shared-memory counter (any device)
+};
+
+/// Creation-time settings of a LightCuller. Checked by validate().
+struct LightCullConfig {
+  uint32_t capacity = 1024;        //!< GlintFlareInstance slots in the instance buffer (1 to 16777216)
+  uint32_t grid = 4;               //!< N: N x N occlusion cells per light (1 to 16)
+  float margin_ndc = 1.2f;         //!< frustum margin: lights with |ndc.x| or |ndc.y| above it are
+                                   //!< culled (1 to 8; the seed's 1.2 keeps off-screen ghosts)
+  float depth_bias = 0.0f;         //!< NDC depth tolerance: a light up to this much behind a surface
+                                   //!< still counts as visible there (0 to 0.1; the seed uses 0.01)
+  uint32_t max_lights = 1u << 20;  //!< most lights per record() (1 to 4194240 = 65535 x 64)
+  CompactionPath path = CompactionPath::automatic;
+
+  void validate() const;
+};
+
+/// Per-frame inputs of LightCuller::record().
+struct LightCullFrame {
+  float view_proj[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};  //!< column-major (GLM)
+  uint32_t vertex_count = 4;         //!< written to GlintFlareIndirect::vertex_count (0 to 2^20)
+  uint32_t groups_per_instance = 1;  //!< GlintFlareIndirect::group_count_x = instances x this
+                                     //!< (0 to 65535; capacity x this must fit the device's
+                                     //!< maxComputeWorkGroupCount[0])
+};
+
+/// The buffers one cull writes. The caller owns them; their state fields are updated.
+struct LightCullOutputs {
+  Buffer instances;  //!< GlintFlareInstance[capacity]; STORAGE usage. Order is unspecified.
+  Buffer indirect;   //!< one GlintFlareIndirect (32 bytes): VkDrawIndirectCommand at 0,
+                     //!< VkDispatchIndirectCommand at 16; STORAGE | INDIRECT usage
+  Buffer stats;      //!< one GlintFlareStats (32 bytes); STORAGE usage. Read it when you want:
+                     //!< glint never waits on it.
+  Buffer results;    //!< optional: GlintFlareLightResult[count] in input order (STORAGE usage);
+                     //!< buffer == VK_NULL_HANDLE writes none (saves 8 bytes per light)
+};
+
+/// Cull + occlusion grid test + compaction of a light list (GlintFlareLight, flare_types.h).
+class LightCuller {
+ public:
+  /// Throws Error if config is invalid or asks for a path the device lacks.
+  LightCuller(const Context& context, const LightCullConfig& config = {});
+  LightCuller(const LightCuller&) = delete;
+  LightCuller& operator=(const LightCuller&) = delete;
+  LightCuller(LightCuller&&) noexcept;
+  LightCuller& operator=(LightCuller&&) noexcept;
+  ~LightCuller();
+
+  /// Records the cull of `count` lights from `lights` (GlintFlareLight[count], STORAGE usage)
+  /// against `hiz` (built from `depth` earlier on this command buffer or before) into `outputs`:
+  /// two dispatches (the cull, then a one-invocation kernel that writes the indirect arguments and
+  /// statistics and resets the counters). count == 0 is allowed (zero instances). Afterwards the
+  /// outputs were last written by the compute shader stage: a draw needs a barrier to
+  /// DRAW_INDIRECT / INDIRECT_COMMAND_READ for `indirect` and to VERTEX_SHADER (or COMPUTE) /
+  /// SHADER_STORAGE_READ for `instances`. The first record() clears the internal counters once.
+  /// Throws Error before recording if a buffer is null, too small or lacks a usage, if `depth`
+  /// does not match `hiz`, or if count or `frame` is out of range.
+  void record(VkCommandBuffer cmd, HiZPyramid& hiz, Image& depth, Buffer& lights, uint32_t count,
+              const LightCullFrame& frame, LightCullOutputs& outputs, Profiler* profiler = nullptr);
+
+  const LightCullConfig& config() const;
+  /// The path chosen at creation (never automatic).
+  CompactionPath path() const;
+
+  struct Impl;
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace glint

@@ -1,0 +1,105 @@
+// The drawing half of the lens flares (issue 5, seed 004), declared once for GLSL and C++ (STYLE
+// rule 2): the element atlas layout, the sprites every light expands to, and the push constants
+// shared by flare.vert, flare.frag, flare_splat.comp and flare_resolve.comp. docs/FLARE.md explains
+// every number here. The visibility half meets the drawing half only in flare_types.h.
+#ifndef GLINT_FLARE_PARAMS_H
+#define GLINT_FLARE_PARAMS_H
+#include "glint_types.h"
+
+// ---- Element atlas ------------------------------------------------------------------------------
+// One RGBA16F image, premultiplied alpha, every tile surrounded by GLINT_FLARE_ATLAS_PADDING texels
+// of zeros (its own edge value: every element fades to 0 at the tile border). Tile offsets and
+// sizes are multiples of 2^(levels - 1) = 16, so at every mip level a texel belongs to exactly one
+// tile or to padding: the 2x2 box mips never mix two tiles. The level count is the padding cap of
+// kernels/common/lod_impl.h plus one (floor(log2(32)) - 1 = 4, so levels 0..4): no level is built
+// that the atlas-aware LOD would refuse to use.
+#define GLINT_FLARE_ATLAS_WIDTH 832u
+#define GLINT_FLARE_ATLAS_HEIGHT 320u
+#define GLINT_FLARE_ATLAS_PADDING 32u
+#define GLINT_FLARE_ATLAS_LEVELS 5u
+
+// Tiles (level-0 texels): x, y, width, height, indexed by GLINT_FLARE_ELEMENT_* (flare_types.h).
+#define GLINT_FLARE_TILE_GLOW_X 672u
+#define GLINT_FLARE_TILE_GLOW_Y 32u
+#define GLINT_FLARE_TILE_GLOW_W 128u
+#define GLINT_FLARE_TILE_GLOW_H 128u
+#define GLINT_FLARE_TILE_STREAK_X 352u
+#define GLINT_FLARE_TILE_STREAK_Y 32u
+#define GLINT_FLARE_TILE_STREAK_W 256u
+#define GLINT_FLARE_TILE_STREAK_H 64u
+#define GLINT_FLARE_TILE_HALO_X 480u
+#define GLINT_FLARE_TILE_HALO_Y 160u
+#define GLINT_FLARE_TILE_HALO_W 128u
+#define GLINT_FLARE_TILE_HALO_H 128u
+#define GLINT_FLARE_TILE_STARBURST_X 32u
+#define GLINT_FLARE_TILE_STARBURST_Y 32u
+#define GLINT_FLARE_TILE_STARBURST_W 256u
+#define GLINT_FLARE_TILE_STARBURST_H 256u
+#define GLINT_FLARE_TILE_GHOST_X 352u
+#define GLINT_FLARE_TILE_GHOST_Y 160u
+#define GLINT_FLARE_TILE_GHOST_W 64u
+#define GLINT_FLARE_TILE_GHOST_H 64u
+
+// ---- Sprites of one light -----------------------------------------------------------------------
+// Every instance expands to GLINT_FLARE_SPRITES screen-aligned rectangles (slots), each drawn as
+// two triangles. Sizes are in units of the light's size_px; every width is further multiplied by
+// the anamorphic ratio (an anamorphic lens stretches every out-of-focus artefact horizontally).
+#define GLINT_FLARE_SPRITES 9u
+#define GLINT_FLARE_VERTICES_PER_SPRITE 6u
+#define GLINT_FLARE_SLOT_MAIN 0u    // the light's own element (GlintFlareInstance::element)
+#define GLINT_FLARE_SLOT_STREAK 1u  // horizontal streak, streak_length wide
+#define GLINT_FLARE_SLOT_HALO 2u
+#define GLINT_FLARE_SLOT_STARBURST 3u
+#define GLINT_FLARE_SLOT_GHOST0 4u  // ghosts 0..4 at the config's ghost positions
+
+#define GLINT_FLARE_MAIN_SCALE 1.0
+#define GLINT_FLARE_STREAK_HEIGHT 0.5  // the streak's height; its width is streak_length
+#define GLINT_FLARE_HALO_SCALE 1.6
+#define GLINT_FLARE_STARBURST_SCALE 2.0
+#define GLINT_FLARE_GHOST_SCALE_0 0.5
+#define GLINT_FLARE_GHOST_SCALE_1 0.35
+#define GLINT_FLARE_GHOST_SCALE_2 0.6
+#define GLINT_FLARE_GHOST_SCALE_3 0.3
+#define GLINT_FLARE_GHOST_SCALE_4 0.8
+// Relative brightness of ghosts 0..4 (times ghost_weight).
+#define GLINT_FLARE_GHOST_GAIN_0 0.6
+#define GLINT_FLARE_GHOST_GAIN_1 0.4
+#define GLINT_FLARE_GHOST_GAIN_2 0.5
+#define GLINT_FLARE_GHOST_GAIN_3 0.3
+#define GLINT_FLARE_GHOST_GAIN_4 0.45
+
+// Push constants of every flare kernel (88 bytes; the per-frame settings of FlareConfig, already
+// combined on the host: tint is (1, 1, 1) when the tint is off).
+struct GlintFlarePush {
+  GLINT_FLOAT viewport_w;  // the colour image's size in pixels
+  GLINT_FLOAT viewport_h;
+  GLINT_FLOAT anamorphic_ratio;
+  GLINT_FLOAT intensity;  // global intensity
+  GLINT_FLOAT weight_main;
+  GLINT_FLOAT weight_streak;
+  GLINT_FLOAT weight_halo;
+  GLINT_FLOAT weight_starburst;
+  GLINT_FLOAT weight_ghost;
+  GLINT_FLOAT streak_length;
+  GLINT_FLOAT tint_r;  // multiplies the streak and the ghosts (lens-coating colour)
+  GLINT_FLOAT tint_g;
+  GLINT_FLOAT tint_b;
+  GLINT_FLOAT ghost_pos0;  // along light -> screen centre: 0 at the light, 1 at the centre
+  GLINT_FLOAT ghost_pos1;
+  GLINT_FLOAT ghost_pos2;
+  GLINT_FLOAT ghost_pos3;
+  GLINT_FLOAT ghost_pos4;
+  GLINT_UINT groups_per_instance;  // compute splat: workgroups per instance (slots * chunks)
+  GLINT_UINT tile_w;               // compute: the resolve's tile (its workgroup) in pixels
+  GLINT_UINT tile_h;
+  GLINT_UINT tiles_x;  // tiles per row
+};
+
+// Push constants of flare_atlas.comp (12 bytes).
+struct GlintFlareAtlasPush {
+  GLINT_UINT level;  // 0: evaluate the elements; k > 0: 2x2 box of level k - 1
+  GLINT_UINT width;  // size of the level written
+  GLINT_UINT height;
+};
+
+#endif

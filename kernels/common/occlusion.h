@@ -1,0 +1,66 @@
+// Push constants and counter layout of the visibility stage of the lens flares (issue 5): the Hi-Z
+// build (hiz_build.comp), the cull + occlusion grid test + compaction (light_cull.comp) and the
+// kernel that turns its counters into indirect arguments and statistics (light_cull_finalize.comp).
+// Declared once for GLSL and C++ (STYLE rule 2); host/occlusion.cpp static_asserts the layouts.
+// docs/OCCLUSION.md explains the algorithms.
+#ifndef GLINT_OCCLUSION_H
+#define GLINT_OCCLUSION_H
+#include "glint_types.h"
+
+// Hi-Z levels: level 0 is the depth image itself, level k (k >= 1) is max(1, size >> k) on a side
+// and is stored in mip k - 1 of the pyramid image. 16384 needs 14 levels.
+#define GLINT_HIZ_MAX_LEVELS 14u
+// A workgroup reduces a 64x64 tile through 6 levels; the last workgroup reduces up to 6 more.
+#define GLINT_HIZ_TILE 64
+#define GLINT_HIZ_TILE_LEVELS 6u
+
+struct GlintHiZPush {
+  GLINT_INT base_width;  // size of the base level this dispatch reads
+  GLINT_INT base_height;
+  GLINT_UINT base_level;     // 0: the depth image; k >= 1: Hi-Z level k (pyramid mip k - 1)
+  GLINT_UINT tile_levels;    // levels every workgroup builds from its tile (1 to 6)
+  GLINT_UINT tail_levels;    // levels the last workgroup then builds (0 to 6)
+  GLINT_UINT reversed_z;     // 0: farthest = max (standard Z); 1: farthest = min (reversed Z)
+  GLINT_UINT counter_index;  // which word of the counter buffer counts finished workgroups
+  GLINT_UINT reserved;
+};
+
+// Words of the cull's counter buffer (all zero between frames: the finalize kernel resets them).
+#define GLINT_CULL_COUNTER_VISIBLE 0u
+#define GLINT_CULL_COUNTER_FRUSTUM 1u
+#define GLINT_CULL_COUNTER_OCCLUDED 2u
+#define GLINT_CULL_COUNTER_DISABLED 3u
+#define GLINT_CULL_COUNTER_WORDS 4u
+
+// GlintCullPush::flags
+#define GLINT_CULL_REVERSED_Z 1u     // depth 1 is near; farthest = min
+#define GLINT_CULL_WRITE_RESULTS 2u  // write one GlintFlareLightResult per light
+
+// Light sizes are clamped to this (pixels) so that footprint arithmetic stays exact in fp32.
+#define GLINT_CULL_MAX_SIZE_PX 65536.0
+// A grid cell whose window at the chosen level exceeds this many texels (only when the pyramid is
+// shallower than the cell needs) is counted visible without reading: conservative and bounded.
+#define GLINT_CULL_MAX_WINDOW_TEXELS 16
+
+struct GlintCullPush {
+  GLINT_FLOAT view_proj[16];  // column-major: clip = view_proj * (position, 1)
+  GLINT_INT width;            // viewport = depth image size in pixels
+  GLINT_INT height;
+  GLINT_UINT count;        // lights in the list
+  GLINT_UINT capacity;     // GlintFlareInstance slots in the instance buffer
+  GLINT_UINT grid;         // N: N x N cells per footprint (1 to 16)
+  GLINT_UINT levels;       // Hi-Z levels built above level 0 (0 to 14)
+  GLINT_UINT flags;        // GLINT_CULL_*
+  GLINT_FLOAT margin_ndc;  // frustum margin: |ndc.xy| <= margin_ndc passes
+  GLINT_FLOAT depth_bias;  // visible where stored depth is not nearer than light depth - bias
+  GLINT_UINT reserved[3];
+};
+
+struct GlintCullFinalizePush {
+  GLINT_UINT count;
+  GLINT_UINT capacity;
+  GLINT_UINT vertex_count;
+  GLINT_UINT groups_per_instance;
+};
+
+#endif

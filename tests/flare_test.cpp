@@ -1,0 +1,748 @@
+// Lens flares, drawing half (issue 5), on the GPU (lavapipe in CI) against the float64 reference
+// (host/reference/flare_reference.h), and the two paths against each other. The instance and
+// indirect buffers are filled from the CPU through a copy, standing in for the visibility stage,
+// so the barriers from a writer to DRAW_INDIRECT / INDIRECT_COMMAND_READ are exercised. Validation
+// with synchronization validation is on for every test (support/gpu_test.h).
+#include <glint/flare.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <random>
+#include <string>
+
+#include "core/barriers.h"
+#include "core/half.h"
+#include "flare_params.h"
+#include "flare_types.h"
+#include "lod.h"
+#include "reference/flare_reference.h"
+#include "reference/lod_reference.h"
+#include "support/gpu_test.h"
+
+namespace glint::test {
+namespace {
+
+constexpr VkFormat kF16 = VK_FORMAT_R16G16B16A16_SFLOAT;
+constexpr VkFormat kF32 = VK_FORMAT_R32G32B32A32_SFLOAT;
+constexpr VkImageUsageFlags kUsage = detail::kToolImageUsage | VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT;
+constexpr uint32_t kW = 160, kH = 96;
+// A float stored to fp16 may be rounded to nearest or toward zero (Vulkan spec, "Floating-Point
+// Format Conversions"; lavapipe truncates): less than one ulp, 2^-10 of the value. fp32: 2^-23.
+const double kHalfStore = std::ldexp(1.0, -10);
+const double kFloatStore = std::ldexp(1.0, -23);
+
+enum class Path { raster, compute };
+const char* path_name(Path p) { return p == Path::raster ? "raster" : "compute"; }
+
+class FlareTest : public GpuTest {};
+
+// The instance and indirect buffers as the visibility stage leaves them: device-local, written by
+// a transfer (here) or a compute shader (the cull), with STORAGE and INDIRECT usage.
+struct FlareInputs {
+  detail::OwnedBuffer instances, indirect, staging;
+  Buffer instances_view, indirect_view;
+  std::vector<GlintFlareInstance> data;
+  GlintFlareIndirect args{};
+
+  FlareInputs(const std::vector<GlintFlareInstance>& list, uint32_t instance_count, uint32_t groups_per_instance,
+              size_t capacity = 0)
+      : data(list) {
+    capacity = std::max({capacity, list.size(), size_t(1)});
+    const VkBufferUsageFlags usage =
+        VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+    instances = detail::OwnedBuffer(context(), capacity * sizeof(GlintFlareInstance), usage, false);
+    indirect = detail::OwnedBuffer(context(), sizeof(GlintFlareIndirect), usage, false);
+    staging = detail::OwnedBuffer(context(), instances.size() + sizeof(GlintFlareIndirect),
+                                  VK_BUFFER_USAGE_TRANSFER_SRC_BIT, true);
+    args.vertex_count = LensFlare::vertices_per_instance();
+    args.instance_count = instance_count;
+    args.group_count_x = instance_count * groups_per_instance;
+    args.group_count_y = 1;
+    args.group_count_z = 1;
+    auto* bytes = static_cast<uint8_t*>(staging.mapped());
+    std::memset(bytes, 0, staging.size());
+    if (!list.empty()) std::memcpy(bytes, list.data(), list.size() * sizeof(GlintFlareInstance));
+    std::memcpy(bytes + instances.size(), &args, sizeof(args));
+    staging.flush();
+    instances_view = {instances.buffer(), 0, instances.size(), usage, VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE};
+    indirect_view = {indirect.buffer(), 0, indirect.size(), usage, VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE};
+  }
+
+  // Records the copies (the stand-in for the cull) and says so in the buffers' state.
+  void record_upload(VkCommandBuffer cmd) {
+    detail::Barriers b;
+    b.use(instances_view, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);
+    b.use(indirect_view, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);
+    b.flush(cmd);
+    VkBufferCopy a{0, 0, instances.size()};
+    vkCmdCopyBuffer(cmd, staging.buffer(), instances.buffer(), 1, &a);
+    VkBufferCopy b2{instances.size(), 0, sizeof(GlintFlareIndirect)};
+    vkCmdCopyBuffer(cmd, staging.buffer(), indirect.buffer(), 1, &b2);
+  }
+};
+
+detail::OwnedImage make_color(const CpuImage& pixels, VkFormat format) {
+  detail::OwnedImage img(context(), {pixels.width, pixels.height}, format, kUsage);
+  detail::upload(context(), img.state, pixels);
+  return img;
+}
+
+CpuImage as_stored(const CpuImage& img, VkFormat format) {
+  if (format != kF16) return img;
+  CpuImage out = img;
+  for (float& v : out.rgba) v = detail::round_to_half(v);
+  return out;
+}
+
+void record(LensFlare& flare, Path path, VkCommandBuffer cmd, Image& color, FlareInputs& in,
+            const FlareConfig& config) {
+  if (path == Path::raster) {
+    flare.record_raster(cmd, color, in.instances_view, in.indirect_view, config);
+  } else {
+    flare.record_compute(cmd, color, in.instances_view, in.indirect_view, config);
+  }
+}
+
+// Uploads `background`, draws the flares of `in` with `path`, reads the image back.
+CpuImage draw(LensFlare& flare, Path path, const CpuImage& background, VkFormat format, FlareInputs& in,
+              const FlareConfig& config) {
+  auto color = make_color(background, format);
+  context().run_once([&](VkCommandBuffer cmd) {
+    in.record_upload(cmd);
+    record(flare, path, cmd, color.state, in, config);
+  });
+  return detail::download(context(), color.state);
+}
+
+// Every level of the atlas as the GPU made it (exact fp16 values as double).
+reference::FlareAtlas read_atlas(const LensFlare& flare) {
+  const FlareAtlasInfo a = flare.atlas();
+  reference::FlareAtlas out;
+  size_t total = 0;
+  for (uint32_t k = 0; k < a.levels; ++k) total += size_t(std::max(1u, a.width >> k)) * std::max(1u, a.height >> k) * 8;
+  detail::OwnedBuffer staging(context(), total, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true);
+  context().run_once([&](VkCommandBuffer cmd) {
+    Image img{a.image,
+              a.view,
+              a.format,
+              {a.width, a.height},
+              0,
+              VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+              VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+              VK_ACCESS_2_SHADER_SAMPLED_READ_BIT};
+    detail::Barriers b;
+    b.use(img, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT,
+          a.levels);
+    b.flush(cmd);
+    std::vector<VkBufferImageCopy> regions;
+    VkDeviceSize offset = 0;
+    for (uint32_t k = 0; k < a.levels; ++k) {
+      VkBufferImageCopy r{};
+      r.bufferOffset = offset;
+      r.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, k, 0, 1};
+      r.imageExtent = {std::max(1u, a.width >> k), std::max(1u, a.height >> k), 1};
+      offset += VkDeviceSize(r.imageExtent.width) * r.imageExtent.height * 8;
+      regions.push_back(r);
+    }
+    vkCmdCopyImageToBuffer(cmd, a.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, staging.buffer(),
+                           uint32_t(regions.size()), regions.data());
+    // Back to where the LensFlare keeps it; the copy's reads finish first, the host read waits.
+    b.use(img, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+          VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+          VK_ACCESS_2_SHADER_SAMPLED_READ_BIT, a.levels);
+    b.flush(cmd);
+    VkMemoryBarrier2 host{VK_STRUCTURE_TYPE_MEMORY_BARRIER_2};
+    host.srcStageMask = VK_PIPELINE_STAGE_2_COPY_BIT;
+    host.srcAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;
+    host.dstStageMask = VK_PIPELINE_STAGE_2_HOST_BIT;
+    host.dstAccessMask = VK_ACCESS_2_HOST_READ_BIT;
+    VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+    dep.memoryBarrierCount = 1;
+    dep.pMemoryBarriers = &host;
+    vkCmdPipelineBarrier2(cmd, &dep);
+  });
+  staging.invalidate();
+  const auto* half = static_cast<const uint16_t*>(staging.mapped());
+  for (uint32_t k = 0; k < a.levels; ++k) {
+    reference::FlareAtlasLevel l{std::max(1u, a.width >> k), std::max(1u, a.height >> k), {}};
+    l.rgba.resize(size_t(l.width) * l.height * 4);
+    for (double& v : l.rgba) v = detail::half_to_float(*half++);
+    out.push_back(std::move(l));
+  }
+  return out;
+}
+
+reference::SamplerPrecision sampler_precision() {
+  VkPhysicalDeviceProperties p;
+  vkGetPhysicalDeviceProperties(context().physical_device(), &p);
+  return {p.limits.subTexelPrecisionBits, p.limits.mipmapPrecisionBits};
+}
+
+// Random lights over the image and around it: inside, on the edges, partly and fully off screen,
+// sizes 3 to 60 px (tiny ones exercise the coarse atlas levels), HDR colours, fractions, elements.
+std::vector<GlintFlareInstance> random_instances(uint32_t n, uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+  std::vector<GlintFlareInstance> out(n);
+  for (uint32_t i = 0; i < n; ++i) {
+    GlintFlareInstance& g = out[i];
+    g.center_x_px = -0.2f * kW + 1.4f * kW * unit(rng);
+    g.center_y_px = -0.2f * kH + 1.4f * kH * unit(rng);
+    if (i % 5 == 1) g.center_x_px = std::round(g.center_x_px);  // on pixel edges
+    if (i % 5 == 2) g.center_y_px = 0.0f;
+    g.size_px = 3.0f + 57.0f * unit(rng) * unit(rng);
+    g.visible_fraction = 0.05f + 0.95f * unit(rng);
+    g.color_r = 0.2f + 4.0f * unit(rng);
+    g.color_g = 0.2f + 4.0f * unit(rng);
+    g.color_b = 0.2f + 4.0f * unit(rng);
+    g.intensity = 0.5f + 3.0f * unit(rng);
+    g.light_index = i;
+    g.element = i % (GLINT_FLARE_ELEMENT_COUNT + 1);  // the last value is out of range: glow
+    g.ndc_depth = unit(rng);
+  }
+  return out;
+}
+
+struct Deviation {
+  double worst_ratio = 0;  // max |gpu - ref| / tolerance
+  size_t outside = 0;
+  std::string first;
+};
+
+// Per channel: |gpu - ref| <= bound + (2 count + 1) * u * |ref| + floor, with u the target's
+// store rounding (kHalfStore, kFloatStore). The raster path rounds twice per blend (the fragment
+// output converted to the attachment format, then the sum); the splat sums in fp32 and rounds once.
+// Each rounding is at most u times the running sum, which for non-negative additions is at most
+// the final value.
+Deviation compare(const CpuImage& gpu, const reference::FlareComposite& ref, VkFormat format) {
+  const double u = format == kF16 ? kHalfStore : kFloatStore;
+  Deviation d;
+  for (uint32_t y = 0; y < ref.height; ++y) {
+    for (uint32_t x = 0; x < ref.width; ++x) {
+      const size_t p = size_t(y) * ref.width + x;
+      for (int c = 0; c < 4; ++c) {
+        const double r = ref.rgba[p * 4 + c];
+        const double tol = ref.bound[p * 4 + c] + (2 * ref.count[p] + 1) * u * std::fabs(r) + 1e-7;
+        const double e = std::fabs(double(gpu.at(x, y)[c]) - r);
+        if (!(e <= tol)) {
+          if (d.outside++ == 0) {
+            d.first = "pixel (" + std::to_string(x) + ", " + std::to_string(y) + ") channel " + std::to_string(c) +
+                      ": gpu " + std::to_string(gpu.at(x, y)[c]) + " ref " + std::to_string(r) + " tol " +
+                      std::to_string(tol);
+          }
+        }
+        d.worst_ratio = std::max(d.worst_ratio, e / tol);
+      }
+    }
+  }
+  return d;
+}
+
+// ---- Config ---------------------------------------------------------------------------------------
+
+TEST_F(FlareTest, PresetsHaveTheSeedsValues) {
+  const FlareConfig subtle = FlareConfig::preset(FlarePreset::retro_subtle);
+  const FlareConfig intense = FlareConfig::preset(FlarePreset::retro_intense);
+  const FlareConfig cinematic = FlareConfig::preset(FlarePreset::cinematic);
+  const FlareConfig disabled = FlareConfig::preset(FlarePreset::disabled);
+  EXPECT_FLOAT_EQ(subtle.anamorphic_ratio, 1.8f);
+  EXPECT_FLOAT_EQ(subtle.intensity, 0.6f);
+  EXPECT_FLOAT_EQ(intense.anamorphic_ratio, 2.5f);
+  EXPECT_FLOAT_EQ(intense.intensity, 1.2f);
+  EXPECT_FLOAT_EQ(cinematic.anamorphic_ratio, 2.0f);
+  EXPECT_FLOAT_EQ(cinematic.intensity, 0.8f);
+  EXPECT_TRUE(subtle.enabled && intense.enabled && cinematic.enabled);
+  EXPECT_FALSE(disabled.enabled);
+  EXPECT_FLOAT_EQ(disabled.intensity, 0.0f);
+  for (const FlareConfig& c : {subtle, intense, cinematic, disabled}) EXPECT_NO_THROW(c.validate());
+  const FlareConfig defaults;
+  EXPECT_FLOAT_EQ(defaults.anamorphic_ratio, 2.0f);
+  const std::array<float, 5> seed_ghosts = {0.0f, 0.3f, 0.7f, 1.0f, 1.5f};
+  EXPECT_EQ(defaults.ghost_positions, seed_ghosts);
+  EXPECT_THROW(FlareConfig::preset(static_cast<FlarePreset>(7)), Error);
+}
+
+TEST_F(FlareTest, BadConfigThrowsNamingTheFieldAndRecordsNothing) {
+  struct Case {
+    const char* field;
+    void (*spoil)(FlareConfig&);
+  };
+  const Case cases[] = {
+      {"anamorphic_ratio", [](FlareConfig& c) { c.anamorphic_ratio = std::nanf(""); }},
+      {"anamorphic_ratio", [](FlareConfig& c) { c.anamorphic_ratio = 3.5f; }},
+      {"anamorphic_ratio", [](FlareConfig& c) { c.anamorphic_ratio = 0.9f; }},
+      {"intensity", [](FlareConfig& c) { c.intensity = -0.1f; }},
+      {"intensity", [](FlareConfig& c) { c.intensity = INFINITY; }},
+      {"streak_length", [](FlareConfig& c) { c.streak_length = 0.5f; }},
+      {"ghost_weight", [](FlareConfig& c) { c.ghost_weight = std::nanf(""); }},
+      {"ghost_positions[3]", [](FlareConfig& c) { c.ghost_positions[3] = 3.5f; }},
+      {"tint_color[2]", [](FlareConfig& c) { c.tint_color[2] = 1.5f; }},
+  };
+  LensFlare flare(context(), kF32, {kW, kH});
+  const CpuImage background = random_hdr(kW, kH, 5);
+  FlareInputs in(random_instances(6, 1), 6, flare.groups_per_instance());
+  for (const Case& k : cases) {
+    FlareConfig c;
+    k.spoil(c);
+    try {
+      c.validate();
+      ADD_FAILURE() << k.field << ": no error";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.code(), ErrorCode::invalid_argument);
+      EXPECT_NE(std::string(e.what()).find(k.field), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("accepted"), std::string::npos) << e.what();
+    }
+    for (Path path : {Path::raster, Path::compute}) {
+      auto color = make_color(background, kF32);
+      const Image before = color.state;
+      context().run_once(
+          [&](VkCommandBuffer cmd) { EXPECT_THROW(record(flare, path, cmd, color.state, in, c), Error) << k.field; });
+      EXPECT_EQ(color.state.layout, before.layout) << "state touched by a throwing record";
+      const CpuImage out = detail::download(context(), color.state);
+      EXPECT_EQ(std::memcmp(out.rgba.data(), background.rgba.data(), out.rgba.size() * 4), 0) << k.field;
+    }
+  }
+}
+
+TEST_F(FlareTest, BadImagesAndBuffersThrowBeforeRecording) {
+  EXPECT_THROW(LensFlare(context(), VK_FORMAT_R8G8B8A8_UNORM, {kW, kH}), Error);
+  EXPECT_THROW(LensFlare(context(), kF16, {0, kH}), Error);
+  LensFlare flare(context(), kF16, {kW, kH});
+  detail::OwnedImage color(context(), {kW, kH}, kF16, kUsage);
+  FlareInputs in(random_instances(2, 2), 2, flare.groups_per_instance());
+  const FlareConfig config;
+  auto expect_code = [&](ErrorCode code, const char* words, auto&& spoil, Path path) {
+    Image img = color.state;
+    Buffer inst = in.instances_view, ind = in.indirect_view;
+    spoil(img, inst, ind);
+    context().run_once([&](VkCommandBuffer cmd) {
+      try {
+        if (path == Path::raster) {
+          flare.record_raster(cmd, img, inst, ind, config);
+        } else {
+          flare.record_compute(cmd, img, inst, ind, config);
+        }
+        ADD_FAILURE() << words << ": no error";
+      } catch (const Error& e) {
+        EXPECT_EQ(e.code(), code) << e.what();
+        EXPECT_NE(std::string(e.what()).find(words), std::string::npos) << e.what();
+      }
+    });
+  };
+  for (Path path : {Path::raster, Path::compute}) {
+    expect_code(
+        ErrorCode::unsupported_format, "VK_FORMAT_R32G32B32A32_SFLOAT",
+        [](Image& i, Buffer&, Buffer&) { i.format = kF32; }, path);
+    expect_code(
+        ErrorCode::invalid_argument, "extent", [](Image& i, Buffer&, Buffer&) { i.extent.width = 8; }, path);
+    expect_code(
+        ErrorCode::invalid_argument, "non-null", [](Image& i, Buffer&, Buffer&) { i.view = VK_NULL_HANDLE; }, path);
+    expect_code(
+        ErrorCode::missing_usage, "INDIRECT_BUFFER",
+        [](Image&, Buffer&, Buffer& b) { b.usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT; }, path);
+    expect_code(
+        ErrorCode::missing_usage, "STORAGE_BUFFER",
+        [](Image&, Buffer& b, Buffer&) { b.usage = VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT; }, path);
+    expect_code(
+        ErrorCode::invalid_argument, "multiple of 4", [](Image&, Buffer&, Buffer& b) { b.offset = 2; }, path);
+    expect_code(
+        ErrorCode::invalid_argument, "32", [](Image&, Buffer&, Buffer& b) { b.size = 16; }, path);
+    expect_code(
+        ErrorCode::invalid_argument, "instances buffer is null",
+        [](Image&, Buffer& b, Buffer&) { b.buffer = VK_NULL_HANDLE; }, path);
+  }
+  expect_code(
+      ErrorCode::missing_usage, "COLOR_ATTACHMENT",
+      [](Image& i, Buffer&, Buffer&) { i.usage = detail::kToolImageUsage; }, Path::raster);
+  expect_code(
+      ErrorCode::missing_usage, "STORAGE_BIT",
+      [](Image& i, Buffer&, Buffer&) { i.usage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT; }, Path::compute);
+}
+
+// ---- Atlas ----------------------------------------------------------------------------------------
+
+TEST_F(FlareTest, AtlasMatchesTheFloat64ReferenceAtEveryLevel) {
+  LensFlare flare(context(), kF16, {kW, kH});
+  ASSERT_TRUE(flare.atlas().generated);
+  const reference::FlareAtlas gpu = read_atlas(flare);
+  const reference::FlareAtlas ref = reference::flare_atlas();
+  ASSERT_EQ(gpu.size(), size_t(GLINT_FLARE_ATLAS_LEVELS));
+  const double u = kHalfStore;
+  const double fp16_min_normal = std::ldexp(1.0, -14);  // a device may flush fp16 subnormals
+  for (size_t k = 0; k < gpu.size(); ++k) {
+    ASSERT_EQ(gpu[k].width, ref[k].width);
+    // Level k from the GPU's own level k - 1: one fp32 evaluation (level 0: exp and sqrt within a
+    // few ulp, about 1e-5 relative at the largest arguments) and one fp16 store (kHalfStore).
+    const reference::FlareAtlasLevel step = k == 0 ? ref[0] : reference::flare_atlas_reduce(gpu[k - 1]);
+    double worst_step = 0, worst_chain = 0;
+    for (size_t i = 0; i < gpu[k].rgba.size(); ++i) {
+      const double g = gpu[k].rgba[i];
+      ASSERT_TRUE(std::isfinite(g));
+      const double e_step = std::fabs(g - step.rgba[i]) / ((u + 2e-5) * std::fabs(step.rgba[i]) + fp16_min_normal);
+      // Against the all-float64 chain: one rounding per level on the way down.
+      const double e_chain =
+          std::fabs(g - ref[k].rgba[i]) / ((k + 1) * (u + 2e-5) * std::fabs(ref[k].rgba[i]) + fp16_min_normal);
+      worst_step = std::max(worst_step, e_step);
+      worst_chain = std::max(worst_chain, e_chain);
+    }
+    EXPECT_LE(worst_step, 1.0) << "level " << k << " vs its reduction of the GPU's level above";
+    EXPECT_LE(worst_chain, 1.0) << "level " << k << " vs the float64 chain";
+  }
+}
+
+TEST_F(FlareTest, AtlasTilesArePaddedAndNoLevelMixesTwoTiles) {
+  LensFlare flare(context(), kF16, {kW, kH});
+  const reference::FlareAtlas gpu = read_atlas(flare);
+  for (size_t k = 0; k < gpu.size(); ++k) {
+    const uint32_t s = 1u << k;
+    std::vector<int> owner(size_t(gpu[k].width) * gpu[k].height, -1);
+    for (uint32_t e = 0; e < GLINT_FLARE_ELEMENT_COUNT; ++e) {
+      const auto t = reference::flare_tile(e);
+      ASSERT_EQ(t[0] % s + t[1] % s + t[2] % s + t[3] % s, 0u) << "tile " << e << " not aligned at level " << k;
+      double peak = 0;
+      for (uint32_t y = t[1] / s; y < (t[1] + t[3]) / s; ++y) {
+        for (uint32_t x = t[0] / s; x < (t[0] + t[2]) / s; ++x) {
+          owner[size_t(y) * gpu[k].width + x] = int(e);
+          peak = std::max(peak, gpu[k].at(x, y)[3]);
+        }
+      }
+      EXPECT_GT(peak, 0.05) << "tile " << e << " is empty at level " << k;
+      // The padding ring: every texel within padding / 2^k of the tile is exactly zero.
+      const uint32_t p = GLINT_FLARE_ATLAS_PADDING / s;
+      for (uint32_t y = t[1] / s - p; y < (t[1] + t[3]) / s + p; ++y) {
+        for (uint32_t x = t[0] / s - p; x < (t[0] + t[2]) / s + p; ++x) {
+          if (owner[size_t(y) * gpu[k].width + x] == int(e)) continue;
+          for (int c = 0; c < 4; ++c)
+            ASSERT_EQ(gpu[k].at(x, y)[c], 0.0) << "padding texel (" << x << ", " << y << ") level " << k;
+        }
+      }
+    }
+    for (uint32_t y = 0; y < gpu[k].height; ++y) {  // nothing outside the tiles at all
+      for (uint32_t x = 0; x < gpu[k].width; ++x) {
+        if (owner[size_t(y) * gpu[k].width + x] >= 0) continue;
+        for (int c = 0; c < 4; ++c) ASSERT_EQ(gpu[k].at(x, y)[c], 0.0) << "(" << x << ", " << y << ") level " << k;
+      }
+    }
+  }
+}
+
+// The atlas-aware LOD picks levels that keep every bilinear footprint inside its tile's padding:
+// the level count is the padding cap + 1, and for sprites from 0.25 px to 4000 px the level is
+// never above the cap, so a tap at the tile's border reaches at most 1.5 * 2^L < padding texels.
+TEST_F(FlareTest, ChosenLevelsKeepFootprintsInsideThePadding) {
+  GlintLodQuery q{};
+  q.tex_w = q.tex_h = 64.0f;
+  GlintLodAtlas a{float(GLINT_FLARE_ATLAS_WIDTH),
+                  float(GLINT_FLARE_ATLAS_HEIGHT),
+                  float(GLINT_FLARE_ATLAS_LEVELS),
+                  0.0f,
+                  1.0f,
+                  float(GLINT_FLARE_ATLAS_PADDING),
+                  GLINT_LOD_PADDING_CAP,
+                  0u};
+  const double cap = reference::lod_padding_cap(q, a);
+  EXPECT_EQ(cap + 1, double(GLINT_FLARE_ATLAS_LEVELS));
+  FlareConfig config;
+  double highest = 0;
+  for (double size = 0.25; size < 4000; size *= 1.07) {
+    GlintFlareInstance inst{};
+    inst.center_x_px = 50;
+    inst.center_y_px = 40;
+    inst.size_px = float(size);
+    inst.visible_fraction = inst.intensity = inst.color_r = inst.color_g = inst.color_b = 1;
+    for (uint32_t slot = 0; slot < GLINT_FLARE_SPRITES; ++slot) {
+      const auto s = reference::flare_sprite(inst, slot, config, kW, kH);
+      ASSERT_LE(s.lod, cap);
+      EXPECT_LT(1.5 * std::ldexp(1.0, int(std::ceil(s.lod))), double(GLINT_FLARE_ATLAS_PADDING));
+      highest = std::max(highest, s.lod);
+    }
+  }
+  EXPECT_EQ(highest, cap);  // tiny sprites do reach the cap: the test is not vacuous
+}
+
+// Poisoning: an adopted context records the generation in the first frame; every texel of every
+// level, cleared to NaN before, must come out finite and equal to the standalone atlas.
+TEST_F(FlareTest, AdoptedContextGeneratesTheAtlasInTheFirstRecordOverPoison) {
+  Context engine = Context::adopt(
+      {context().instance(), context().physical_device(), context().device(), context().queue_family_index()});
+  LensFlare flare(engine, kF32, {kW, kH});
+  EXPECT_FALSE(flare.atlas().generated);
+  const FlareAtlasInfo a = flare.atlas();
+  context().run_once([&](VkCommandBuffer cmd) {
+    Image img{
+        a.image,         a.view, a.format, {a.width, a.height}, 0, VK_IMAGE_LAYOUT_UNDEFINED, VK_PIPELINE_STAGE_2_NONE,
+        VK_ACCESS_2_NONE};
+    detail::Barriers b;
+    b.use(img, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_PIPELINE_STAGE_2_CLEAR_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+          a.levels);
+    b.flush(cmd);
+    VkClearColorValue nan{};
+    nan.float32[0] = nan.float32[1] = nan.float32[2] = nan.float32[3] = std::nanf("");
+    VkImageSubresourceRange all{VK_IMAGE_ASPECT_COLOR_BIT, 0, a.levels, 0, 1};
+    vkCmdClearColorImage(cmd, a.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, &nan, 1, &all);
+  });
+  // A second submission, after the first has completed (run_once waits for its fence): the
+  // LensFlare's first barrier starts from UNDEFINED, which may discard the NaNs but need not; any
+  // texel the generation did not write would stay NaN on lavapipe.
+  context().run_once([&](VkCommandBuffer cmd) { flare.record_setup(cmd); });
+  EXPECT_TRUE(flare.atlas().generated);
+  LensFlare standalone(context(), kF32, {kW, kH});
+  const reference::FlareAtlas got = read_atlas(flare), want = read_atlas(standalone);
+  for (size_t k = 0; k < got.size(); ++k) {
+    for (size_t i = 0; i < got[k].rgba.size(); ++i) {
+      ASSERT_TRUE(std::isfinite(got[k].rgba[i])) << "level " << k << " texel " << i / 4 << " never written";
+      ASSERT_EQ(got[k].rgba[i], want[k].rgba[i]) << "level " << k;
+    }
+  }
+  // The engine enabled no dynamicRendering (its feature chain says so): the raster path refuses.
+  VkPhysicalDeviceVulkan13Features f13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
+  f13.synchronization2 = VK_TRUE;
+  AdoptInfo info{context().instance(), context().physical_device(), context().device(), context().queue_family_index(),
+                 &f13};
+  Context no_rendering = Context::adopt(info);
+  LensFlare compute_only(no_rendering, kF32, {kW, kH});
+  detail::OwnedImage color(context(), {kW, kH}, kF32, kUsage);
+  FlareInputs in({}, 0, compute_only.groups_per_instance());
+  context().run_once([&](VkCommandBuffer cmd) {
+    try {
+      compute_only.record_raster(cmd, color.state, in.instances_view, in.indirect_view, FlareConfig{});
+      ADD_FAILURE() << "record_raster without dynamicRendering did not throw";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("dynamicRendering"), std::string::npos) << e.what();
+    }
+  });
+}
+
+// ---- Drawing --------------------------------------------------------------------------------------
+
+class FlareDrawTest : public FlareTest, public ::testing::WithParamInterface<std::tuple<Path, VkFormat>> {};
+
+TEST_P(FlareDrawTest, MatchesTheReferenceOnRandomLights) {
+  const auto [path, format] = GetParam();
+  LensFlare flare(context(), format, {kW, kH});
+  const reference::FlareAtlas atlas = read_atlas(flare);
+  const CpuImage background = as_stored(random_hdr(kW, kH, 11), format);
+  const auto lights = random_instances(24, 7);
+  FlareInputs in(lights, uint32_t(lights.size()), flare.groups_per_instance());
+  FlareConfig config = FlareConfig::preset(FlarePreset::retro_intense);
+  config.halo_weight = 0.8f;  // every element clearly visible
+  const CpuImage gpu = draw(flare, path, background, format, in, config);
+  ASSERT_TRUE(all_finite(gpu));
+  const auto ref =
+      reference::flare_composite(background, lights, uint32_t(lights.size()), config, atlas, sampler_precision());
+  // The flares really add light here (the comparison is not of the background with itself).
+  double added = 0;
+  for (size_t i = 0; i < ref.rgba.size(); ++i) added += ref.rgba[i] - background.rgba[i];
+  EXPECT_GT(added, 100.0);
+  const Deviation d = compare(gpu, ref, format);
+  EXPECT_EQ(d.outside, 0u) << path_name(path) << ": " << d.first;
+  std::printf("flare %s %s vs float64: worst |error| / tolerance %.3f\n", path_name(path),
+              format == kF16 ? "rgba16f" : "rgba32f", d.worst_ratio);
+}
+
+INSTANTIATE_TEST_SUITE_P(Paths, FlareDrawTest,
+                         ::testing::Combine(::testing::Values(Path::raster, Path::compute),
+                                            ::testing::Values(kF16, kF32)),
+                         [](const auto& info) {
+                           return std::string(path_name(std::get<0>(info.param))) +
+                                  (std::get<1>(info.param) == kF16 ? "_rgba16f" : "_rgba32f");
+                         });
+
+// Raster and compute evaluate the same function at the same pixel centres with the same sampler
+// and explicit level; they differ in how the sum is rounded: the raster path rounds to the target
+// after every blend, the splat sums in fp32 and rounds once. Tolerance: (2n + 1) * u * |value| with
+// n the number of sprites on the pixel (as in compare()), plus the reference's coverage bound at pixels whose centre
+// lies within 2e-3 px of a sprite edge, where the vertex and compute stages' fp32 may disagree.
+TEST_F(FlareTest, RasterAndComputeGiveTheSameImageWithinTolerance) {
+  for (VkFormat format : {kF16, kF32}) {
+    LensFlare flare(context(), format, {kW, kH});
+    const reference::FlareAtlas atlas = read_atlas(flare);
+    const CpuImage background = as_stored(random_hdr(kW, kH, 21), format);
+    const auto lights = random_instances(40, 9);
+    FlareInputs in(lights, uint32_t(lights.size()), flare.groups_per_instance());
+    const FlareConfig config;
+    const CpuImage raster = draw(flare, Path::raster, background, format, in, config);
+    const CpuImage compute = draw(flare, Path::compute, background, format, in, config);
+    const auto ref =
+        reference::flare_composite(background, lights, uint32_t(lights.size()), config, atlas, sampler_precision());
+    const double u = format == kF16 ? kHalfStore : kFloatStore;
+    size_t outside = 0, differ = 0;
+    double worst = 0;
+    for (uint32_t y = 0; y < kH; ++y) {
+      for (uint32_t x = 0; x < kW; ++x) {
+        const size_t p = size_t(y) * kW + x;
+        for (int c = 0; c < 4; ++c) {
+          const double r = raster.at(x, y)[c], k = compute.at(x, y)[c];
+          // Coverage bound only where an edge is ambiguous: the reference adds the full contribution
+          // there, and sampling differences are zero (same sampler, same inputs) elsewhere.
+          const double coverage =
+              ref.bound[p * 4 + c] > 1e-3 * std::fabs(ref.rgba[p * 4 + c]) ? ref.bound[p * 4 + c] : 0.0;
+          const double tol = (2 * ref.count[p] + 1) * u * std::max(std::fabs(r), std::fabs(k)) + coverage + 1e-7;
+          differ += r != k;
+          if (!(std::fabs(r - k) <= tol)) ++outside;
+          worst = std::max(worst, std::fabs(r - k) / tol);
+        }
+      }
+    }
+    EXPECT_EQ(outside, 0u) << (format == kF16 ? "rgba16f" : "rgba32f");
+    std::printf("flare raster vs compute %s: %zu of %u channels differ, worst |diff| / tolerance %.3f\n",
+                format == kF16 ? "rgba16f" : "rgba32f", differ, kW * kH * 4, worst);
+  }
+}
+
+TEST_F(FlareTest, ZeroInstancesAndDisabledLeaveTheImageBitIdentical) {
+  for (VkFormat format : {kF16, kF32}) {
+    LensFlare flare(context(), format, {kW, kH});
+    const CpuImage background = as_stored(random_hdr(kW, kH, 31), format);
+    const auto lights = random_instances(8, 3);
+    FlareInputs none(lights, 0, flare.groups_per_instance());  // the cull found nothing visible
+    FlareInputs some(lights, 8, flare.groups_per_instance());
+    for (Path path : {Path::raster, Path::compute}) {
+      const CpuImage a = draw(flare, path, background, format, none, FlareConfig{});
+      EXPECT_EQ(std::memcmp(a.rgba.data(), background.rgba.data(), a.rgba.size() * 4), 0)
+          << path_name(path) << " 0 instances";
+      const CpuImage b = draw(flare, path, background, format, some, FlareConfig::preset(FlarePreset::disabled));
+      EXPECT_EQ(std::memcmp(b.rgba.data(), background.rgba.data(), b.rgba.size() * 4), 0)
+          << path_name(path) << " disabled";
+      const CpuImage c = draw(flare, path, background, format, some, FlareConfig{});
+      EXPECT_NE(std::memcmp(c.rgba.data(), background.rgba.data(), c.rgba.size() * 4), 0)
+          << path_name(path) << " drew nothing";
+      // Alpha is never written.
+      for (size_t i = 3; i < c.rgba.size(); i += 4) ASSERT_EQ(c.rgba[i], background.rgba[i]) << path_name(path);
+    }
+  }
+}
+
+TEST_F(FlareTest, InstancesBeyondTheIndirectCountAreIgnored) {
+  LensFlare flare(context(), kF32, {kW, kH});
+  const reference::FlareAtlas atlas = read_atlas(flare);
+  const CpuImage background = random_hdr(kW, kH, 41);
+  const auto lights = random_instances(10, 13);
+  FlareInputs three(lights, 3, flare.groups_per_instance());
+  const FlareConfig config;
+  const auto ref3 = reference::flare_composite(background, lights, 3, config, atlas, sampler_precision());
+  const auto ref10 = reference::flare_composite(background, lights, 10, config, atlas, sampler_precision());
+  for (Path path : {Path::raster, Path::compute}) {
+    const CpuImage gpu = draw(flare, path, background, kF32, three, config);
+    EXPECT_EQ(compare(gpu, ref3, kF32).outside, 0u) << path_name(path) << " differs from the first 3 lights";
+    EXPECT_GT(compare(gpu, ref10, kF32).outside, 100u) << path_name(path) << ": the other 7 would have shown";
+  }
+}
+
+// Added light (image minus background) on a black background, one light in the middle.
+std::vector<double> added_light(LensFlare& flare, Path path, GlintFlareInstance light, const FlareConfig& config) {
+  FlareInputs in({light}, 1, flare.groups_per_instance());
+  const CpuImage black(kW, kH, 0.0f);
+  const CpuImage out = draw(flare, path, black, kF32, in, config);
+  std::vector<double> added(size_t(kW) * kH);
+  for (size_t p = 0; p < added.size(); ++p) added[p] = out.rgba[p * 4] + out.rgba[p * 4 + 1] + out.rgba[p * 4 + 2];
+  return added;
+}
+
+GlintFlareInstance centre_light(float size) {
+  GlintFlareInstance g{};
+  g.center_x_px = kW / 2.0f + 0.3f;
+  g.center_y_px = kH / 2.0f - 0.2f;
+  g.size_px = size;
+  g.visible_fraction = 0.8f;
+  g.color_r = 2.0f;
+  g.color_g = 1.5f;
+  g.color_b = 1.0f;
+  g.intensity = 3.0f;
+  g.element = GLINT_FLARE_ELEMENT_GLOW;
+  return g;
+}
+
+TEST_F(FlareTest, BrightnessIsLinearInVisibleFractionAndIntensity) {
+  LensFlare flare(context(), kF32, {kW, kH});
+  for (Path path : {Path::raster, Path::compute}) {
+    const GlintFlareInstance base = centre_light(20.0f);
+    const auto a = added_light(flare, path, base, FlareConfig{});
+    GlintFlareInstance half_fraction = base;
+    half_fraction.visible_fraction *= 0.5f;
+    GlintFlareInstance double_intensity = base;
+    double_intensity.intensity *= 2.0f;
+    FlareConfig dim;
+    dim.intensity = 0.25f;
+    const auto b = added_light(flare, path, half_fraction, FlareConfig{});
+    const auto c = added_light(flare, path, double_intensity, FlareConfig{});
+    const auto d = added_light(flare, path, base, dim);
+    double total = 0;
+    for (size_t p = 0; p < a.size(); ++p) {
+      total += a[p];
+      // Scaling by a power of two is exact in fp32 up to the sum's rounding (a few ulp).
+      ASSERT_NEAR(b[p], 0.5 * a[p], 1e-6 * a[p] + 1e-12) << path_name(path) << " pixel " << p;
+      ASSERT_NEAR(c[p], 2.0 * a[p], 1e-6 * a[p] + 1e-12) << path_name(path) << " pixel " << p;
+      ASSERT_NEAR(d[p], 0.25 * a[p], 1e-6 * a[p] + 1e-12) << path_name(path) << " pixel " << p;
+    }
+    EXPECT_GT(total, 10.0) << path_name(path);
+  }
+}
+
+// Second moments of the added light about the light: the anamorphic ratio stretches x only.
+TEST_F(FlareTest, AnamorphicRatioStretchesHorizontally) {
+  LensFlare flare(context(), kF32, {kW, kH});
+  FlareConfig only_main;
+  only_main.streak_weight = only_main.halo_weight = only_main.starburst_weight = only_main.ghost_weight = 0.0f;
+  const GlintFlareInstance light = centre_light(24.0f);
+  for (Path path : {Path::raster, Path::compute}) {
+    auto moments = [&](float ratio) {
+      FlareConfig c = only_main;
+      c.anamorphic_ratio = ratio;
+      const auto added = added_light(flare, path, light, c);
+      double e = 0, xx = 0, yy = 0;
+      for (uint32_t y = 0; y < kH; ++y) {
+        for (uint32_t x = 0; x < kW; ++x) {
+          const double a = added[size_t(y) * kW + x];
+          e += a;
+          xx += a * (x + 0.5 - light.center_x_px) * (x + 0.5 - light.center_x_px);
+          yy += a * (y + 0.5 - light.center_y_px) * (y + 0.5 - light.center_y_px);
+        }
+      }
+      return std::array<double, 3>{e, xx / e, yy / e};
+    };
+    const auto one = moments(1.0f), three = moments(3.0f);
+    EXPECT_NEAR(three[1] / one[1], 9.0, 0.3) << path_name(path) << ": x spread scales with the ratio squared";
+    EXPECT_NEAR(three[2] / one[2], 1.0, 0.03) << path_name(path) << ": y spread unchanged";
+    EXPECT_NEAR(three[0] / one[0], 3.0, 0.1) << path_name(path) << ": area (energy) scales with the ratio";
+  }
+}
+
+TEST_F(FlareTest, RecordingAgainCreatesNoVulkanObject) {
+  LensFlare flare(context(), kF16, {kW, kH});
+  const auto lights = random_instances(5, 17);
+  FlareInputs in(lights, 5, flare.groups_per_instance());
+  auto color = make_color(random_hdr(kW, kH, 3), kF16);
+  auto frame = [&] {
+    context().run_once([&](VkCommandBuffer cmd) {
+      in.record_upload(cmd);
+      flare.record_raster(cmd, color.state, in.instances_view, in.indirect_view, FlareConfig{});
+      flare.record_compute(cmd, color.state, in.instances_view, in.indirect_view, FlareConfig{});
+    });
+  };
+  frame();
+  const uint64_t before = context().objects_created();
+  frame();
+  frame();
+  EXPECT_EQ(context().objects_created(), before);
+}
+
+TEST_F(FlareTest, NonFiniteOrEmptyInstancesDrawNothing) {
+  LensFlare flare(context(), kF32, {kW, kH});
+  std::vector<GlintFlareInstance> bad(5, centre_light(20.0f));
+  bad[0].center_x_px = std::nanf("");
+  bad[1].size_px = 0.0f;
+  bad[2].visible_fraction = 0.0f;
+  bad[3].intensity = INFINITY;
+  bad[4].color_g = std::nanf("");
+  const CpuImage background = random_hdr(kW, kH, 51);
+  FlareInputs in(bad, 5, flare.groups_per_instance());
+  for (Path path : {Path::raster, Path::compute}) {
+    const CpuImage out = draw(flare, path, background, kF32, in, FlareConfig{});
+    EXPECT_EQ(std::memcmp(out.rgba.data(), background.rgba.data(), out.rgba.size() * 4), 0) << path_name(path);
+  }
+}
+
+}  // namespace
+}  // namespace glint::test

@@ -1,0 +1,590 @@
+// Lens-flare visibility on the GPU against the float64 references (host/reference/
+// occlusion_reference.h): the Hi-Z pyramid bit for bit at odd, tiny and very wide sizes, the cull +
+// grid test + compaction on random scenes (exact grid result, conservative against brute force,
+// error within the bound of docs/OCCLUSION.md), monotone fading, overflow, zero lights, errors.
+#include "occlusion.h"
+
+#include <glint/occlusion.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <map>
+#include <random>
+#include <set>
+
+#include "core/barriers.h"
+#include "core/transfer.h"
+#include "reference/occlusion_reference.h"
+#include "support/gpu_test.h"
+
+namespace glint::test {
+namespace {
+
+class OcclusionTest : public GpuTest {};
+
+constexpr VkBufferUsageFlags kBufferUsage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT |
+                                            VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+
+// A host-visible buffer filled with 0xFF bytes (NaN as float, ~0u as uint): unwritten data shows.
+struct HostBuffer {
+  detail::OwnedBuffer owned;
+  Buffer view;
+  explicit HostBuffer(VkDeviceSize bytes) : owned(context(), std::max<VkDeviceSize>(bytes, 4), kBufferUsage, true) {
+    std::memset(owned.mapped(), 0xFF, owned.size());
+    owned.flush();
+    view.buffer = owned.buffer();
+    view.size = owned.size();
+    view.usage = kBufferUsage;
+    view.stage = VK_PIPELINE_STAGE_2_HOST_BIT;
+    view.access = VK_ACCESS_2_HOST_WRITE_BIT;
+  }
+  template <typename T>
+  const T* as() const {
+    owned.invalidate();
+    return static_cast<const T*>(owned.mapped());
+  }
+};
+
+void to_host(VkCommandBuffer cmd, Buffer& b) {
+  detail::Barriers barriers;
+  barriers.use(b, VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
+  barriers.flush(cmd);
+}
+
+detail::OwnedImage make_depth(const reference::DepthImage& d, VkFormat format) {
+  detail::OwnedImage img(
+      context(), {d.width, d.height}, format,
+      VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT);
+  detail::upload_r32(context(), img.state, d.depth);
+  return img;
+}
+
+reference::DepthImage random_depth(uint32_t w, uint32_t h, uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+  reference::DepthImage d{w, h, std::vector<float>(size_t(w) * h)};
+  for (float& v : d.depth) v = unit(rng);
+  return d;
+}
+
+// Poisons every mip of the pyramid with NaN, so an unwritten texel fails the comparison.
+void poison_pyramid(HiZPyramid& hiz) {
+  context().run_once([&](VkCommandBuffer cmd) {
+    detail::Barriers b;
+    b.use(hiz.image(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_PIPELINE_STAGE_2_CLEAR_BIT,
+          VK_ACCESS_2_TRANSFER_WRITE_BIT, std::max(1u, hiz.levels()));
+    b.flush(cmd);
+    VkClearColorValue nan{};
+    for (float& c : nan.float32) c = std::nanf("");
+    VkImageSubresourceRange range{VK_IMAGE_ASPECT_COLOR_BIT, 0, std::max(1u, hiz.levels()), 0, 1};
+    vkCmdClearColorImage(cmd, hiz.image().image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, &nan, 1, &range);
+  });
+}
+
+std::vector<reference::DepthImage> read_pyramid(HiZPyramid& hiz) {
+  std::vector<reference::DepthImage> out;
+  const VkExtent2D e = hiz.config().extent;
+  for (uint32_t k = 1; k <= hiz.levels(); ++k) {
+    reference::DepthImage l;
+    l.width = std::max(1u, e.width >> k);
+    l.height = std::max(1u, e.height >> k);
+    l.depth = detail::download_r32(context(), hiz.image(), k - 1, {l.width, l.height}, hiz.levels());
+    out.push_back(std::move(l));
+  }
+  return out;
+}
+
+// Bit-exact comparison of every level, plus the conservative property checked directly: every
+// texel of level k is at least as far as every source pixel it covers.
+void expect_pyramid(const std::vector<reference::DepthImage>& gpu, const reference::DepthImage& depth, bool reversed,
+                    const std::string& what) {
+  const auto ref = reference::hiz_pyramid(depth, reversed, static_cast<uint32_t>(gpu.size()));
+  for (size_t k = 0; k < gpu.size(); ++k) {
+    ASSERT_EQ(gpu[k].depth.size(), ref[k].depth.size());
+    size_t bad = 0;
+    for (size_t i = 0; i < ref[k].depth.size(); ++i) {
+      if (std::memcmp(&gpu[k].depth[i], &ref[k].depth[i], 4) != 0 && bad++ < 5) {
+        ADD_FAILURE() << what << ": level " << k + 1 << " texel (" << i % ref[k].width << ", " << i / ref[k].width
+                      << ") is " << gpu[k].depth[i] << ", reference " << ref[k].depth[i];
+      }
+    }
+    EXPECT_EQ(bad, 0u) << what << ": level " << k + 1;
+  }
+  // Conservative: walk the source and look each pixel up at every level.
+  size_t violations = 0;
+  for (uint32_t y = 0; y < depth.height; ++y) {
+    for (uint32_t x = 0; x < depth.width; ++x) {
+      const float v = depth.at(x, y);
+      for (size_t k = 0; k < gpu.size(); ++k) {
+        const uint32_t s = static_cast<uint32_t>(k + 1);
+        const uint32_t tx = std::min(x >> s, gpu[k].width - 1), ty = std::min(y >> s, gpu[k].height - 1);
+        const float t = gpu[k].at(tx, ty);
+        if (!(reversed ? t <= v : t >= v)) ++violations;
+      }
+    }
+  }
+  EXPECT_EQ(violations, 0u) << what << ": texels nearer than a source pixel they cover";
+}
+
+struct HiZCase {
+  uint32_t w, h;
+};
+
+TEST_F(OcclusionTest, HiZMatchesReferenceAtAllSizes) {
+  const HiZCase cases[] = {{1, 1},    {7, 3},    {3, 7},    {2, 1},   {64, 64},  {65, 63},  {127, 129},
+                           {130, 67}, {333, 97}, {4097, 2}, {2, 600}, {8200, 2}, {3, 16384}};
+  uint32_t seed = 1;
+  for (const HiZCase& c : cases) {
+    for (VkFormat format : {VK_FORMAT_D32_SFLOAT, VK_FORMAT_R32_SFLOAT}) {
+      for (bool reversed : {false, true}) {
+        if (format == VK_FORMAT_R32_SFLOAT && (c.w * c.h > 20000)) continue;  // big sizes once per format
+        const auto depth = random_depth(c.w, c.h, seed++);
+        auto img = make_depth(depth, format);
+        HiZConfig config;
+        config.extent = {c.w, c.h};
+        config.format = format;
+        config.reversed_z = reversed;
+        HiZPyramid hiz(context(), config);
+        ASSERT_EQ(hiz.levels(), static_cast<uint32_t>(std::floor(std::log2(double(std::max(c.w, c.h))))));
+        poison_pyramid(hiz);
+        context().run_once([&](VkCommandBuffer cmd) { hiz.record(cmd, img.state); });
+        std::string what = std::to_string(c.w) + "x" + std::to_string(c.h) + (reversed ? " reversed" : " standard") +
+                           (format == VK_FORMAT_D32_SFLOAT ? " D32" : " R32");
+        expect_pyramid(read_pyramid(hiz), depth, reversed, what);
+      }
+    }
+  }
+}
+
+// The counter resets itself: frames with different depth, in separate submissions and twice in
+// one command buffer, each give their own exact pyramid. Also the level cap.
+TEST_F(OcclusionTest, HiZRepeatsFramesAndCapsLevels) {
+  for (bool two_pass : {false, true}) {
+    const uint32_t w = two_pass ? 8300 : 1000, h = two_pass ? 3 : 37;
+    HiZConfig config;
+    config.extent = {w, h};
+    HiZPyramid hiz(context(), config);
+    for (uint32_t frame = 0; frame < 3; ++frame) {
+      const auto a = random_depth(w, h, 100 + frame), b = random_depth(w, h, 200 + frame);
+      auto ia = make_depth(a, config.format), ib = make_depth(b, config.format);
+      context().run_once([&](VkCommandBuffer cmd) { hiz.record(cmd, ia.state); });
+      expect_pyramid(read_pyramid(hiz), a, false, "frame " + std::to_string(frame));
+      context().run_once([&](VkCommandBuffer cmd) {
+        hiz.record(cmd, ia.state);
+        hiz.record(cmd, ib.state);
+      });
+      expect_pyramid(read_pyramid(hiz), b, false, "second build in one command buffer");
+    }
+  }
+  HiZConfig capped;
+  capped.extent = {300, 200};
+  capped.max_cell_px = 5;
+  HiZPyramid hiz(context(), capped);
+  EXPECT_EQ(hiz.levels(), 3u);  // ceil(log2(5))
+  const auto d = random_depth(300, 200, 9);
+  auto img = make_depth(d, capped.format);
+  context().run_once([&](VkCommandBuffer cmd) { hiz.record(cmd, img.state); });
+  expect_pyramid(read_pyramid(hiz), d, false, "capped");
+}
+
+// Everything the cull writes for one frame.
+struct CullRun {
+  std::vector<GlintFlareLightResult> results;
+  std::vector<GlintFlareInstance> instances;  // the written slots (instance_count of them)
+  GlintFlareIndirect indirect;
+  GlintFlareStats stats;
+  bool canary_intact = true;  // bytes past the capacity untouched
+};
+
+CullRun run_cull(const reference::DepthImage& depth, VkFormat format, bool reversed,
+                 const std::vector<GlintFlareLight>& lights, const float view_proj[16], const LightCullConfig& config,
+                 uint32_t max_cell_px = 0, int frames = 1) {
+  auto img = make_depth(depth, format);
+  HiZConfig hc;
+  hc.extent = {depth.width, depth.height};
+  hc.format = format;
+  hc.reversed_z = reversed;
+  hc.max_cell_px = max_cell_px;
+  HiZPyramid hiz(context(), hc);
+  LightCuller culler(context(), config);
+  const uint32_t n = static_cast<uint32_t>(lights.size());
+  HostBuffer lbuf(n * sizeof(GlintFlareLight));
+  if (n) std::memcpy(lbuf.owned.mapped(), lights.data(), n * sizeof(GlintFlareLight));
+  lbuf.owned.flush();
+  const uint32_t canary_slots = 16;
+  HostBuffer inst((config.capacity + canary_slots) * sizeof(GlintFlareInstance));
+  HostBuffer indirect(sizeof(GlintFlareIndirect)), stats(sizeof(GlintFlareStats)),
+      results(n * sizeof(GlintFlareLightResult));
+  LightCullOutputs out{inst.view, indirect.view, stats.view, results.view};
+  LightCullFrame frame;
+  std::copy(view_proj, view_proj + 16, frame.view_proj);
+  frame.vertex_count = 6;
+  frame.groups_per_instance = 3;
+  context().run_once([&](VkCommandBuffer cmd) {
+    for (int f = 0; f < frames; ++f) {
+      hiz.record(cmd, img.state);
+      culler.record(cmd, hiz, img.state, lbuf.view, n, frame, out);
+    }
+    to_host(cmd, out.instances);
+    to_host(cmd, out.indirect);
+    to_host(cmd, out.stats);
+    to_host(cmd, out.results);
+  });
+  CullRun r;
+  r.indirect = *indirect.as<GlintFlareIndirect>();
+  r.stats = *stats.as<GlintFlareStats>();
+  const auto* res = results.as<GlintFlareLightResult>();
+  r.results.assign(res, res + n);
+  const auto* in = inst.as<GlintFlareInstance>();
+  r.instances.assign(in, in + std::min(r.indirect.instance_count, config.capacity));
+  const auto* bytes = reinterpret_cast<const uint8_t*>(in + config.capacity);
+  for (size_t i = 0; i < canary_slots * sizeof(GlintFlareInstance); ++i)
+    r.canary_intact = r.canary_intact && bytes[i] == 0xFF;
+  return r;
+}
+
+// Compares one GPU run with the references light by light; returns the mean |fraction - brute force|.
+double expect_cull_matches(const CullRun& run, const reference::Scene& scene, const LightCullConfig& config,
+                           bool reversed, uint32_t levels, const std::string& what) {
+  reference::CullSettings s;
+  std::copy(scene.view_proj, scene.view_proj + 16, s.view_proj);
+  s.grid = config.grid;
+  s.margin_ndc = config.margin_ndc;
+  s.depth_bias = config.depth_bias;
+  s.reversed_z = reversed;
+  s.levels = levels;
+  const auto pyramid = reference::hiz_pyramid(scene.depth, reversed, levels);
+  uint32_t counts[5] = {};
+  uint32_t ambiguous = 0, failures = 0;
+  double error_sum = 0.0;
+  uint32_t tested = 0;
+  std::set<uint32_t> expected_visible;
+  const double n2 = double(config.grid) * config.grid;
+  for (size_t i = 0; i < scene.lights.size(); ++i) {
+    const auto ref = reference::cull_light(scene.lights[i], s, scene.depth, pyramid);
+    const auto& gpu = run.results[i];
+    const uint32_t gpu_state = gpu.culled == GLINT_FLARE_OVERFLOW ? GLINT_FLARE_VISIBLE : gpu.culled;
+    counts[std::min(gpu_state, 4u)]++;
+    if (gpu_state == GLINT_FLARE_VISIBLE) expected_visible.insert(static_cast<uint32_t>(i));
+    if (ref.ambiguous) {
+      ++ambiguous;
+      continue;
+    }
+    auto fail = [&](const std::string& msg) {
+      if (failures++ < 8)
+        ADD_FAILURE() << what << ": light " << i << ": " << msg << " (ref state " << ref.culled << " fraction "
+                      << ref.grid_fraction << " brute " << ref.brute_force << " level " << ref.level << " centre "
+                      << ref.center_x << "," << ref.center_y << " z " << ref.ndc_z << " size "
+                      << scene.lights[i].size_px << ")";
+    };
+    if (gpu_state != ref.culled) fail("GPU state " + std::to_string(gpu.culled));
+    const double frac = gpu.culled == GLINT_FLARE_VISIBLE ? ref.grid_fraction : 0.0;
+    if (gpu.culled != GLINT_FLARE_OVERFLOW && std::fabs(gpu.visible_fraction - frac) > 1e-6) {
+      fail("GPU fraction " + std::to_string(gpu.visible_fraction));
+    }
+    if (ref.culled == GLINT_FLARE_VISIBLE || ref.culled == GLINT_FLARE_OCCLUDED) {
+      // Conservative: any visible pixel under the footprint keeps the light visible, and the grid
+      // never reports less than the true fraction; the excess is bounded by the mixed cells.
+      if (ref.brute_force > 0.0 && gpu_state != GLINT_FLARE_VISIBLE) fail("fully occluded but brute force is > 0");
+      if (ref.grid_fraction < ref.brute_force - 1e-9) fail("grid fraction below brute force");
+      if (ref.grid_fraction - ref.brute_force > ref.mixed_cells / n2 + 1e-9) fail("error above the bound");
+      error_sum += std::fabs(ref.grid_fraction - ref.brute_force);
+      ++tested;
+    }
+  }
+  EXPECT_EQ(failures, 0u) << what;
+  EXPECT_LE(ambiguous, scene.lights.size() / 20 + 2) << what << ": too many lights within rounding of a boundary";
+  // Statistics, indirect arguments and compaction against the CPU count.
+  const uint32_t visible = static_cast<uint32_t>(expected_visible.size());
+  const uint32_t written = std::min(visible, config.capacity);
+  EXPECT_EQ(run.stats.total, scene.lights.size()) << what;
+  EXPECT_EQ(run.stats.visible, visible) << what;
+  EXPECT_EQ(run.stats.frustum_culled, counts[GLINT_FLARE_FRUSTUM]) << what;
+  EXPECT_EQ(run.stats.occluded, counts[GLINT_FLARE_OCCLUDED]) << what;
+  EXPECT_EQ(run.stats.disabled, counts[GLINT_FLARE_DISABLED]) << what;
+  EXPECT_EQ(run.stats.overflow, visible - written) << what;
+  EXPECT_EQ(run.indirect.vertex_count, 6u);
+  EXPECT_EQ(run.indirect.instance_count, written);
+  EXPECT_EQ(run.indirect.first_vertex, 0u);
+  EXPECT_EQ(run.indirect.first_instance, 0u);
+  EXPECT_EQ(run.indirect.group_count_x, written * 3);
+  EXPECT_EQ(run.indirect.group_count_y, 1u);
+  EXPECT_EQ(run.indirect.group_count_z, 1u);
+  EXPECT_TRUE(run.canary_intact) << what << ": written past the capacity";
+  std::set<uint32_t> seen;
+  for (const auto& inst : run.instances) {
+    EXPECT_TRUE(seen.insert(inst.light_index).second) << what << ": light " << inst.light_index << " twice";
+    if (inst.light_index >= scene.lights.size()) {
+      ADD_FAILURE() << what << ": instance names light " << inst.light_index;
+      continue;
+    }
+    const auto& l = scene.lights[inst.light_index];
+    const auto& res = run.results[inst.light_index];
+    EXPECT_EQ(res.culled, GLINT_FLARE_VISIBLE);
+    EXPECT_EQ(inst.visible_fraction, res.visible_fraction);
+    EXPECT_EQ(inst.size_px, l.size_px);
+    EXPECT_EQ(inst.color_g, l.color_g);
+    EXPECT_EQ(inst.intensity, l.intensity);
+    EXPECT_EQ(inst.element, l.element);
+    EXPECT_EQ(inst.reserved, 0u);
+  }
+  if (written == visible) {
+    EXPECT_EQ(seen, expected_visible) << what << ": compacted set differs from the CPU's";
+  } else {
+    for (uint32_t i : seen) EXPECT_TRUE(expected_visible.count(i));
+    uint32_t overflowed = 0;
+    for (const auto& r : run.results) overflowed += r.culled == GLINT_FLARE_OVERFLOW;
+    EXPECT_EQ(overflowed, visible - written) << what;
+  }
+  return tested ? error_sum / tested : 0.0;
+}
+
+struct SceneCase {
+  uint32_t w, h, lights, grid;
+  double max_size;
+};
+
+TEST_F(OcclusionTest, CullMatchesReferenceOnRandomScenes) {
+  const SceneCase cases[] = {{257, 143, 600, 4, 120}, {257, 143, 300, 1, 120}, {200, 111, 300, 16, 200},
+                             {161, 97, 300, 7, 60},   {1, 1, 40, 4, 10},       {7, 3, 80, 4, 12},
+                             {4097, 2, 200, 4, 300}};
+  uint32_t seed = 11;
+  for (const SceneCase& c : cases) {
+    for (bool reversed : {false, true}) {
+      for (CompactionPath path : {CompactionPath::automatic, CompactionPath::shared}) {
+        const auto scene = reference::random_scene(c.w, c.h, c.lights, seed++, reversed, c.max_size);
+        LightCullConfig config;
+        config.grid = c.grid;
+        config.capacity = c.lights;
+        config.path = path;
+        float vp[16];
+        for (int i = 0; i < 16; ++i) vp[i] = static_cast<float>(scene.view_proj[i]);
+        const VkFormat format = reversed ? VK_FORMAT_R32_SFLOAT : VK_FORMAT_D32_SFLOAT;
+        const auto run = run_cull(scene.depth, format, reversed, scene.lights, vp, config);
+        const uint32_t levels = static_cast<uint32_t>(std::floor(std::log2(double(std::max(c.w, c.h)))));
+        const std::string what = std::to_string(c.w) + "x" + std::to_string(c.h) + " N=" + std::to_string(c.grid) +
+                                 (reversed ? " reversed" : " standard") +
+                                 (path == CompactionPath::shared ? " shared" : " auto");
+        expect_cull_matches(run, scene, config, reversed, levels, what);
+        // Enough of every kind in the larger scenes that the checks above mean something.
+        if (c.lights >= 300) {
+          EXPECT_GT(run.stats.visible, c.lights / 20) << what;
+          if (c.grid <= 4) {
+            EXPECT_GT(run.stats.occluded, 0u) << what;
+          }
+          EXPECT_GT(run.stats.frustum_culled, c.lights / 20) << what;
+          EXPECT_GT(run.stats.disabled, 0u) << what;
+        }
+      }
+    }
+  }
+}
+
+// A shallow pyramid (max_cell_px) and a depth bias: still exact against the reference.
+TEST_F(OcclusionTest, CullWithCappedPyramidAndBias) {
+  const auto scene = reference::random_scene(190, 130, 400, 77, false, 150);
+  LightCullConfig config;
+  config.capacity = 400;
+  config.depth_bias = 0.02f;
+  config.grid = 2;
+  float vp[16];
+  for (int i = 0; i < 16; ++i) vp[i] = static_cast<float>(scene.view_proj[i]);
+  const auto run = run_cull(scene.depth, VK_FORMAT_D32_SFLOAT, false, scene.lights, vp, config, 4);
+  expect_cull_matches(run, scene, config, false, 2, "capped + bias");
+}
+
+// Capacity overflow: the count is clamped, nothing is written past the capacity, overflow counted.
+// Also two frames in one command buffer: the counters reset between them.
+TEST_F(OcclusionTest, CullOverflowAndRepeatedFrames) {
+  const auto scene = reference::random_scene(150, 100, 500, 5, false, 40);
+  for (uint32_t capacity : {1u, 13u}) {
+    LightCullConfig config;
+    config.capacity = capacity;
+    float vp[16];
+    for (int i = 0; i < 16; ++i) vp[i] = static_cast<float>(scene.view_proj[i]);
+    const auto run = run_cull(scene.depth, VK_FORMAT_D32_SFLOAT, false, scene.lights, vp, config, 0, 2);
+    ASSERT_GT(run.stats.visible, capacity);
+    EXPECT_EQ(run.indirect.instance_count, capacity);
+    EXPECT_EQ(run.stats.overflow, run.stats.visible - capacity);
+    expect_cull_matches(run, scene, config, false, 7, "overflow " + std::to_string(capacity));
+  }
+}
+
+TEST_F(OcclusionTest, ZeroLights) {
+  reference::DepthImage d = random_depth(33, 17, 3);
+  LightCullConfig config;
+  config.capacity = 4;
+  float vp[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+  const auto run = run_cull(d, VK_FORMAT_D32_SFLOAT, false, {}, vp, config);
+  EXPECT_EQ(run.indirect.vertex_count, 6u);
+  EXPECT_EQ(run.indirect.instance_count, 0u);
+  EXPECT_EQ(run.indirect.group_count_x, 0u);
+  EXPECT_EQ(run.indirect.group_count_y, 1u);
+  EXPECT_EQ(run.stats.total, 0u);
+  EXPECT_EQ(run.stats.visible, 0u);
+  EXPECT_EQ(run.stats.frustum_culled + run.stats.occluded + run.stats.overflow + run.stats.disabled, 0u);
+  EXPECT_TRUE(run.canary_intact);
+}
+
+// A light sliding behind an occluder edge fades monotonically, in steps of whole cells. The depth
+// is a near half-plane (an occluder) over a far background; lights move across its edge in
+// 1/8-pixel steps (identity view_proj: position = NDC). Axis-aligned and oblique edges.
+TEST_F(OcclusionTest, MonotoneFadeAcrossAnOccluderEdge) {
+  const uint32_t w = 320, h = 160;
+  for (uint32_t grid : {1u, 4u, 8u}) {
+    for (double slope : {0.0, 0.37}) {
+      reference::DepthImage d{w, h, std::vector<float>(size_t(w) * h)};
+      for (uint32_t y = 0; y < h; ++y) {
+        for (uint32_t x = 0; x < w; ++x)
+          d.depth[size_t(y) * w + x] = (x + 0.5 < 160.0 + slope * (y + 0.5 - 80.0)) ? 0.2f : 0.9f;
+      }
+      std::vector<GlintFlareLight> lights;
+      const float size = 48.0f;
+      for (int s = 0; s <= 8 * 240; ++s) {  // centre from x = 280 (fully visible) to 40 (fully behind)
+        GlintFlareLight l{};
+        const double px = 280.0 - s / 8.0;
+        l.position_x = static_cast<float>(px / w * 2.0 - 1.0);
+        l.position_y = static_cast<float>(80.3 / h * 2.0 - 1.0);
+        l.position_z = 0.5f;
+        l.size_px = size;
+        l.enabled = 1;
+        lights.push_back(l);
+      }
+      LightCullConfig config;
+      config.grid = grid;
+      config.capacity = static_cast<uint32_t>(lights.size());
+      float vp[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+      const auto run = run_cull(d, VK_FORMAT_D32_SFLOAT, false, lights, vp, config);
+      const double n2 = double(grid) * grid;
+      double max_step = 0.0;
+      const std::string what = "N=" + std::to_string(grid) + " slope " + std::to_string(slope);
+      EXPECT_EQ(run.results.front().visible_fraction, 1.0f) << what;
+      EXPECT_EQ(run.results.back().culled, GLINT_FLARE_OCCLUDED) << what;
+      for (size_t i = 0; i < run.results.size(); ++i) {
+        const double f = run.results[i].visible_fraction;
+        EXPECT_NEAR(f * n2, std::round(f * n2), 1e-4) << what << ": not a multiple of 1/N^2";
+        if (i == 0) continue;
+        const double prev = run.results[i - 1].visible_fraction;
+        EXPECT_LE(f, prev) << what << ": fraction rose at step " << i;
+        max_step = std::max(max_step, prev - f);
+      }
+      // docs/OCCLUSION.md: a level-k texel column flips at once, so an axis-aligned edge moves the
+      // fraction by at most the cells of two columns (2N / N^2); an oblique edge flips fewer.
+      EXPECT_LE(max_step, 2.0 * grid / n2 + 1e-6) << what;
+      std::printf("%s: largest step %.4f (1/N^2 = %.4f)\n", what.c_str(), max_step, 1.0 / n2);
+    }
+  }
+}
+
+// Bad settings and arguments throw Error naming the field, before anything is recorded or made.
+TEST_F(OcclusionTest, BadConfigAndArgumentsThrow) {
+  auto expect_error = [](auto&& f, ErrorCode code, const std::string& needle) {
+    try {
+      f();
+      ADD_FAILURE() << "no error for " << needle;
+    } catch (const Error& e) {
+      EXPECT_EQ(e.code(), code) << e.what();
+      EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+    }
+  };
+  HiZConfig hc;
+  expect_error([&] { HiZPyramid(context(), hc); }, ErrorCode::invalid_argument, "HiZConfig::extent.width = 0");
+  hc.extent = {16385, 4};
+  expect_error([&] { HiZPyramid(context(), hc); }, ErrorCode::invalid_argument, "accepted 1 to 16384");
+  hc.extent = {64, 64};
+  hc.format = VK_FORMAT_R16G16B16A16_SFLOAT;
+  expect_error([&] { HiZPyramid(context(), hc); }, ErrorCode::unsupported_format, "HiZConfig::format");
+  hc.format = VK_FORMAT_D32_SFLOAT;
+  hc.max_cell_px = 20000;
+  expect_error([&] { HiZPyramid(context(), hc); }, ErrorCode::invalid_argument, "HiZConfig::max_cell_px = 20000");
+  hc.max_cell_px = 0;
+  LightCullConfig cc;
+  cc.grid = 17;
+  expect_error([&] { LightCuller(context(), cc); }, ErrorCode::invalid_argument, "LightCullConfig::grid = 17");
+  cc.grid = 0;
+  expect_error([&] { LightCuller(context(), cc); }, ErrorCode::invalid_argument, "accepted 1 to 16");
+  cc.grid = 4;
+  cc.margin_ndc = std::nanf("");
+  expect_error([&] { LightCuller(context(), cc); }, ErrorCode::invalid_argument, "LightCullConfig::margin_ndc");
+  cc.margin_ndc = 1.2f;
+  cc.capacity = 0;
+  expect_error([&] { LightCuller(context(), cc); }, ErrorCode::invalid_argument, "LightCullConfig::capacity = 0");
+  cc.capacity = 8;
+
+  // Record-time errors: nothing may be recorded (the command buffer stays valid and empty of our
+  // work) and no Vulkan object may be made.
+  const auto d = random_depth(64, 64, 4);
+  auto img = make_depth(d, VK_FORMAT_D32_SFLOAT);
+  auto other = make_depth(random_depth(32, 64, 5), VK_FORMAT_D32_SFLOAT);
+  HiZPyramid hiz(context(), hc);
+  LightCuller culler(context(), cc);
+  HostBuffer lights(10 * sizeof(GlintFlareLight)), inst(8 * sizeof(GlintFlareInstance)), small(8),
+      indirect(sizeof(GlintFlareIndirect)), stats(sizeof(GlintFlareStats));
+  Buffer no_indirect = indirect.view;
+  no_indirect.usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+  LightCullFrame frame;
+  const uint64_t objects = context().objects_created();
+  context().run_once([&](VkCommandBuffer cmd) {
+    expect_error([&] { hiz.record(cmd, other.state); }, ErrorCode::unsupported_size, "HiZConfig::extent is 64x64");
+    LightCullOutputs out{inst.view, indirect.view, stats.view, {}};
+    expect_error([&] { culler.record(cmd, hiz, other.state, lights.view, 10, frame, out); },
+                 ErrorCode::invalid_argument, "does not match the Hi-Z pyramid");
+    expect_error([&] { culler.record(cmd, hiz, img.state, lights.view, 11, frame, out); }, ErrorCode::invalid_argument,
+                 "lights buffer holds 480 bytes; 528 needed");
+    expect_error([&] { culler.record(cmd, hiz, img.state, lights.view, cc.max_lights + 1, frame, out); },
+                 ErrorCode::invalid_argument, "count = 1048577");
+    LightCullOutputs bad = out;
+    bad.indirect = no_indirect;
+    expect_error([&] { culler.record(cmd, hiz, img.state, lights.view, 10, frame, bad); }, ErrorCode::missing_usage,
+                 "indirect buffer lacks usage");
+    bad = out;
+    bad.instances = small.view;
+    expect_error([&] { culler.record(cmd, hiz, img.state, lights.view, 10, frame, bad); }, ErrorCode::invalid_argument,
+                 "instances buffer holds 8 bytes; 384 needed");
+    bad = out;
+    bad.stats = {};
+    expect_error([&] { culler.record(cmd, hiz, img.state, lights.view, 10, frame, bad); }, ErrorCode::invalid_argument,
+                 "stats buffer is null");
+    LightCullFrame big = frame;
+    big.groups_per_instance = 65535;
+    expect_error([&] { culler.record(cmd, hiz, img.state, lights.view, 10, big, out); }, ErrorCode::invalid_argument,
+                 "maxComputeWorkGroupCount");
+    LightCullFrame nan = frame;
+    nan.view_proj[5] = std::nanf("");
+    expect_error([&] { culler.record(cmd, hiz, img.state, lights.view, 10, nan, out); }, ErrorCode::invalid_argument,
+                 "view_proj[5]");
+  });
+  EXPECT_EQ(context().objects_created(), objects);
+  EXPECT_EQ(img.state.layout, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL) << "a failed record changed the depth state";
+}
+
+// Recording a second frame with the same resources makes no Vulkan object.
+TEST_F(OcclusionTest, SecondFrameCreatesNoObjects) {
+  const auto scene = reference::random_scene(120, 80, 50, 8, false, 30);
+  auto img = make_depth(scene.depth, VK_FORMAT_D32_SFLOAT);
+  HiZConfig hc;
+  hc.extent = {120, 80};
+  HiZPyramid hiz(context(), hc);
+  LightCuller culler(context(), {});
+  HostBuffer lights(50 * sizeof(GlintFlareLight)), inst(1024 * sizeof(GlintFlareInstance)),
+      indirect(sizeof(GlintFlareIndirect)), stats(sizeof(GlintFlareStats)), results(50 * 8);
+  std::memcpy(lights.owned.mapped(), scene.lights.data(), 50 * sizeof(GlintFlareLight));
+  LightCullOutputs out{inst.view, indirect.view, stats.view, results.view};
+  LightCullFrame frame;
+  for (int i = 0; i < 16; ++i) frame.view_proj[i] = static_cast<float>(scene.view_proj[i]);
+  auto record = [&] {
+    context().run_once([&](VkCommandBuffer cmd) {
+      hiz.record(cmd, img.state);
+      culler.record(cmd, hiz, img.state, lights.view, 50, frame, out);
+    });
+  };
+  record();
+  const uint64_t objects = context().objects_created();
+  record();
+  record();
+  EXPECT_EQ(context().objects_created(), objects);
+}
+
+}  // namespace
+}  // namespace glint::test
