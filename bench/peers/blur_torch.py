@@ -51,7 +51,14 @@ def median_us(run, reps, warmup, event_factory, synchronize):
         run()
         b.record()
     synchronize()
-    return statistics.median([a_b[0].elapsed_time(a_b[1]) * 1e3 for a_b in events])  # ms -> us
+    def elapsed_ms(a, b):
+        if hasattr(a, "elapsed_time"):  # torch.cuda.Event
+            return a.elapsed_time(b)
+        import cupy  # cupy.cuda.Event has no method; the module function times a pair
+
+        return cupy.cuda.get_elapsed_time(a, b)
+
+    return statistics.median([elapsed_ms(a, b) * 1e3 for a, b in events])  # ms -> us
 
 
 def torch_peers(width, height, sigma, reps, results):
