@@ -98,27 +98,30 @@ struct FusedShape {
   uint32_t rows = 1;
 };
 
-uint32_t fused_shared_bytes(FusedShape s, uint32_t radius) {
+// Shared memory of kernels/blur_level.comp: the loaded tile + apron and the horizontal pass's
+// rows, 16 bytes a texel (8 packed as fp16).
+uint32_t fused_shared_bytes(FusedShape s, uint32_t radius, bool half_shared) {
   const uint32_t w = s.workgroup.x, h = s.workgroup.y * s.rows;
-  return 16 * ((w + 2 * radius) * (h + 2 * radius) + w * (h + 2 * radius));
+  const auto padded = [](uint32_t n) { return n + (17 - n % 16) % 16; };  // LOAD_S, ROW_S
+  return (half_shared ? 8 : 16) * (padded(w + 2 * radius) * (h + 2 * radius) + padded(w) * (h + 2 * radius));
 }
 
 // The largest tile whose shared memory fits the device (STYLE rule 3): larger tiles re-read less
 // apron. CPU devices (lavapipe) get 8-row-high tiles, which keep their per-thread groups small.
-FusedShape fused_shape(const DeviceInfo& info, uint32_t radius) {
+FusedShape fused_shape(const DeviceInfo& info, uint32_t radius, bool half_shared = false) {
   static const FusedShape gpu[] = {{{32, 8}, 4}, {{32, 8}, 2}, {{32, 8}, 1}, {{16, 8}, 2}, {{16, 8}, 1}, {{8, 8}, 1}};
-  static const FusedShape cpu[] = {{{16, 8}, 1}, {{8, 8}, 1}};
+  static const FusedShape cpu[] = {{{16, 8}, 1}, {{8, 8}, 1}};  // widths are multiples of 4 (RUN)
   const bool is_cpu = info.type == VK_PHYSICAL_DEVICE_TYPE_CPU;
   const FusedShape* begin = is_cpu ? cpu : gpu;
   const FusedShape* end = is_cpu ? cpu + 2 : gpu + 6;
   for (const FusedShape* s = begin; s != end; ++s) {
     if (s->workgroup.x * s->workgroup.y <= info.max_workgroup_invocations &&
-        fused_shared_bytes(*s, radius) <= info.max_shared_memory_bytes) {
+        fused_shared_bytes(*s, radius, half_shared) <= info.max_shared_memory_bytes) {
       return *s;
     }
   }
   throw Error(ErrorCode::no_device,
-              concat("blur radius ", radius, " needs ", fused_shared_bytes({{8, 8}, 1}, radius),
+              concat("blur radius ", radius, " needs ", fused_shared_bytes({{8, 8}, 1}, radius, half_shared),
                      " bytes of shared memory; device '", info.name, "' has ", info.max_shared_memory_bytes));
 }
 
@@ -332,10 +335,17 @@ Step fused_step(StepProgram& prog, const DeviceInfo& info, int src, int dst, VkE
   if (radius > kFusedMaxRadius)
     throw Error(ErrorCode::invalid_argument, concat("blur sigma ", sigma, " needs radius ", radius,
                                                     "; the fused kernel takes at most ", kFusedMaxRadius));
-  const FusedShape shape = fused_shape(info, radius);
+  // Where the result is stored as fp16, the shared copies may be too (half the shared traffic).
+  const bool half_shared = dst_format == VK_FORMAT_R16G16B16A16_SFLOAT;
+  const FusedShape shape = fused_shape(info, radius, half_shared);
+  // The source read, fixed per pipeline so each variant compiles only its own path.
+  const bool same = src_size.width == dst_size.width && src_size.height == dst_size.height;
+  const bool exact_half = src_size.width == 2 * dst_size.width && src_size.height == 2 * dst_size.height;
+  const uint32_t mode = binomial ? 3u : same ? 0u : exact_half ? 1u : 2u;
   Step s;
-  s.pipeline = &prog.pipeline("blur_level", dst_format, shape.workgroup, {shape.rows, radius, binomial ? 1u : 0u},
-                              {VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
+  s.pipeline =
+      &prog.pipeline("blur_level", dst_format, shape.workgroup, {shape.rows, radius, mode, half_shared ? 1u : 0u},
+                     {VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
   s.src = src;
   s.dst = dst;
   s.push = make_push(src_size, dst_size, flags, max_value);
