@@ -161,7 +161,7 @@ FlareScene make_flare_scene(VkExtent2D extent) {
       {0.20, 0.60, 30.0, 1.0f, 0.2f, 0.2f, 4.0f, 80.0f, GLINT_FLARE_ELEMENT_GLOW, true},       // behind the left tower
       {0.43, 0.40, 20.0, 0.2f, 1.0f, 0.2f, 4.0f, 60.0f, GLINT_FLARE_ELEMENT_GLOW, true},       // behind the pillar
       {0.62, 0.80, 40.0, 0.2f, 0.2f, 1.0f, 4.0f, 80.0f, GLINT_FLARE_ELEMENT_GLOW, true},       // behind the right tower
-      {0.48, 0.30, 20.0, 1.0f, 1.0f, 0.6f, 2.5f, 100.0f, GLINT_FLARE_ELEMENT_GLOW, true},      // half behind the pillar
+      {0.465, 0.30, 20.0, 1.0f, 1.0f, 0.6f, 2.5f, 100.0f, GLINT_FLARE_ELEMENT_GLOW, true},     // half behind the pillar
       {0.25, 0.35, 30.0, 1.0f, 0.5f, 0.8f, 2.5f, 90.0f, GLINT_FLARE_ELEMENT_HALO, true},       // on the tower's roof
       {1.25, 0.50, 20.0, 1.0f, 1.0f, 1.0f, 2.0f, 80.0f, GLINT_FLARE_ELEMENT_GLOW, true},       // off screen (culled)
       {0.05, 0.10, 30.0, 1.0f, 1.0f, 1.0f, 2.0f, 80.0f, GLINT_FLARE_ELEMENT_GLOW, false},      // disabled
