@@ -42,9 +42,10 @@ ok --version
 ok devices
 grep -q '^index' "$tmp/out" || fail "glint devices printed no table"
 ok demo --size 96x64 --out "$tmp/demo"
-expect_file "$tmp/demo/scene.exr"
-expect_file "$tmp/demo/bloom.exr"
-expect_file "$tmp/demo/bloom.png"
+for f in scene.exr depth.exr lights.json flares.exr bloom.exr bloom.png; do expect_file "$tmp/demo/$f"; done
+grep -q '^flares: .*lights: 14 total, 2 frustum-culled, 3 occluded, 8 visible (0 overflow), 1 disabled' "$tmp/out" ||
+  fail "glint demo flare statistics: $(grep '^flares' "$tmp/out")"
+grep -q 'flare raster' "$tmp/out" || grep -q 'not available' "$tmp/out" || fail "glint demo printed no flare stage"
 grep -q 'total' "$tmp/out" || grep -q 'not available' "$tmp/out" || fail "glint demo printed no stage times"
 scene="$tmp/demo/scene.exr"
 for filter in cod13 dual gauss9; do
@@ -144,6 +145,125 @@ printf '1,2,3\n' >"$tmp/short.csv"
 bad lod --levels 13 "$tmp/short.csv" "$tmp/x.csv"
 printf '0.1,0,0,0.1,nan?,4,0,0\n' >"$tmp/junk.csv"
 bad lod --levels 13 "$tmp/junk.csv" "$tmp/x.csv"
+
+# glint flare: the demo's scene, depth and light list replayed. The statistics must be the demo's,
+# with one entry per light in input order, for every preset and both drawing paths.
+# check_stats FILE TOTAL FRUSTUM OCCLUDED VISIBLE OVERFLOW DISABLED
+check_stats() {
+  python3 - "$@" <<'PY' || fail "stats $1 do not match: $(head -c 300 "$1")"
+import json, sys
+path, total, frustum, occluded, visible, overflow, disabled = sys.argv[1], *map(int, sys.argv[2:])
+s = json.load(open(path))
+assert (s["total"], s["frustum_culled"], s["occluded"], s["visible"], s["overflow"], s["disabled"]) == \
+    (total, frustum, occluded, visible, overflow, disabled), s
+lights = s["lights"]
+assert len(lights) == total
+names = [l["culled"] for l in lights]
+assert names.count("frustum") == frustum and names.count("occluded") == occluded
+assert names.count("disabled") == disabled and names.count("overflow") == overflow
+assert names.count(None) == visible - overflow
+for l in lights:
+    f = l["visible_fraction"]
+    assert (0 < f <= 1) if l["culled"] is None else f == 0, l
+PY
+}
+d="$tmp/demo"
+flare_args=(--color "$d/scene.exr" --depth "$d/depth.exr" --lights "$d/lights.json")
+for preset in retro_subtle RETRO_INTENSE Cinematic disabled; do
+  for draw in raster compute; do
+    ok flare "${flare_args[@]}" "$tmp/f_${preset}_$draw.exr" --preset "$preset" --draw "$draw" \
+      --stats "$tmp/s_${preset}_$draw.json"
+    expect_file "$tmp/f_${preset}_$draw.exr"
+    check_stats "$tmp/s_${preset}_$draw.json" 14 2 3 8 0 1
+  done
+done
+# The light list's order is kept: the demo's lights 7-9 are the ones behind the occluders.
+python3 -c '
+import json, sys
+s = json.load(open(sys.argv[1]))
+assert [l["culled"] for l in s["lights"]][6:9] == ["occluded"] * 3, s["lights"]
+' "$tmp/s_Cinematic_raster.json" || fail "glint flare stats are not in input order"
+ok flare "${flare_args[@]}" "$tmp/f_grid.exr" --grid 16 --fp32
+ok flare "${flare_args[@]}" "$tmp/f_grid1.exr" --grid 1 --stats "$tmp/s_grid1.json"
+check_stats "$tmp/s_grid1.json" 14 2 3 8 0 1
+# --reverse-z on the demo's standard depth: the far plane (1) now counts as near, so the sky lights
+# become occluded; the frustum and disabled verdicts do not depend on the depth.
+ok flare "${flare_args[@]}" "$tmp/f_rev.exr" --reverse-z --stats "$tmp/s_rev.json"
+python3 -c '
+import json, sys
+s = json.load(open(sys.argv[1]))
+assert s["total"] == 14 and s["frustum_culled"] == 2 and s["disabled"] == 1 and s["occluded"] > 3, s
+' "$tmp/s_rev.json" || fail "glint flare --reverse-z stats: $(head -c 200 "$tmp/s_rev.json")"
+python3 - "$d/lights.json" "$tmp/empty_lights.json" "$tmp/many.json" <<'PY'
+import json, sys
+src = json.load(open(sys.argv[1]))
+json.dump({"view_proj": src["view_proj"], "lights": []}, open(sys.argv[2], "w"))
+# 2000 copies of the demo's first (visible) light: more than the compute path's capacity on some
+# devices is fine, overflow is reported per light.
+json.dump({"view_proj": src["view_proj"], "lights": [src["lights"][0]] * 2000}, open(sys.argv[3], "w"))
+PY
+ok flare --color "$d/scene.exr" --depth "$d/depth.exr" --lights "$tmp/empty_lights.json" "$tmp/f_none.exr" \
+  --stats "$tmp/s_none.json"
+check_stats "$tmp/s_none.json" 0 0 0 0 0 0
+ok flare --color "$d/scene.exr" --depth "$d/depth.exr" --lights "$tmp/many.json" "$tmp/f_many.exr" --draw compute \
+  --stats "$tmp/s_many.json"
+python3 -c '
+import json, sys
+s = json.load(open(sys.argv[1]))
+assert s["total"] == 2000 and s["visible"] == 2000 and len(s["lights"]) == 2000, s["total"]
+assert sum(l["culled"] is None for l in s["lights"]) + s["overflow"] == 2000
+' "$tmp/s_many.json" || fail "glint flare with 2000 lights on one spot"
+
+# glint flare: bad command lines, files and light lists (exit 2, one line).
+bad flare "${flare_args[@]}"
+bad flare --depth "$d/depth.exr" --lights "$d/lights.json" "$tmp/x.exr"
+bad flare "${flare_args[@]}" "$tmp/x.exr" --preset sparkly
+bad flare "${flare_args[@]}" "$tmp/x.exr" --grid 0
+bad flare "${flare_args[@]}" "$tmp/x.exr" --grid 17
+bad flare "${flare_args[@]}" "$tmp/x.exr" --grid -1
+bad flare "${flare_args[@]}" "$tmp/x.exr" --draw splat
+bad flare "${flare_args[@]}" "$tmp/x.exr" --no-such-flag
+bad flare "${flare_args[@]}" "$tmp/x.exr" --stats "$tmp/no/such/dir/s.json"
+bad flare "${flare_args[@]}" "$tmp/no/such/dir/x.exr"
+bad flare "${flare_args[@]}" "$tmp/x.exr" --device no-such-gpu
+bad flare --color "$tmp/missing.exr" --depth "$d/depth.exr" --lights "$d/lights.json" "$tmp/x.exr"
+bad flare --color "$d/scene.exr" --depth "$tmp/missing.exr" --lights "$d/lights.json" "$tmp/x.exr"
+bad flare --color "$d/scene.exr" --depth "$d/depth.exr" --lights "$tmp/missing.json" "$tmp/x.exr"
+bad flare --color "$d/scene.exr" --depth "$d/depth.exr" --lights "$tmp" "$tmp/x.exr"
+bad flare --color "$d/scene.exr" --depth "$tmp/noise.exr" --lights "$d/lights.json" "$tmp/x.exr"
+bad flare --color "$d/scene.exr" --depth "$tmp/tiny/depth.exr" --lights "$d/lights.json" "$tmp/x.exr"  # 1x1
+grep -q 'sizes must match' "$tmp/err" || fail "size mismatch message: $(cat "$tmp/err")"
+# Bad JSON of each kind: the message names the JSON path.
+bad_json() {  # bad_json 'TEXT' 'EXPECTED PART OF THE MESSAGE'
+  printf '%s' "$1" >"$tmp/bad.json"
+  bad flare --color "$d/scene.exr" --depth "$d/depth.exr" --lights "$tmp/bad.json" "$tmp/x.exr"
+  grep -qF -- "$2" "$tmp/err" || fail "bad JSON '$1': message lacks '$2': $(cat "$tmp/err")"
+}
+vp='[1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,1]'
+bad_json '' 'invalid JSON'
+bad_json '{"view_proj": '"$vp"', "lights": [' 'invalid JSON'
+bad_json '[]' 'expected an object'
+bad_json '{"lights": []}' 'view_proj: missing'
+bad_json '{"view_proj": '"$vp"'}' 'lights: missing'
+bad_json '{"view_proj": [1,2,3], "lights": []}' 'view_proj: has 3 numbers'
+bad_json '{"view_proj": '"$vp"', "lights": [{"color": [1,1,1]}]}' 'lights[0]: "position" is missing'
+bad_json '{"view_proj": '"$vp"', "lights": [{"position": [0,0]}]}' 'lights[0].position: has 2 numbers'
+bad_json '{"view_proj": '"$vp"', "lights": [{"position": [0,0,"1"]}]}' 'lights[0].position[2]: expected'
+bad_json '{"view_proj": '"$vp"', "lights": [{"position": [0,0,0], "intensity": -1}]}' 'lights[0].intensity: -1'
+bad_json '{"view_proj": '"$vp"', "lights": [{"position": [0,0,0], "size": -2}]}' 'lights[0].size: -2'
+bad_json '{"view_proj": '"$vp"', "lights": [{"position": [0,0,0], "size": 1e6}]}' 'at most 4096'
+bad_json '{"view_proj": '"$vp"', "lights": [{"position": [0,0,0], "element": "sparkle"}]}' 'unknown element'
+bad_json '{"view_proj": '"$vp"', "lights": [{"position": [0,1e39,0]}]}' 'float range'
+bad_json '{"view_proj": '"$vp"', "lights": [{"position": [0,1e999,0]}]}' 'overflow'
+bad_json '{"view_proj": '"$vp"', "lights": [{"position": [0,NaN,0]}]}' 'invalid JSON'
+bad_json '{"view_proj": '"$vp"', "lights": [], "extra": 1}' 'unknown key'
+bad_json '{"view_proj": '"$vp"', "lights": [{"position": [0,0,0], "size": 1, "size": 2}]}' 'duplicate key'
+python3 -c 'print("[" * 200000)' >"$tmp/deep.json"
+bad flare --color "$d/scene.exr" --depth "$d/depth.exr" --lights "$tmp/deep.json" "$tmp/x.exr"
+python3 -c 'print("{\"lights\": [" + "[" * 200000)' >"$tmp/deep2.json"
+bad flare --color "$d/scene.exr" --depth "$d/depth.exr" --lights "$tmp/deep2.json" "$tmp/x.exr"
+head -c 4096 /dev/urandom >"$tmp/noise.json"
+bad flare --color "$d/scene.exr" --depth "$d/depth.exr" --lights "$tmp/noise.json" "$tmp/x.exr"
 
 if ((failures)); then
   printf 'cli_test: %d failure(s)\n' "$failures" >&2

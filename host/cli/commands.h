@@ -25,6 +25,7 @@ Command add_demo_command(CLI::App& app);
 Command add_lod_command(CLI::App& app);
 Command add_blur_command(CLI::App& app);
 Command add_gauss_command(CLI::App& app);
+Command add_flare_command(CLI::App& app);
 
 // ---- helpers shared by the commands (common.cpp) ----
 

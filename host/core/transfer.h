@@ -4,16 +4,16 @@
 
 #include <glint/glint.h>
 
+#include <vector>
+
 #include "core/cpu_image.h"
 #include "core/resources.h"
-
-#include <vector>
 
 namespace glint::detail {
 
 /// Usage that test and tool images get: sampled, storage, transfer source and destination.
 inline constexpr VkImageUsageFlags kToolImageUsage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_STORAGE_BIT |
-                                                    VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
+                                                     VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
 
 /// Copies `pixels` (RGBA float; converted to half for RGBA16F) into `image` and leaves it in
 /// TRANSFER_DST_OPTIMAL, last written by a transfer. Sizes must match.
@@ -30,6 +30,25 @@ void upload_r32(const Context& context, Image& image, const std::vector<float>& 
 /// of its first `level_count` mips (the state is updated and covers them all).
 std::vector<float> download_r32(const Context& context, Image& image, uint32_t level, VkExtent2D extent,
                                 uint32_t level_count = 1);
+
+// The same, recorded into a caller's command buffer (so that uploads, effects and readbacks share
+// one submission): make_*_staging() makes and fills a host-visible buffer, record_upload() /
+// record_readback() record the barrier and the copy (readback adds the barrier to host reads),
+// read_staged() converts what a completed readback left in its staging buffer.
+
+/// A staging buffer holding `pixels` in `image`'s format (RGBA16F or RGBA32F; sizes must match).
+OwnedBuffer make_upload_staging(const Context& context, const Image& image, const CpuImage& pixels);
+/// A staging buffer holding one float per texel of a D32_SFLOAT or R32_SFLOAT `image`.
+OwnedBuffer make_upload_staging_r32(const Context& context, const Image& image, const std::vector<float>& values);
+/// Records the copy of a whole staging buffer into mip 0 of `image` (depth aspect for D32), leaving
+/// it in TRANSFER_DST_OPTIMAL, last written by a transfer.
+void record_upload(VkCommandBuffer cmd, const OwnedBuffer& staging, Image& image);
+/// A host-visible buffer for reading mip 0 of `image` back.
+OwnedBuffer make_readback_staging(const Context& context, const Image& image);
+/// Records the copy of mip 0 of a colour `image` into `staging` and the barrier to host reads.
+void record_readback(VkCommandBuffer cmd, Image& image, const OwnedBuffer& staging);
+/// `image`'s texels (RGBA16F or RGBA32F) from a staging buffer a completed readback filled.
+CpuImage read_staged(const OwnedBuffer& staging, const Image& image);
 
 /// Fills `image` with `value` in every channel (NaN poisons: an unwritten texel stays NaN).
 void fill(const Context& context, Image& image, float value);

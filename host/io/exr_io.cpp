@@ -4,15 +4,15 @@
 // subclasses); each is caught here and re-thrown as glint::Error(io_failure) naming the path.
 #include "io/exr_io.h"
 
-#include <glint/glint.h>
-
+#include <ImathBox.h>
 #include <ImfChannelList.h>
 #include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
 #include <ImfInputFile.h>
+#include <ImfOutputFile.h>
 #include <ImfRgbaFile.h>
 #include <ImfTestFile.h>
-#include <ImathBox.h>
+#include <glint/glint.h>
 #include <half.h>
 
 #include <algorithm>
@@ -87,7 +87,8 @@ Window checked_window(const std::string& path, const Imf::Header& header) {
   const int64_t width = int64_t(w.box.max.x) - w.box.min.x + 1;
   const int64_t height = int64_t(w.box.max.y) - w.box.min.y + 1;
   if (width <= 0 || height <= 0) fail(path, "empty data window (zero-size image)");
-  if (width > kMaxImageDimension || height > kMaxImageDimension || uint64_t(width) * uint64_t(height) > kMaxImagePixels) {
+  if (width > kMaxImageDimension || height > kMaxImageDimension ||
+      uint64_t(width) * uint64_t(height) > kMaxImagePixels) {
     std::ostringstream m;
     m << "image is " << width << "x" << height << ", larger than glint reads (at most " << kMaxImageDimension
       << " on a side and " << kMaxImagePixels << " pixels)";
@@ -146,12 +147,13 @@ auto guarded(const std::string& path, const char* action, F&& body) -> decltype(
 
 void check_writable_image(const std::string& path, const CpuImage& image) {
   if (image.width == 0 || image.height == 0) {
-    fail(path, "cannot write an empty image (" + std::to_string(image.width) + "x" + std::to_string(image.height) + ")");
+    fail(path,
+         "cannot write an empty image (" + std::to_string(image.width) + "x" + std::to_string(image.height) + ")");
   }
   if (image.rgba.size() != size_t(image.width) * image.height * 4) {
-    throw Error(ErrorCode::invalid_argument, path + ": CpuImage has " + std::to_string(image.rgba.size()) +
-                                                 " floats; width * height * 4 = " +
-                                                 std::to_string(size_t(image.width) * image.height * 4));
+    throw Error(ErrorCode::invalid_argument,
+                path + ": CpuImage has " + std::to_string(image.rgba.size()) +
+                    " floats; width * height * 4 = " + std::to_string(size_t(image.width) * image.height * 4));
   }
   if (image.width > kMaxImageDimension || image.height > kMaxImageDimension ||
       uint64_t(image.width) * image.height > kMaxImagePixels) {
@@ -221,8 +223,7 @@ ExrChannel read_exr_channel(const std::string& path, const std::string& preferre
     out.height = w.height;
     out.values.assign(size_t(w.width) * w.height, 0.0f);
     Imf::FrameBuffer fb;
-    fb.insert(out.name, Imf::Slice::Make(Imf::FLOAT, out.values.data(), w.box, sizeof(float),
-                                         sizeof(float) * w.width));
+    fb.insert(out.name, Imf::Slice::Make(Imf::FLOAT, out.values.data(), w.box, sizeof(float), sizeof(float) * w.width));
     file.setFrameBuffer(fb);
     file.readPixels(w.box.min.y, w.box.max.y);
     return out;
@@ -242,6 +243,32 @@ void write_exr_half(const std::string& path, const CpuImage& image) {
     Imf::RgbaOutputFile file(path.c_str(), header, Imf::WRITE_RGBA);
     file.setFrameBuffer(pixels.data(), 1, image.width);
     file.writePixels(int(image.height));
+  });
+}
+
+void write_exr_channel(const std::string& path, const std::string& name, uint32_t width, uint32_t height,
+                       const std::vector<float>& values) {
+  limit_openexr_sizes();
+  if (name.empty()) throw Error(ErrorCode::invalid_argument, path + ": empty channel name");
+  if (width == 0 || height == 0 || width > kMaxImageDimension || height > kMaxImageDimension ||
+      uint64_t(width) * height > kMaxImagePixels) {
+    fail(path, "cannot write a " + std::to_string(width) + "x" + std::to_string(height) + " image (1 to " +
+                   std::to_string(kMaxImageDimension) + " on a side)");
+  }
+  if (values.size() != size_t(width) * height) {
+    throw Error(ErrorCode::invalid_argument, path + ": " + std::to_string(values.size()) + " values for a " +
+                                                 std::to_string(width) + "x" + std::to_string(height) + " image");
+  }
+  guarded(path, "write OpenEXR file", [&] {
+    Imf::Header header(static_cast<int>(width), static_cast<int>(height));  // ZIP compression by default
+    header.channels().insert(name, Imf::Channel(Imf::FLOAT));
+    Imf::OutputFile file(path.c_str(), header);
+    Imf::FrameBuffer fb;
+    // OpenEXR's Slice takes a non-const pointer but only reads through it when writing.
+    fb.insert(name, Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(const_cast<float*>(values.data())), sizeof(float),
+                               sizeof(float) * width));
+    file.setFrameBuffer(fb);
+    file.writePixels(static_cast<int>(height));
   });
 }
 

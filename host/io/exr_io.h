@@ -52,6 +52,13 @@ ExrChannel read_exr_channel(const std::string& path, const std::string& preferre
 /// image: must be non-empty, with rgba.size() == width * height * 4 (else Error(invalid_argument)).
 void write_exr_half(const std::string& path, const CpuImage& image);
 
+/// Writes one float channel called `name` (e.g. "Z" for depth) as a 32-bit float OpenEXR file (ZIP
+/// compression), replacing `path`; read_exr_channel() reads it back bit for bit.
+/// path: the file to write; its directory must exist.
+/// values: width * height floats, row-major, top row first (else Error(invalid_argument)).
+void write_exr_channel(const std::string& path, const std::string& name, uint32_t width, uint32_t height,
+                       const std::vector<float>& values);
+
 /// Throws Error naming `path` unless `image` can be written: non-empty, its pixel buffer
 /// width * height * 4 floats, and within the size limits above. Shared by the EXR and PNG writers.
 void check_writable_image(const std::string& path, const CpuImage& image);
