@@ -346,6 +346,11 @@ void LightCullConfig::validate() const {
     throw Error(ErrorCode::invalid_argument,
                 concat("LightCullConfig::path = ", p, " is not a CompactionPath: accepted automatic, ballot, shared"));
   }
+  const auto q = static_cast<uint32_t>(pattern);
+  if (q > 1) {
+    throw Error(ErrorCode::invalid_argument, concat("LightCullConfig::pattern = ", q,
+                                                    " is not an OcclusionPattern: accepted multi_jittered, regular"));
+  }
 }
 
 struct LightCuller::Impl {
@@ -529,7 +534,8 @@ void LightCuller::record(VkCommandBuffer cmd, HiZPyramid& hiz, Image& depth, Buf
     push.capacity = m.config.capacity;
     push.grid = m.config.grid;
     push.levels = hiz.levels();
-    push.flags = (hc.reversed_z ? GLINT_CULL_REVERSED_Z : 0u) | (want_results ? GLINT_CULL_WRITE_RESULTS : 0u);
+    push.flags = (hc.reversed_z ? GLINT_CULL_REVERSED_Z : 0u) | (want_results ? GLINT_CULL_WRITE_RESULTS : 0u) |
+                 (m.config.pattern == OcclusionPattern::regular ? GLINT_CULL_REGULAR_GRID : 0u);
     push.margin_ndc = m.config.margin_ndc;
     push.depth_bias = m.config.depth_bias;
     m.cull.dispatch(cmd, cull_set, push, count, 1);

@@ -9,12 +9,15 @@
 // 004 "Method 4", grid test on the Hi-Z of "Method 3"). One invocation per light:
 // 1. project (Vulkan conventions); reject disabled lights, w <= 0, depth outside [0, 1] and
 //    |ndc.xy| > margin;
-// 2. grid test: the light's size_px square is cut into N x N cells; a cell is visible when any
-//    depth texel under it is not nearer than the light. It is read at Hi-Z level
-//    k = ceil(log2(cell size)), where a cell touches at most 2x2 texels, each holding the
-//    farthest depth of its pixels, so the test is conservative (docs/OCCLUSION.md derives the
-//    error bound). Pixels off screen read the nearest edge pixel (clamp to edge).
-//    visible_fraction = visible cells / N^2;
+// 2. grid test: the light's size_px square is cut into N x N cells, each holding one
+//    multi-jittered sample (Chiu, Shirley & Wang 1994: distinct x and y sub-positions over all
+//    N^2 samples, so an occluder edge sliding across the light flips one sample at a time). A
+//    sample is visible when any depth texel under its one-cell footprint is not nearer than the
+//    light. It is read at Hi-Z level k = ceil(log2(cell size)), where a footprint touches at most
+//    2x2 texels (3x3 on the light's border), each holding the farthest depth of its pixels; the
+//    footprints cover the light, so the test is conservative (docs/OCCLUSION.md proves it and
+//    derives the error and step bounds). Pixels off screen read the nearest edge pixel.
+//    visible_fraction = visible samples / N^2;
 // 3. compaction: visible lights are appended to the instance buffer, with one atomic per subgroup
 //    (ballot + exclusive bit count, Wihlidal GDC 2016) or, without subgroup ballot, one per
 //    workgroup (shared-memory counter). Slots at or beyond the capacity are never written.
@@ -60,10 +63,25 @@ ivec2 texel_range(float lo, float hi, int k, int pixels, int lsize) {
   return ivec2(min(p0 >> k, lsize - 1), min(max(p0, p1) >> k, lsize - 1));
 }
 
+// Footprint of the sample of cell (i, j) along one axis, in units of cell / (2n) from the light's
+// left (top) edge: [lo, hi). Multi-jittered (Chiu, Shirley & Wang 1994, canonical arrangement):
+// the sample of cell (i, j) sits at x = i + (j + 0.5) / n, y = j + (i + 0.5) / n cells, so all n^2
+// samples have distinct x and distinct y sub-positions (spaced cell / n). Its footprint is one cell
+// wide, centred on the sample; on the light's outer border it reaches (n - 1) / (2n) cell further out
+// so that the footprints cover the whole light (docs/OCCLUSION.md proves it). Call with
+// (i, j) for x and (j, i) for y. Regular grid (GLINT_CULL_REGULAR_GRID): the cell itself.
+ivec2 sample_span(int i, int j, int n, bool regular) {
+  if (regular) return ivec2(2 * n * i, 2 * n * (i + 1));
+  const int centre = 2 * n * i + 2 * j + 1;
+  return ivec2(i == 0 ? 2 * j + 2 - 2 * n : centre - n, i == n - 1 ? 2 * n * n + 2 * j : centre + n);
+}
+
 // Visible fraction of the size_px square centred at `center` (pixels) for a light at depth `z`.
 float grid_test(vec2 center, float size, float z) {
   const int n = int(pc.grid);
+  const bool regular = (pc.flags & GLINT_CULL_REGULAR_GRID) != 0u;
   const float cell = size / float(n);
+  const float unit = size / float(2 * n * n);  // cell / (2n), the unit of sample_span
   const int k = min(cell <= 1.0 ? 0 : ceil_log2(cell), int(pc.levels));
   const ivec2 lsize = max(ivec2(1), ivec2(pc.width, pc.height) >> k);
   const bool reversed = (pc.flags & GLINT_CULL_REVERSED_Z) != 0u;
@@ -71,9 +89,10 @@ float grid_test(vec2 center, float size, float z) {
   const vec2 origin = center - 0.5 * size;
   int visible = 0;
   for (int j = 0; j < n; ++j) {
-    const ivec2 ty = texel_range(origin.y + float(j) * cell, origin.y + float(j + 1) * cell, k, pc.height, lsize.y);
     for (int i = 0; i < n; ++i) {
-      const ivec2 tx = texel_range(origin.x + float(i) * cell, origin.x + float(i + 1) * cell, k, pc.width, lsize.x);
+      const ivec2 sx = sample_span(i, j, n, regular), sy = sample_span(j, i, n, regular);
+      const ivec2 tx = texel_range(origin.x + float(sx.x) * unit, origin.x + float(sx.y) * unit, k, pc.width, lsize.x);
+      const ivec2 ty = texel_range(origin.y + float(sy.x) * unit, origin.y + float(sy.y) * unit, k, pc.height, lsize.y);
       bool seen = (tx.y - tx.x + 1) * (ty.y - ty.x + 1) > GLINT_CULL_MAX_WINDOW_TEXELS;
       for (int y = ty.x; y <= ty.y && !seen; ++y) {
         for (int x = tx.x; x <= tx.y && !seen; ++x) {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
+#include <stdexcept>
 
 #include "occlusion.h"
 
@@ -22,6 +23,15 @@ void coverage(uint32_t c, uint32_t k, uint32_t size, uint32_t& first, uint32_t& 
 bool near_integer(double v, double tolerance) { return std::fabs(v - std::round(v)) < tolerance; }
 
 }  // namespace
+
+std::pair<int, int> sample_footprint(uint32_t i, uint32_t j, uint32_t n, bool regular_grid) {
+  const int ii = static_cast<int>(i), jj = static_cast<int>(j), nn = static_cast<int>(n);
+  if (regular_grid) return {2 * nn * ii, 2 * nn * (ii + 1)};
+  // Sample at i + (j + 0.5) / n cells = 2n i + 2j + 1 units; one cell (2n units) wide around it.
+  const int centre = 2 * nn * ii + 2 * jj + 1;
+  // Outer border: (n - 1) units further out, so that the footprints cover the whole light.
+  return {ii == 0 ? 2 * jj + 2 - 2 * nn : centre - nn, ii == nn - 1 ? 2 * nn * nn + 2 * jj : centre + nn};
+}
 
 bool depth_visible(double d, double z, const CullSettings& s) {
   return s.reversed_z ? d <= z + s.depth_bias : d >= z - s.depth_bias;
@@ -109,22 +119,60 @@ LightVisibility cull_light(const GlintFlareLight& light, const CullSettings& s, 
   const double z_tol = 1e-5 * (1.0 + std::fabs(z));
   const double ox = r.center_x - 0.5 * size, oy = r.center_y - 0.5 * size;
 
-  // Texels of level k under pixels [lo, hi) of an axis, clamp to edge.
+  // Texels of level k under pixels [lo, hi) of an axis, clamp to edge. A footprint edge within
+  // fp32 rounding of a multiple of the texel size could land in either texel on the GPU.
+  const double texel = std::ldexp(1.0, k);
   auto texels = [&](double lo, double hi, uint32_t pixels, uint32_t lsize, double tol, uint32_t& t0, uint32_t& t1) {
-    if (near_integer(lo, tol) || near_integer(hi, tol)) r.ambiguous = true;
+    if (near_integer(lo / texel, tol / texel) || near_integer(hi / texel, tol / texel)) r.ambiguous = true;
     const double last = pixels - 1.0;
     const auto p0 = static_cast<uint32_t>(std::clamp(std::floor(lo), 0.0, last));
     const auto p1 = static_cast<uint32_t>(std::clamp(std::ceil(hi) - 1.0, 0.0, last));
     t0 = std::min(p0 >> k, lsize - 1);
     t1 = std::min(std::max(p0, p1) >> k, lsize - 1);
   };
+  // Pixels [p0, p1] overlapping [lo, hi) of an axis, clamp to edge.
+  auto pixel_span = [](double lo, double hi, uint32_t pixels, uint32_t& p0, uint32_t& p1) {
+    const double last = pixels - 1.0;
+    p0 = static_cast<uint32_t>(std::clamp(std::floor(lo), 0.0, last));
+    p1 = std::max(p0, static_cast<uint32_t>(std::clamp(std::ceil(hi) - 1.0, 0.0, last)));
+  };
+  const double unit = size / (2.0 * n * n);  // sample_footprint()'s unit: cell / (2N)
+  // Visible pixels per rectangle, from a summed-area table over every pixel a window or cell can
+  // reach: the footprint plus half a cell, one pixel and two texels (the wider last texel of a
+  // row or column) on each side, clamped to the image.
+  const double margin = cell + 2.0 * texel + 2.0;
+  // Widened to whole texels: a window clamped at the image edge reads the edge texel.
+  uint32_t rx0, rx1, ry0, ry1, unused;
+  coverage(std::min(static_cast<uint32_t>(std::clamp(std::floor(ox - margin), 0.0, w - 1.0)) >> k, lw - 1), k,
+           depth.width, rx0, unused);
+  coverage(std::min(static_cast<uint32_t>(std::clamp(std::ceil(ox + size + margin), 0.0, w - 1.0)) >> k, lw - 1), k,
+           depth.width, unused, rx1);
+  coverage(std::min(static_cast<uint32_t>(std::clamp(std::floor(oy - margin), 0.0, h - 1.0)) >> k, lh - 1), k,
+           depth.height, ry0, unused);
+  coverage(std::min(static_cast<uint32_t>(std::clamp(std::ceil(oy + size + margin), 0.0, h - 1.0)) >> k, lh - 1), k,
+           depth.height, unused, ry1);
+  const size_t rw = rx1 - rx0 + 2;
+  std::vector<uint32_t> sat(rw * (ry1 - ry0 + 2), 0u);
+  for (uint32_t y = ry0; y <= ry1; ++y) {
+    uint32_t row = 0;
+    for (uint32_t x = rx0; x <= rx1; ++x) {
+      row += depth_visible(depth.at(x, y), z, s) ? 1u : 0u;
+      sat[(y - ry0 + 1) * rw + (x - rx0 + 1)] = sat[(y - ry0) * rw + (x - rx0 + 1)] + row;
+    }
+  }
+  auto visible_in = [&](uint32_t x0, uint32_t x1, uint32_t y0, uint32_t y1) -> uint64_t {
+    if (x0 < rx0 || x1 > rx1 || y0 < ry0 || y1 > ry1) throw std::logic_error("occlusion reference: window outside");
+    const size_t a = (y0 - ry0) * rw + (x0 - rx0), b = (y0 - ry0) * rw + (x1 - rx0 + 1);
+    const size_t c = (y1 - ry0 + 1) * rw + (x0 - rx0), d = (y1 - ry0 + 1) * rw + (x1 - rx0 + 1);
+    return uint64_t(sat[d]) + sat[a] - sat[b] - sat[c];
+  };
   uint32_t visible_cells = 0;
   for (uint32_t j = 0; j < n; ++j) {
-    uint32_t ty0, ty1;
-    texels(oy + j * cell, oy + (j + 1) * cell, depth.height, lh, tol_y, ty0, ty1);
     for (uint32_t i = 0; i < n; ++i) {
-      uint32_t tx0, tx1;
-      texels(ox + i * cell, ox + (i + 1) * cell, depth.width, lw, tol_x, tx0, tx1);
+      const auto fx = sample_footprint(i, j, n, s.regular_grid), fy = sample_footprint(j, i, n, s.regular_grid);
+      uint32_t tx0, tx1, ty0, ty1;
+      texels(ox + fx.first * unit, ox + fx.second * unit, depth.width, lw, tol_x, tx0, tx1);
+      texels(oy + fy.first * unit, oy + fy.second * unit, depth.height, lh, tol_y, ty0, ty1);
       const bool unread = (tx1 - tx0 + 1) * (ty1 - ty0 + 1) > GLINT_CULL_MAX_WINDOW_TEXELS;
       bool seen = unread;
       for (uint32_t y = ty0; y <= ty1 && !unread; ++y) {
@@ -135,16 +183,19 @@ LightVisibility cull_light(const GlintFlareLight& light, const CullSettings& s, 
         }
       }
       visible_cells += seen ? 1 : 0;
-      // Pixels under the window: visible and occluded ones both present makes the cell "mixed".
-      uint32_t px0, px1, py0, py1, unused;
+      // Mixed: the window's pixels and the cell's pixels hold both visible and occluded pixels.
+      uint32_t px0, px1, py0, py1;
       coverage(tx0, k, depth.width, px0, unused);
       coverage(tx1, k, depth.width, unused, px1);
       coverage(ty0, k, depth.height, py0, unused);
       coverage(ty1, k, depth.height, unused, py1);
-      bool any_visible = false, any_occluded = false;
-      for (uint32_t y = py0; y <= py1; ++y) {
-        for (uint32_t x = px0; x <= px1; ++x) (depth_visible(depth.at(x, y), z, s) ? any_visible : any_occluded) = true;
-      }
+      uint32_t cx0, cx1, cy0, cy1;
+      pixel_span(ox + i * cell, ox + (i + 1) * cell, depth.width, cx0, cx1);
+      pixel_span(oy + j * cell, oy + (j + 1) * cell, depth.height, cy0, cy1);
+      const uint64_t window_visible = visible_in(px0, px1, py0, py1), cell_visible = visible_in(cx0, cx1, cy0, cy1);
+      const bool any_visible = window_visible > 0 || cell_visible > 0;
+      const bool any_occluded = window_visible < uint64_t(px1 - px0 + 1) * (py1 - py0 + 1) ||
+                                cell_visible < uint64_t(cx1 - cx0 + 1) * (cy1 - cy0 + 1);
       if (unread || (any_visible && any_occluded)) ++r.mixed_cells;
     }
   }

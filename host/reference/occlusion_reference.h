@@ -3,17 +3,19 @@
 // - the Hi-Z pyramid, each texel computed directly as the farthest of the source pixels it covers
 //   ([c * 2^k, (c + 1) * 2^k), the last texel of a row or column up to the edge), not by the
 //   kernel's level-by-level fold;
-// - the exact expected result of the grid test (projection in double, the same cells, level and
-//   clamp-to-edge windows), with a flag for lights where a decision lies within rounding of a
-//   boundary (fp32 on the GPU may go either way there);
+// - the exact expected result of the grid test (projection in double, the same multi-jittered
+//   sample footprints, level and clamp-to-edge windows), with a flag for lights where a decision
+//   lies within rounding of a boundary (fp32 on the GPU may go either way there);
 // - the brute-force visible fraction: every full-resolution pixel under the footprint, weighted
 //   by its overlap area;
-// - the error bound's numerator: cells whose window holds both visible and occluded pixels.
+// - the error bound's numerator: samples whose window and cell together hold both visible and
+//   occluded pixels.
 // CPU only: no Vulkan call is made here.
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "flare_types.h"
@@ -38,15 +40,24 @@ struct CullSettings {
   double margin_ndc = 1.2;
   double depth_bias = 0.0;
   bool reversed_z = false;
-  uint32_t levels = 0;  // Hi-Z levels available above level 0
+  uint32_t levels = 0;        // Hi-Z levels available above level 0
+  bool regular_grid = false;  // OcclusionPattern::regular: each cell reads the cell itself
 };
+
+/// Footprint [first, second) along one axis of the sample of cell (i, j) (column i, row j; call
+/// with (j, i) for the y axis), in units of cell / (2n) from the light's left (top) edge.
+/// Multi-jittered (Chiu, Shirley & Wang 1994, canonical): the sample sits at i + (j + 0.5) / n
+/// cells, its footprint is one cell wide around it, reaching (n - 1) / (2n) cell further out on the
+/// light's border. regular_grid: the cell [i, i + 1).
+std::pair<int, int> sample_footprint(uint32_t i, uint32_t j, uint32_t n, bool regular_grid);
 
 /// The reference's verdict on one light.
 struct LightVisibility {
   uint32_t culled = GLINT_FLARE_DISABLED;  // GLINT_FLARE_VISIBLE / _FRUSTUM / _OCCLUDED / _DISABLED
-  double grid_fraction = 0.0;              // expected result of the grid test (visible cells / N^2)
+  double grid_fraction = 0.0;              // expected result of the grid test (visible samples / N^2)
   double brute_force = 0.0;                // area-weighted visible fraction of the footprint at full resolution
-  uint32_t mixed_cells = 0;                // cells whose window holds visible and occluded pixels (or is not read)
+  uint32_t mixed_cells = 0;                // samples whose window + cell hold visible and occluded pixels
+                                           // (or whose window is not read): |grid - brute| <= this / N^2
   uint32_t level = 0;                      // Hi-Z level the cells were read at
   bool ambiguous = false;                  // a decision lies within fp32 rounding of a boundary
   double center_x = 0, center_y = 0, ndc_z = 0;

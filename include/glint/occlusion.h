@@ -89,6 +89,17 @@ enum class CompactionPath : uint32_t {
   shared = 2,     //!< one atomic per workgroup through a shared-memory counter (any device)
 };
 
+/// Where LightCuller's N x N occlusion samples read the Hi-Z pyramid (docs/OCCLUSION.md).
+enum class OcclusionPattern : uint32_t {
+  /// One sample per cell at multi-jittered positions (distinct x and y over all N^2 samples), each
+  /// reading a one-cell footprint centred on it: an occluder edge sliding across a light moves the
+  /// fraction by 1/N^2 at a time.
+  multi_jittered = 0,
+  /// Each cell reads the texels under the cell itself: never below the true fraction, but an
+  /// axis-aligned edge flips a whole column of N cells at once (steps of 1/N). For comparison.
+  regular = 1,
+};
+
 /// Creation-time settings of a LightCuller. Checked by validate().
 struct LightCullConfig {
   uint32_t capacity = 1024;        //!< GlintFlareInstance slots in the instance buffer (1 to 16777216)
@@ -99,6 +110,7 @@ struct LightCullConfig {
                                    //!< still counts as visible there (0 to 0.1; the seed uses 0.01)
   uint32_t max_lights = 1u << 20;  //!< most lights per record() (1 to 4194240 = 65535 x 64)
   CompactionPath path = CompactionPath::automatic;
+  OcclusionPattern pattern = OcclusionPattern::multi_jittered;  //!< where the N x N samples read
 
   void validate() const;
 };

@@ -35,6 +35,7 @@ struct GlintHiZPush {
 // GlintCullPush::flags
 #define GLINT_CULL_REVERSED_Z 1u     // depth 1 is near; farthest = min
 #define GLINT_CULL_WRITE_RESULTS 2u  // write one GlintFlareLightResult per light
+#define GLINT_CULL_REGULAR_GRID 4u   // samples read their whole cell (no multi-jitter; for comparison)
 
 // Light sizes are clamped to this (pixels) so that footprint arithmetic stays exact in fp32.
 #define GLINT_CULL_MAX_SIZE_PX 65536.0
