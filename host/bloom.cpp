@@ -37,10 +37,13 @@ void BloomConfig::validate() const {
   check_range("BloomConfig::max_brightness", max_brightness, 1e-3, 8000.0);
   const auto f = static_cast<uint32_t>(filter);
   if (f > GLINT_BLOOM_GAUSS9) {
-    throw Error(ErrorCode::invalid_argument, concat("BloomConfig::filter = ", f, " is not a BloomFilter: accepted cod13, dual, gauss9"));
+    throw Error(ErrorCode::invalid_argument,
+                concat("BloomConfig::filter = ", f, " is not a BloomFilter: accepted cod13, dual, gauss9"));
   }
   const auto p = static_cast<uint32_t>(precision);
-  if (p > 1) throw Error(ErrorCode::invalid_argument, concat("BloomConfig::precision = ", p, " is not a Precision: accepted fp16, fp32"));
+  if (p > 1)
+    throw Error(ErrorCode::invalid_argument,
+                concat("BloomConfig::precision = ", p, " is not a Precision: accepted fp16, fp32"));
 }
 
 std::vector<LevelSize> bloom_mip_chain(VkExtent2D input, uint32_t iterations) {
@@ -58,13 +61,9 @@ std::vector<LevelSize> bloom_mip_chain(VkExtent2D input, uint32_t iterations) {
 
 namespace {
 
-const char* format_variant(VkFormat f) {
-  return f == VK_FORMAT_R32G32B32A32_SFLOAT ? "rgba32f" : "rgba16f";
-}
+const char* format_variant(VkFormat f) { return f == VK_FORMAT_R32G32B32A32_SFLOAT ? "rgba32f" : "rgba16f"; }
 
-bool is_float_rgba(VkFormat f) {
-  return f == VK_FORMAT_R16G16B16A16_SFLOAT || f == VK_FORMAT_R32G32B32A32_SFLOAT;
-}
+bool is_float_rgba(VkFormat f) { return f == VK_FORMAT_R16G16B16A16_SFLOAT || f == VK_FORMAT_R32G32B32A32_SFLOAT; }
 
 constexpr VkPipelineStageFlags2 kCompute = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
 constexpr VkAccessFlags2 kSampled = VK_ACCESS_2_SHADER_SAMPLED_READ_BIT;
@@ -145,7 +144,8 @@ struct Bloom::Impl {
     up = detail::ComputePipeline(*context, desc("bloom_up_" + lv, {S, W}));
     const char* out_variants[2] = {"rgba16f", "rgba32f"};
     for (int i = 0; i < 2; ++i) {
-      composite[i] = detail::ComputePipeline(*context, desc(std::string("bloom_composite_") + out_variants[i], {S, S, W}));
+      composite[i] =
+          detail::ComputePipeline(*context, desc(std::string("bloom_composite_") + out_variants[i], {S, S, W}));
       copy[i] = detail::ComputePipeline(*context, desc(std::string("image_copy_") + out_variants[i], {S, W}));
     }
   }
@@ -237,10 +237,11 @@ struct Bloom::Impl {
                     concat("Bloom::record: ", role, " format is ", detail::format_name(img.format),
                            "; accepted VK_FORMAT_R16G16B16A16_SFLOAT or VK_FORMAT_R32G32B32A32_SFLOAT"));
       }
-      if (img.extent.width == 0 || img.extent.height == 0 || img.extent.width > max_dim || img.extent.height > max_dim) {
-        throw Error(ErrorCode::unsupported_size, concat("Bloom::record: ", role, " extent ", img.extent.width, "x",
-                                                        img.extent.height, " is out of range: accepted 1 to ", max_dim,
-                                                        " on each side"));
+      if (img.extent.width == 0 || img.extent.height == 0 || img.extent.width > max_dim ||
+          img.extent.height > max_dim) {
+        throw Error(ErrorCode::unsupported_size,
+                    concat("Bloom::record: ", role, " extent ", img.extent.width, "x", img.extent.height,
+                           " is out of range: accepted 1 to ", max_dim, " on each side"));
       }
       if ((img.usage & need) != need) {
         throw Error(ErrorCode::missing_usage, concat("Bloom::record: ", role, " image lacks ", need_name, " usage"));
@@ -250,9 +251,9 @@ struct Bloom::Impl {
     check_one(in, "input", VK_IMAGE_USAGE_SAMPLED_BIT, "VK_IMAGE_USAGE_SAMPLED_BIT");
     check_one(out, "output", VK_IMAGE_USAGE_STORAGE_BIT, "VK_IMAGE_USAGE_STORAGE_BIT");
     if (in.extent.width != out.extent.width || in.extent.height != out.extent.height) {
-      throw Error(ErrorCode::invalid_argument, concat("Bloom::record: output extent ", out.extent.width, "x",
-                                                      out.extent.height, " differs from input extent ",
-                                                      in.extent.width, "x", in.extent.height));
+      throw Error(ErrorCode::invalid_argument,
+                  concat("Bloom::record: output extent ", out.extent.width, "x", out.extent.height,
+                         " differs from input extent ", in.extent.width, "x", in.extent.height));
     }
     if (in_place && in.format != out.format) {
       throw Error(ErrorCode::invalid_argument, "Bloom::record: in-place input and output must have the same format");
@@ -275,7 +276,8 @@ void Bloom::Impl::record(VkCommandBuffer cmd, Image& input, Image& output, Profi
     b.use(output, VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, kStorageWrite);
     b.flush(cmd);
     const LevelSize full{input.extent.width, input.extent.height};
-    copy[output.format == VK_FORMAT_R32G32B32A32_SFLOAT].dispatch(cmd, s.copy, push(full, full), full.width, full.height);
+    copy[output.format == VK_FORMAT_R32G32B32A32_SFLOAT].dispatch(cmd, s.copy, push(full, full), full.width,
+                                                                  full.height);
     if (profiler) profiler->mark(cmd, "bloom copy (intensity 0)");
     return;
   }
@@ -337,7 +339,7 @@ void Bloom::Impl::record(VkCommandBuffer cmd, Image& input, Image& output, Profi
   b.use(output, G, kCompute, in_place ? (kSampled | kStorageWrite) : kStorageWrite);
   b.flush(cmd);
   composite[output.format == VK_FORMAT_R32G32B32A32_SFLOAT].dispatch(cmd, sets.composite, push(chain[0], full),
-                                                                      full.width, full.height);
+                                                                     full.width, full.height);
   if (profiler) profiler->mark(cmd, "bloom composite");
   if (in_place) input = output;
 }
@@ -358,8 +360,8 @@ void Bloom::set_config(const BloomConfig& config) {
   config.validate();
   const BloomConfig old = impl_->config;
   impl_->config = config;
-  const bool shape_changed = old.iterations != config.iterations || old.filter != config.filter ||
-                             old.precision != config.precision;
+  const bool shape_changed =
+      old.iterations != config.iterations || old.filter != config.filter || old.precision != config.precision;
   if (!shape_changed) return;
   const VkExtent2D size = impl_->extent;
   impl_->release_pyramid();
@@ -380,6 +382,12 @@ void Bloom::prepare(VkExtent2D extent) {
 
 void Bloom::record(VkCommandBuffer cmd, Image& input, Image& output, Profiler* profiler) {
   impl_->record(cmd, input, output, profiler);
+}
+
+void Bloom::forget_caller_resources() {
+  impl_->caller_sets.clear();
+  impl_->caller_arenas.clear();
+  impl_->caller_sets_left = 0;
 }
 
 uint32_t Bloom::levels() const { return static_cast<uint32_t>(impl_->chain.size()); }

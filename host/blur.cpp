@@ -215,10 +215,14 @@ struct StepProgram {
   std::map<std::pair<VkImageView, VkImageView>, std::vector<VkDescriptorSet>> caller_sets;
   std::vector<detail::DescriptorArena> caller_arenas;
 
-  void clear_size() {
-    steps.clear();
+  void forget_caller_sets() {
     caller_sets.clear();
     caller_arenas.clear();
+  }
+
+  void clear_size() {
+    steps.clear();
+    forget_caller_sets();
     internal_sets.reset();
     images.clear();
     tap_buffers.clear();
@@ -459,6 +463,8 @@ const Image& BlurPyramid::level(uint32_t k) const {
 
 Image& BlurPyramid::level(uint32_t k) { return const_cast<Image&>(std::as_const(*this).level(k)); }
 
+void BlurPyramid::forget_caller_resources() { impl_->prog.forget_caller_sets(); }
+
 LevelSize BlurPyramid::level_size(uint32_t k) const {
   const Image& l = level(k);
   return {l.extent.width, l.extent.height};
@@ -678,6 +684,8 @@ void GaussianBlur::record(VkCommandBuffer cmd, Image& input, Image& output, Prof
   }
   impl_->prog.record(cmd, input, &output, profiler);
 }
+
+void GaussianBlur::forget_caller_resources() { impl_->prog.forget_caller_sets(); }
 
 const BlurChoice& GaussianBlur::choice() const { return impl_->choice; }
 

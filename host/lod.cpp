@@ -97,17 +97,24 @@ LodBatch::LodBatch(const Context& context) : impl_(new Impl{&context, {}, {}, 0,
 
 LodBatch::~LodBatch() { delete impl_; }
 
+void LodBatch::forget_caller_resources() {
+  impl_->sets.clear();
+  impl_->arenas.clear();
+  impl_->sets_left = 0;
+}
+
 void LodBatch::record(VkCommandBuffer cmd, Buffer& queries, Buffer& levels, uint32_t count, const LodAtlasConfig& atlas,
                       Profiler* profiler) {
   atlas.validate();
   auto check = [&](const Buffer& b, const char* role, VkDeviceSize need) {
     if (!b.buffer) throw Error(ErrorCode::invalid_argument, concat("LodBatch::record: ", role, " buffer is null"));
     if (!(b.usage & VK_BUFFER_USAGE_STORAGE_BUFFER_BIT)) {
-      throw Error(ErrorCode::missing_usage, concat("LodBatch::record: ", role, " buffer lacks VK_BUFFER_USAGE_STORAGE_BUFFER_BIT usage"));
+      throw Error(ErrorCode::missing_usage,
+                  concat("LodBatch::record: ", role, " buffer lacks VK_BUFFER_USAGE_STORAGE_BUFFER_BIT usage"));
     }
     if (b.size != VK_WHOLE_SIZE && b.size < need) {
-      throw Error(ErrorCode::invalid_argument, concat("LodBatch::record: ", role, " buffer holds ", b.size,
-                                                      " bytes; ", count, " queries need ", need));
+      throw Error(ErrorCode::invalid_argument, concat("LodBatch::record: ", role, " buffer holds ", b.size, " bytes; ",
+                                                      count, " queries need ", need));
     }
   };
   check(queries, "queries", VkDeviceSize(count) * sizeof(LodQuery));
@@ -115,7 +122,8 @@ void LodBatch::record(VkCommandBuffer cmd, Buffer& queries, Buffer& levels, uint
   if (count == 0) return;
   const uint32_t max_count = 65535u * 64u;  // one dispatch row of 64-wide groups
   if (count > max_count) {
-    throw Error(ErrorCode::invalid_argument, concat("LodBatch::record: count = ", count, " is out of range: accepted 0 to ", max_count));
+    throw Error(ErrorCode::invalid_argument,
+                concat("LodBatch::record: count = ", count, " is out of range: accepted 0 to ", max_count));
   }
   VkDescriptorSet set = impl_->set_for(queries, levels);
   detail::Barriers b;

@@ -31,6 +31,7 @@ CpuImage run_bloom(Bloom& bloom, const CpuImage& input, VkFormat in_format, VkFo
     }
     bloom.record(cmd, in.state, out.state, profiler);
   });
+  bloom.forget_caller_resources();  // `in` and `out` die here; their handles may be reused
   return detail::download(context(), out.state);
 }
 
@@ -50,9 +51,12 @@ CpuImage as_stored(const CpuImage& img, VkFormat format) {
 
 const char* filter_name(BloomFilter f) {
   switch (f) {
-    case BloomFilter::cod13: return "cod13";
-    case BloomFilter::dual: return "dual";
-    case BloomFilter::gauss9: return "gauss9";
+    case BloomFilter::cod13:
+      return "cod13";
+    case BloomFilter::dual:
+      return "dual";
+    case BloomFilter::gauss9:
+      return "gauss9";
   }
   return "?";
 }
@@ -117,9 +121,8 @@ TEST_F(BloomTest, IterationsAreClampedAtSmallSizesAndReported) {
     uint32_t iterations, levels;
     bool clamped;
   };
-  const Case cases[] = {{{64, 64}, 5, 5, false}, {{64, 64}, 8, 5, true}, {{3, 5}, 5, 1, true},
-                        {{1, 1}, 5, 1, true},    {{1, 1}, 1, 1, false}, {{4097, 3}, 8, 1, true},
-                        {{320, 240}, 8, 6, true}};
+  const Case cases[] = {{{64, 64}, 5, 5, false}, {{64, 64}, 8, 5, true},  {{3, 5}, 5, 1, true},    {{1, 1}, 5, 1, true},
+                        {{1, 1}, 1, 1, false},   {{4097, 3}, 8, 1, true}, {{320, 240}, 8, 6, true}};
   for (const Case& c : cases) {
     BloomConfig config;
     config.iterations = c.iterations;
@@ -175,7 +178,8 @@ TEST_F(BloomTest, ReferenceComparisonDetectsAWrongParameter) {
 }
 
 TEST_F(BloomTest, AllSizesWorkAndMatchTheReference) {
-  const VkExtent2D sizes[] = {{320, 240}, {640, 480}, {1280, 720}, {1920, 1080}, {64, 64}, {3, 5}, {1, 1}, {1, 9}, {9, 1}};
+  const VkExtent2D sizes[] = {{320, 240}, {640, 480}, {1280, 720}, {1920, 1080}, {64, 64},
+                              {3, 5},     {1, 1},     {1, 9},      {9, 1}};
   Bloom bloom(context());  // one object, resized each time
   for (VkExtent2D s : sizes) {
     const CpuImage input = random_hdr(s.width, s.height, s.width * 31 + s.height, 0.01f);
@@ -401,7 +405,8 @@ TEST_F(BloomTest, BadImagesAreRejectedAndNothingIsRecorded) {
   auto out = make_poisoned({32, 32}, kF16);
   auto small = make_poisoned({16, 32}, kF16);
   detail::OwnedImage unorm(context(), {32, 32}, VK_FORMAT_R8G8B8A8_UNORM, detail::kToolImageUsage);
-  detail::OwnedImage no_storage(context(), {32, 32}, kF16, VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT);
+  detail::OwnedImage no_storage(context(), {32, 32}, kF16,
+                                VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT);
   Bloom bloom(context());
   struct Case {
     const char* what;

@@ -40,12 +40,14 @@ CpuImage run_gauss(GaussianBlur& blur, const CpuImage& input, VkFormat format = 
   auto in = make_image(input, format);
   auto out = make_poisoned({input.width, input.height}, format);
   context().run_once([&](VkCommandBuffer cmd) { blur.record(cmd, in.state, out.state); });
+  blur.forget_caller_resources();  // `in` and `out` die here; their handles may be reused
   return detail::download(context(), out.state);
 }
 
 std::array<CpuImage, 3> run_pyramid(BlurPyramid& pyramid, const CpuImage& input, VkFormat format = kF32) {
   auto in = make_image(input, format);
   context().run_once([&](VkCommandBuffer cmd) { pyramid.record(cmd, in.state); });
+  pyramid.forget_caller_resources();  // `in` dies here
   return {detail::download(context(), pyramid.level(1)), detail::download(context(), pyramid.level(2)),
           detail::download(context(), pyramid.level(3))};
 }

@@ -21,16 +21,16 @@ enum class BloomFilter : uint32_t {
 /// Shape fields (iterations, filter, precision) decide images and pipelines: changing them through
 /// Bloom::set_config() rebuilds those. The other fields are per-frame push constants.
 struct BloomConfig {
-  float threshold = 1.0f;         //!< luminance where bloom starts (0 to 65504)
-  float soft_knee = 0.5f;         //!< knee width as a fraction of threshold (0 to 1)
-  float intensity = 0.3f;         //!< weight of the bloom added to the scene (0 to 100); 0 = off
-  uint32_t iterations = 5;        //!< pyramid levels (1 to 8); reduced at small sizes [shape]
-  float radius = 1.0f;            //!< scales the upsample (or Gaussian) footprint (0.25 to 4)
+  float threshold = 1.0f;                   //!< luminance where bloom starts (0 to 65504)
+  float soft_knee = 0.5f;                   //!< knee width as a fraction of threshold (0 to 1)
+  float intensity = 0.3f;                   //!< weight of the bloom added to the scene (0 to 100); 0 = off
+  uint32_t iterations = 5;                  //!< pyramid levels (1 to 8); reduced at small sizes [shape]
+  float radius = 1.0f;                      //!< scales the upsample (or Gaussian) footprint (0.25 to 4)
   BloomFilter filter = BloomFilter::cod13;  //!< [shape]
-  bool firefly_guard = true;      //!< Karis average on the first downsample
-  float max_brightness = 1000.0f; //!< per-channel clamp before the bright-pass (1e-3 to 8000);
-                                  //!< also what +Inf becomes. Keeps fp16 levels finite.
-  Precision precision = Precision::fp16;  //!< intermediate storage [shape]
+  bool firefly_guard = true;                //!< Karis average on the first downsample
+  float max_brightness = 1000.0f;           //!< per-channel clamp before the bright-pass (1e-3 to 8000);
+                                            //!< also what +Inf becomes. Keeps fp16 levels finite.
+  Precision precision = Precision::fp16;    //!< intermediate storage [shape]
 
   /// Throws Error(invalid_argument) naming the first field that is out of range or NaN.
   void validate() const;
@@ -77,6 +77,13 @@ class Bloom {
   /// `profiler` (may be null) gets a mark after each stage.
   /// Throws Error before recording anything if an image has the wrong format, usage or extent.
   void record(VkCommandBuffer cmd, Image& input, Image& output, Profiler* profiler = nullptr);
+
+  /// Drops the descriptor sets cached for the caller's images/buffers passed to record(). Vulkan
+  /// may give a new object the handle of a destroyed one, and these sets are keyed by handle: call
+  /// this before destroying (or after destroying, before the next record() with) a view or buffer
+  /// that was passed to record(), once no submitted work uses it. Engines that keep their render
+  /// targets alive never need it. Creates nothing; the next record() makes the sets again.
+  void forget_caller_resources();
 
   /// Levels the current size uses (after the small-size clamp), and whether iterations were
   /// reduced to get there. Valid after prepare() or record().

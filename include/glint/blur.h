@@ -67,6 +67,13 @@ class BlurPyramid {
   /// image has the wrong format, usage or extent. `profiler` (may be null) gets a mark per level.
   void record(VkCommandBuffer cmd, Image& input, Profiler* profiler = nullptr);
 
+  /// Drops the descriptor sets cached for the caller's images/buffers passed to record(). Vulkan
+  /// may give a new object the handle of a destroyed one, and these sets are keyed by handle: call
+  /// this before destroying (or after destroying, before the next record() with) a view or buffer
+  /// that was passed to record(), once no submitted work uses it. Engines that keep their render
+  /// targets alive never need it. Creates nothing; the next record() makes the sets again.
+  void forget_caller_resources();
+
   /// Level k = 1, 2, 3 (Blur1 .. Blur3) with its current state. Valid after prepare()/record().
   /// Throws Error(invalid_argument) for another k. A caller that transitions or uses a level
   /// updates its layout/stage/access here (as for its own images), so the next record() starts
@@ -148,6 +155,13 @@ class GaussianBlur {
   /// Records the blur. Throws before recording anything on a wrong format, usage or extent, or
   /// when input and output are the same image.
   void record(VkCommandBuffer cmd, Image& input, Image& output, Profiler* profiler = nullptr);
+
+  /// Drops the descriptor sets cached for the caller's images/buffers passed to record(). Vulkan
+  /// may give a new object the handle of a destroyed one, and these sets are keyed by handle: call
+  /// this before destroying (or after destroying, before the next record() with) a view or buffer
+  /// that was passed to record(), once no submitted work uses it. Engines that keep their render
+  /// targets alive never need it. Creates nothing; the next record() makes the sets again.
+  void forget_caller_resources();
 
   const BlurChoice& choice() const;
 

@@ -12,8 +12,8 @@ namespace glint {
 
 /// One query. Layout matches kernels/common/lod.h (GlintLodQuery): 8 floats, 32 bytes.
 struct LodQuery {
-  float dudx = 0, dvdx = 0;  //!< derivatives of the tile's own UV (0..1 across the tile) along screen x
-  float dudy = 0, dvdy = 0;  //!< ... along screen y. For REPEAT inside a tile, of the unwrapped UV.
+  float dudx = 0, dvdx = 0;    //!< derivatives of the tile's own UV (0..1 across the tile) along screen x
+  float dudy = 0, dvdy = 0;    //!< ... along screen y. For REPEAT inside a tile, of the unwrapped UV.
   float tex_w = 1, tex_h = 1;  //!< tile size in texels at level 0 (>= 1)
   float off_x = 0, off_y = 0;  //!< tile offset in the atlas in texels (tile must lie inside the atlas)
 };
@@ -42,6 +42,13 @@ class LodBatch {
   LodBatch(const LodBatch&) = delete;
   LodBatch& operator=(const LodBatch&) = delete;
   ~LodBatch();
+
+  /// Drops the descriptor sets cached for the caller's buffers passed to record(). Vulkan
+  /// may give a new object the handle of a destroyed one, and these sets are keyed by handle: call
+  /// this before destroying (or after destroying, before the next record() with) a buffer
+  /// that was passed to record(), once no submitted work uses it. Engines that keep their render
+  /// targets alive never need it. Creates nothing; the next record() makes the sets again.
+  void forget_caller_resources();
 
   /// Records the evaluation of `count` queries (LodQuery array in `queries`) into `levels`
   /// (`count` floats). Both buffers need STORAGE_BUFFER usage and at least count * 32 and
