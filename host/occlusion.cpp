@@ -6,7 +6,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
-#include <cstdlib>
 #include <map>
 #include <utility>
 #include <vector>
@@ -283,9 +282,6 @@ HiZPyramid::HiZPyramid(const Context& context, const HiZConfig& config) : impl_(
   si.maxLod = 0.0f;
   detail::vk_check(vkCreateSampler(context.device(), &si, nullptr, &m.sampler), "vkCreateSampler (Hi-Z)");
   context.state().count_object();
-  // GLINT_HIZ_VARIANT (benchmarking only): bit 0 = gather, bit 1 = edge tiles first.
-  uint32_t variant = 3;
-  if (const char* env = std::getenv("GLINT_HIZ_VARIANT")) variant = static_cast<uint32_t>(std::atoi(env)) & 3u;
   detail::PipelineDesc d;
   d.kernel_id = "hiz_build_main";
   d.bindings.push_back(VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER);
@@ -297,7 +293,7 @@ HiZPyramid::HiZPyramid(const Context& context, const HiZConfig& config) : impl_(
     const uint32_t base = i == 0 ? 0u : GLINT_HIZ_TILE_LEVELS;
     const bool used = std::any_of(m.passes.begin(), m.passes.end(), [&](const Impl::Pass& p) { return p.push.base_level == base; });
     if (!used) continue;
-    d.specialization = {base, variant & 1u, (variant >> 1) & 1u};  // constant_id 2, 3, 4
+    d.specialization = {base};  // constant_id 2
     m.pipelines[i] = detail::ComputePipeline(context, d);
   }
 }

@@ -22,10 +22,6 @@ layout(local_size_x = 256) in;
 // The level this pipeline reads as its base: 0 (the depth image) or GLINT_HIZ_TILE_LEVELS (the
 // second pass above 4096); the host makes one pipeline per value it needs.
 layout(constant_id = 2) const uint kBaseLevel = 0u;
-// 1: read 2x2 texels of the depth image per textureGather; 0: one texel per texelFetch.
-layout(constant_id = 3) const uint kGather = 1u;
-// 1: number tiles from the bottom-right corner, so that the larger edge tiles start first.
-layout(constant_id = 4) const uint kEdgeFirst = 1u;
 
 // Nearest, clamp-to-edge sampler: a gather that reaches past the edge repeats the edge texel,
 // which leaves a max or min unchanged.
@@ -103,10 +99,11 @@ float farther4(float a, float b, float c, float d) { return farther(farther(a, b
 float load_base(ivec2 p) { return load_level(kBaseLevel, p); }
 
 // Farthest of the base texels p, p + (1, 0), p + (0, 1), p + (1, 1), each coordinate clamped to the
-// base (a repeated texel changes nothing). With kGather, one textureGather at the shared corner of
+// base (a repeated texel changes nothing). From the depth image, one textureGather at the corner of
 // the four texels: u * size - 0.5 = p + 0.5 exactly enough that the 2x2 footprint is p .. p + 1.
+// (On the H100 this beat four texelFetch by 13 us at 3840x2160: docs/OCCLUSION.md.)
 float load_base_2x2(ivec2 p, ivec2 base) {
-  if (kBaseLevel == 0u && kGather != 0u) {
+  if (kBaseLevel == 0u) {
     const vec4 g = textureGather(depth_tex, vec2(p + 1) / vec2(base), 0);
     return farther4(g.x, g.y, g.z, g.w);
   }
@@ -260,9 +257,9 @@ void interior_tile(ivec2 begin, ivec2 base) {
 void main() {
   const ivec2 base = ivec2(pc.base_width, pc.base_height);
   const ivec2 groups = ivec2(gl_NumWorkGroups.xy);
-  // With kEdgeFirst the last row and column of tiles, which are up to twice as tall or wide and
-  // run the general loops, are numbered first so that they do not finish last.
-  const ivec2 g = kEdgeFirst != 0u ? groups - 1 - ivec2(gl_WorkGroupID.xy) : ivec2(gl_WorkGroupID.xy);
+  // Tiles are numbered from the bottom-right corner: the last row and column of tiles, up to twice
+  // as tall or wide and on the general loops, start first so that they do not finish last.
+  const ivec2 g = groups - 1 - ivec2(gl_WorkGroupID.xy);
   const bvec2 edge = equal(g, groups - 1);
   // This group's region of the base level: a 64x64 tile, the last one extended to the edge.
   const ivec2 begin = g * GLINT_HIZ_TILE;
