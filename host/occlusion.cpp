@@ -122,9 +122,17 @@ struct HiZPyramid::Impl {
   detail::OwnedBuffer counters;  // one word per dispatch
   Buffer counter_state;
   bool counters_cleared = false;
-  detail::ComputePipeline pipeline;
-  // One descriptor set per caller depth view (each set holds 14 storage images).
-  std::map<VkImageView, std::pair<detail::DescriptorArena, VkDescriptorSet>> sets;
+  // Nearest, clamp-to-edge: the kernel gathers 2x2 depth texels per fetch (hiz_build.comp).
+  VkSampler sampler = VK_NULL_HANDLE;
+  // One pipeline per base level a pass reads (specialization constant 2): [0] reads the depth
+  // image, [1] level GLINT_HIZ_TILE_LEVELS (made only when a second pass is planned, above 4096).
+  detail::ComputePipeline pipelines[2];
+  // Descriptor sets per caller depth view, one per pipeline (each holds 14 storage images).
+  struct Sets {
+    detail::DescriptorArena arena;
+    VkDescriptorSet set[2] = {VK_NULL_HANDLE, VK_NULL_HANDLE};
+  };
+  std::map<VkImageView, Sets> sets;
 
   struct Pass {
     GlintHiZPush push;
@@ -140,6 +148,8 @@ struct HiZPyramid::Impl {
     if (!device) return;
     for (VkImageView v : level_views) vkDestroyImageView(device, v, nullptr);
     level_views.clear();
+    if (sampler) vkDestroySampler(device, sampler, nullptr);
+    sampler = VK_NULL_HANDLE;
     if (state.view) vkDestroyImageView(device, state.view, nullptr);
     if (image) vkDestroyImage(device, image, nullptr);
     if (memory) vkFreeMemory(device, memory, nullptr);
@@ -206,7 +216,10 @@ struct HiZPyramid::Impl {
       Pass p{};
       p.push.base_width = static_cast<int32_t>(bw);
       p.push.base_height = static_cast<int32_t>(bh);
-      p.push.base_level = base;
+      p.push.base_level = base;  // 0, then GLINT_HIZ_TILE_LEVELS above 4096: one pipeline each
+      if (base != 0 && base != GLINT_HIZ_TILE_LEVELS) {
+        throw Error(ErrorCode::vulkan_failure, concat("HiZPyramid: pass from level ", base, " has no pipeline"));
+      }
       p.push.tile_levels = std::min(GLINT_HIZ_TILE_LEVELS, levels - base);
       p.groups_x = std::max(1u, bw >> 6);
       p.groups_y = std::max(1u, bh >> 6);
@@ -220,22 +233,28 @@ struct HiZPyramid::Impl {
     }
   }
 
-  VkDescriptorSet set_for(const Image& depth) {
+  // The descriptor set of `depth` for pipeline `which` (0: base level 0, 1: the second pass).
+  VkDescriptorSet set_for(const Image& depth, uint32_t which) {
     auto it = sets.find(depth.view);
-    if (it != sets.end()) return it->second.second;
-    // 14 storage images per set; the arena's pool holds 4 of each type per set.
-    detail::DescriptorArena arena(*context, 4);
-    std::vector<detail::DescriptorArena::AnyBinding> b(GLINT_HIZ_MAX_LEVELS + 2);
-    b[0].image = {depth.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
-    for (uint32_t k = 1; k <= GLINT_HIZ_MAX_LEVELS; ++k) {
-      // Levels not built bind the last built one: never accessed, but every binding needs a view.
-      const uint32_t m = std::min(k, std::max(1u, levels)) - 1;
-      b[k].image = {level_views[m], VK_IMAGE_LAYOUT_GENERAL};
+    if (it == sets.end()) {
+      Sets s;
+      // 14 storage images per set; the arena's pool holds 4 of each type per set, 2 sets.
+      s.arena = detail::DescriptorArena(*context, 8);
+      std::vector<detail::DescriptorArena::AnyBinding> b(GLINT_HIZ_MAX_LEVELS + 2);
+      b[0].image = {depth.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+      b[0].sampler = sampler;
+      for (uint32_t k = 1; k <= GLINT_HIZ_MAX_LEVELS; ++k) {
+        // Levels not built bind the last built one: never accessed, but every binding needs a view.
+        const uint32_t m = std::min(k, std::max(1u, levels)) - 1;
+        b[k].image = {level_views[m], VK_IMAGE_LAYOUT_GENERAL};
+      }
+      b[GLINT_HIZ_MAX_LEVELS + 1].buffer = counter_state;
+      for (uint32_t i = 0; i < 2; ++i) {
+        if (pipelines[i].set_layout()) s.set[i] = s.arena.make_mixed_set(pipelines[i], b);
+      }
+      it = sets.emplace(depth.view, std::move(s)).first;
     }
-    b[GLINT_HIZ_MAX_LEVELS + 1].buffer = counter_state;
-    VkDescriptorSet set = arena.make_mixed_set(pipeline, b);
-    sets.emplace(depth.view, std::make_pair(std::move(arena), set));
-    return set;
+    return it->second.set[which];
   }
 };
 
@@ -256,14 +275,27 @@ HiZPyramid::HiZPyramid(const Context& context, const HiZConfig& config) : impl_(
   const VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
   m.counters = detail::OwnedBuffer(context, 16, usage, false);
   m.counter_state = view_of(m.counters, usage);
+  VkSamplerCreateInfo si{VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO};
+  si.magFilter = si.minFilter = VK_FILTER_NEAREST;
+  si.mipmapMode = VK_SAMPLER_MIPMAP_MODE_NEAREST;
+  si.addressModeU = si.addressModeV = si.addressModeW = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
+  si.maxLod = 0.0f;
+  detail::vk_check(vkCreateSampler(context.device(), &si, nullptr, &m.sampler), "vkCreateSampler (Hi-Z)");
+  context.state().count_object();
   detail::PipelineDesc d;
   d.kernel_id = "hiz_build_main";
-  d.bindings.push_back(VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE);
+  d.bindings.push_back(VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER);
   for (uint32_t k = 0; k < GLINT_HIZ_MAX_LEVELS; ++k) d.bindings.push_back(VK_DESCRIPTOR_TYPE_STORAGE_IMAGE);
   d.bindings.push_back(VK_DESCRIPTOR_TYPE_STORAGE_BUFFER);
   d.push_constant_bytes = sizeof(GlintHiZPush);
   d.workgroup = {256, 1};  // the kernel's local size is fixed at 256 (64x64 tiles)
-  m.pipeline = detail::ComputePipeline(context, d);
+  for (uint32_t i = 0; i < 2; ++i) {
+    const uint32_t base = i == 0 ? 0u : GLINT_HIZ_TILE_LEVELS;
+    const bool used = std::any_of(m.passes.begin(), m.passes.end(), [&](const Impl::Pass& p) { return p.push.base_level == base; });
+    if (!used) continue;
+    d.specialization = {base};  // constant_id 2
+    m.pipelines[i] = detail::ComputePipeline(context, d);
+  }
 }
 
 HiZPyramid::HiZPyramid(HiZPyramid&&) noexcept = default;
@@ -309,7 +341,6 @@ void HiZPyramid::record(VkCommandBuffer cmd, Image& depth, Profiler* profiler) {
     if (profiler) profiler->mark(cmd, "hi-z");
     return;
   }
-  VkDescriptorSet set = m.set_for(depth);
   detail::Barriers b;
   if (!m.counters_cleared) {  // once per object: the kernel resets the counter after each use
     b.use(m.counter_state, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);  // fill = "transfer"
@@ -327,7 +358,8 @@ void HiZPyramid::record(VkCommandBuffer cmd, Image& depth, Profiler* profiler) {
       b.flush(cmd);
     }
     const auto& p = m.passes[i];
-    m.pipeline.dispatch(cmd, set, p.push, p.groups_x * 256, p.groups_y);
+    const uint32_t which = p.push.base_level == 0 ? 0 : 1;
+    m.pipelines[which].dispatch(cmd, m.set_for(depth, which), p.push, p.groups_x * 256, p.groups_y);
   }
   if (profiler) profiler->mark(cmd, "hi-z");
 }
