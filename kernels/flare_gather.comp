@@ -7,8 +7,8 @@
 //    arguments, read here, over groups_per_instance() = 1; indices past the buffer are skipped) and
 //    appends each of its sprites whose conservative rectangle (glint_flare_bounds) meets the tile
 //    to a shared list.
-// 2. Sprites: the list is turned into GlintFlareSprite (glint_flare_sprite, the function flare.vert
-//    evaluates) in chunks of one per invocation, kept in shared memory.
+// 2. Sprites: the list is turned into GlintFlareShading (glint_flare_sprite and glint_flare_prepare,
+//    the functions flare.vert evaluates) in chunks of one per invocation, kept in shared memory.
 // 3. Shading: every invocation adds glint_flare_shade (the function flare.frag evaluates) of every
 //    listed sprite at each of its pixel centres, in fp32.
 // Finally a pixel that received light is read, gains the sum and is written once (alpha kept);
@@ -31,9 +31,9 @@ layout(push_constant) uniform Push { GlintFlarePush pc; };
 const uint kMaxThreads = GLINT_FLARE_GATHER_MAX_THREADS;
 shared uint s_list_count;
 shared uint s_list[kMaxThreads * GLINT_FLARE_SPRITES];  // instance * 16 + slot
-shared vec4 s_rect[kMaxThreads];                        // lo.xy, size.xy
+shared vec4 s_rect[kMaxThreads];                        // GlintFlareShading of the listed sprites
+shared vec4 s_atlas[kMaxThreads];
 shared vec4 s_rgb_lod[kMaxThreads];
-shared uint s_tile[kMaxThreads];
 
 void main() {
   const uint threads = gl_WorkGroupSize.x * gl_WorkGroupSize.y;
@@ -70,25 +70,21 @@ void main() {
       // 2. Sprites: one per invocation.
       if (e0 + t < listed) {
         uint packed = s_list[e0 + t];
-        GlintFlareSprite s = glint_flare_sprite(instances[packed >> 4u], packed & 15u, pc);
-        s_rect[t] = vec4(s.lo, s.size);
-        s_rgb_lod[t] = vec4(s.rgb, s.lod);
-        s_tile[t] = s.tile;
+        GlintFlareShading h = glint_flare_prepare(glint_flare_sprite(instances[packed >> 4u], packed & 15u, pc));
+        s_rect[t] = h.rect;
+        s_atlas[t] = h.atlas;
+        s_rgb_lod[t] = h.rgb_lod;
       }
       barrier();
       // 3. Shading: each listed sprite at each of this invocation's pixel centres.
       uint n = min(threads, listed - e0);
       for (uint k = 0u; k < n; ++k) {
-        GlintFlareSprite s;
-        s.lo = s_rect[k].xy;
-        s.size = s_rect[k].zw;
-        s.rgb = s_rgb_lod[k].rgb;
-        s.lod = s_rgb_lod[k].w;
-        s.tile = s_tile[k];
-        if (!(s.size.x > 0.0)) continue;
+        GlintFlareShading h = GlintFlareShading(s_rect[k], s_atlas[k], s_rgb_lod[k]);
+        float x = float(p0.x) + 0.5;
+        if (!(x >= h.rect.x && x < h.rect.z)) continue;  // glint_flare_shade's own test, for the column
         for (uint r = 0u; r < GLINT_FLARE_GATHER_ROWS; ++r) {
           vec2 pixel = vec2(p0.x, p0.y + r * gl_WorkGroupSize.y) + 0.5;
-          sum[r] += glint_flare_shade(s, pixel, atlas).rgb;
+          sum[r] += glint_flare_shade(h, pixel, atlas).rgb;
         }
       }
     }
