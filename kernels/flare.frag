@@ -8,8 +8,16 @@
 layout(binding = 1) uniform sampler2D atlas;
 
 layout(location = 0) flat in vec4 v_rect;
-layout(location = 1) flat in vec4 v_atlas;
-layout(location = 2) flat in vec4 v_rgb_lod;
+layout(location = 1) flat in vec4 v_rgb_lod;
+layout(location = 2) flat in uint v_tile;
 layout(location = 0) out vec4 color;
 
-void main() { color = glint_flare_shade(GlintFlareShading(v_rect, v_atlas, v_rgb_lod), gl_FragCoord.xy, atlas); }
+void main() {
+  GlintFlareSprite s;
+  s.lo = v_rect.xy;
+  s.size = v_rect.zw;
+  s.rgb = v_rgb_lod.rgb;
+  s.lod = v_rgb_lod.w;
+  s.tile = v_tile;
+  color = glint_flare_shade(s, gl_FragCoord.xy, atlas);
+}

@@ -10,9 +10,9 @@
 layout(std430, binding = 0) readonly buffer Instances { GlintFlareInstance instances[]; };
 layout(push_constant) uniform Push { GlintFlarePush pc; };
 
-layout(location = 0) flat out vec4 v_rect;  // GlintFlareShading, prepared once per sprite
-layout(location = 1) flat out vec4 v_atlas;
-layout(location = 2) flat out vec4 v_rgb_lod;
+layout(location = 0) flat out vec4 v_rect;  // lo.xy, size.xy
+layout(location = 1) flat out vec4 v_rgb_lod;
+layout(location = 2) flat out uint v_tile;
 
 void main() {
   uint slot = uint(gl_VertexIndex) / GLINT_FLARE_VERTICES_PER_SPRITE;
@@ -20,10 +20,9 @@ void main() {
   GlintFlareSprite s;
   s.size = vec2(0.0);
   if (uint(gl_InstanceIndex) < uint(instances.length())) s = glint_flare_sprite(instances[gl_InstanceIndex], slot, pc);
-  GlintFlareShading h = glint_flare_prepare(s);
-  v_rect = h.rect;
-  v_atlas = h.atlas;
-  v_rgb_lod = h.rgb_lod;
+  v_rect = vec4(s.lo, s.size);
+  v_rgb_lod = vec4(s.rgb, s.lod);
+  v_tile = s.tile;
   if (!(s.size.x > 0.0)) {  // nothing to draw: a degenerate triangle outside the view volume
     gl_Position = vec4(-2.0, -2.0, 0.0, 1.0);
     return;

@@ -148,38 +148,15 @@ vec4 glint_flare_bounds(GlintFlareInstance inst, uint slot, GlintFlarePush p) {
   return vec4(centre - half_size, centre + half_size);
 }
 
-// What glint_flare_shade needs at a pixel, prepared once per sprite (in flare.vert, or once per
-// tile in flare_gather.comp) so that a pixel costs two compares, two multiply-adds, one textureLod
-// and a multiply: no division per pixel.
-struct GlintFlareShading {
-  vec4 rect;     // lo.xy, hi.xy = lo + size: pixel centres in [lo, hi) are lit; empty: nothing drawn
-  vec4 atlas;    // atlas uv = (pixel - lo) * atlas.xy + atlas.zw
-  vec4 rgb_lod;  // the sprite's rgb and atlas level
-};
-
-GlintFlareShading glint_flare_prepare(GlintFlareSprite s) {
-  GlintFlareShading h;
-  h.rect = vec4(0.0);
-  h.atlas = vec4(0.0);
-  h.rgb_lod = vec4(s.rgb, s.lod);
-  if (!(s.size.x > 0.0)) return h;
+// Premultiplied light that `s` adds at the pixel whose centre is `pixel` (gl_FragCoord.xy in the
+// raster path, (x, y) + 0.5 in the gather). Zero outside [lo, lo + size): this test, not the
+// rasterizer's coverage, decides which pixels a sprite touches, so both paths agree exactly.
+vec4 glint_flare_shade(GlintFlareSprite s, vec2 pixel, sampler2D atlas) {
+  if (!(s.size.x > 0.0)) return vec4(0.0);
+  precise vec2 uv = (pixel - s.lo) / s.size;
+  if (uv.x < 0.0 || uv.y < 0.0 || uv.x >= 1.0 || uv.y >= 1.0) return vec4(0.0);
   vec4 tile = glint_flare_tile(s.tile);
-  const vec2 atlas_size = vec2(GLINT_FLARE_ATLAS_WIDTH, GLINT_FLARE_ATLAS_HEIGHT);
-  precise vec2 hi = s.lo + s.size;
-  precise vec2 scale = tile.zw / (s.size * atlas_size);
-  precise vec2 offset = tile.xy / atlas_size;
-  h.rect = vec4(s.lo, hi);
-  h.atlas = vec4(scale, offset);
-  return h;
-}
-
-// Premultiplied light that the prepared sprite `h` adds at the pixel whose centre is `pixel`
-// (gl_FragCoord.xy in the raster path, (x, y) + 0.5 in the gather). Zero outside [lo, hi): this
-// test, not the rasterizer's coverage, decides which pixels a sprite touches, so both paths agree
-// exactly.
-vec4 glint_flare_shade(GlintFlareShading h, vec2 pixel, sampler2D atlas) {
-  if (!(pixel.x >= h.rect.x && pixel.y >= h.rect.y && pixel.x < h.rect.z && pixel.y < h.rect.w)) return vec4(0.0);
-  precise vec2 atlas_uv = (pixel - h.rect.xy) * h.atlas.xy + h.atlas.zw;
-  vec4 t = textureLod(atlas, atlas_uv, h.rgb_lod.w);
-  return vec4(h.rgb_lod.rgb * t.rgb, t.a);
+  precise vec2 atlas_uv = (tile.xy + uv * tile.zw) / vec2(GLINT_FLARE_ATLAS_WIDTH, GLINT_FLARE_ATLAS_HEIGHT);
+  vec4 t = textureLod(atlas, atlas_uv, s.lod);
+  return vec4(s.rgb * t.rgb, t.a);
 }

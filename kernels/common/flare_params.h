@@ -70,8 +70,9 @@
 
 // ---- Compute path (flare_gather.comp) ------------------------------------------------------------
 // One workgroup per screen tile; each invocation shades GLINT_FLARE_GATHER_ROWS pixels of one column
-// (rows a workgroup height apart), so a 16x8 workgroup gathers a 16x64 tile. Taller tiles bin each
-// instance against fewer tiles; 8 rows keep the 1080p tile count (2040) near one wave of an H100.
+// (rows a workgroup height apart), so a 32x8 workgroup gathers a 32x64 tile (1020 tiles at 1080p).
+// Larger tiles bin each instance against fewer tiles; the rows share one binning and one sprite
+// setup per tile.
 // Shared lists are sized for at most GLINT_FLARE_GATHER_MAX_THREADS invocations (18 KiB).
 #define GLINT_FLARE_GATHER_ROWS 8u
 #define GLINT_FLARE_GATHER_MAX_THREADS 256u
