@@ -29,6 +29,7 @@ static_assert(sizeof(GlintFlarePush) == 88,
               "GlintFlarePush layout changed: update kernels/common/flare_params.h users");
 static_assert(offsetof(GlintFlarePush, ghost_pos0) == 52);
 static_assert(offsetof(GlintFlarePush, groups_per_instance) == 72);
+static_assert(offsetof(GlintFlarePush, indirect_word) == 84);
 static_assert(sizeof(GlintFlareAtlasPush) == 12);
 static_assert(sizeof(GlintFlareInstance) == 48 && sizeof(GlintFlareIndirect) == 32);
 static_assert(LensFlare::vertices_per_instance() == GLINT_FLARE_SPRITES * GLINT_FLARE_VERTICES_PER_SPRITE);
@@ -88,10 +89,6 @@ namespace {
 constexpr VkPipelineStageFlags2 kCompute = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
 constexpr VkPipelineStageFlags2 kIndirect = VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT;
 constexpr VkAccessFlags2 kStorageRW = VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT;
-
-// Workgroups per instance in the splat: one per sprite and chunk. GPUs get 8 chunks so a large
-// sprite is spread over 8 workgroups; CPU devices (lavapipe) have few cores and get 1.
-uint32_t splat_chunks(const DeviceInfo& info) { return info.type == VK_PHYSICAL_DEVICE_TYPE_CPU ? 1u : 8u; }
 
 bool is_float_rgba(VkFormat f) { return f == VK_FORMAT_R16G16B16A16_SFLOAT || f == VK_FORMAT_R32G32B32A32_SFLOAT; }
 
@@ -164,6 +161,8 @@ void write_set(VkDevice device, VkDescriptorSet set, const std::vector<Write>& b
 
 using BufferKey = std::tuple<VkBuffer, VkDeviceSize, VkDeviceSize>;
 BufferKey key_of(const Buffer& b) { return {b.buffer, b.offset, b.size}; }
+// The compute path's descriptor set: instances, indirect arguments, colour view.
+using GatherKey = std::tuple<BufferKey, BufferKey, VkImageView>;
 
 }  // namespace
 
@@ -172,9 +171,10 @@ struct LensFlare::Impl {
   VkDevice device = VK_NULL_HANDLE;
   VkFormat format = VK_FORMAT_UNDEFINED;
   VkExtent2D extent{0, 0};
-  uint32_t chunks = 1;
-  uint32_t max_group_count_x = 65535;
-  detail::Workgroup2D tile;  // the resolve's workgroup, and the tile of the touched-tile flags
+  uint32_t max_compute_instances = 0;    // instances one storage-buffer descriptor can hold
+  VkDeviceSize storage_alignment = 256;  // minStorageBufferOffsetAlignment
+  detail::Workgroup2D workgroup;         // the gather's workgroup
+  uint32_t tiles_x = 0, tiles_y = 0;     // gather tiles: workgroup x by workgroup y * GATHER_ROWS
 
   // Atlas: one image with every level, a view of all levels (sampling) and one per level (storage).
   Image atlas;  // state tracks all levels together
@@ -192,16 +192,12 @@ struct LensFlare::Impl {
   VkPipelineLayout raster_layout = VK_NULL_HANDLE;
   VkPipeline raster_pipeline = VK_NULL_HANDLE;
 
-  // Compute path.
-  detail::ComputePipeline splat, resolve;
-  detail::OwnedBuffer accum_buffer, flags_buffer;
-  Buffer accum, flags;  // views of the two with their last use
-  bool accum_needs_clear = false;
-  uint32_t tiles_x = 0, tiles_y = 0;
+  // Compute path: one gather kernel, no buffers of its own.
+  detail::ComputePipeline gather;
 
   std::unique_ptr<SetPool> sets;
-  std::map<BufferKey, VkDescriptorSet> raster_sets, splat_sets;
-  std::map<VkImageView, VkDescriptorSet> resolve_sets;
+  std::map<BufferKey, VkDescriptorSet> raster_sets;
+  std::map<GatherKey, VkDescriptorSet> gather_sets;
 
   ~Impl() {
     if (!device) return;
@@ -219,7 +215,6 @@ struct LensFlare::Impl {
   void make_atlas();
   void make_raster_pipeline();
   void make_compute_pipelines();
-  void make_accumulation();
   void record_setup(VkCommandBuffer cmd);
   GlintFlarePush push(const FlareConfig& c) const;
   void check_inputs(const char* fn, const Image& color, VkImageUsageFlags usage, const char* usage_name,
@@ -426,26 +421,11 @@ void LensFlare::Impl::make_raster_pipeline() {
 void LensFlare::Impl::make_compute_pipelines() {
   const auto SB = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
   detail::PipelineDesc d;
-  d.kernel_id = "flare_splat_main";
-  d.bindings = {SB, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, SB, SB};
+  d.kernel_id = format == VK_FORMAT_R32G32B32A32_SFLOAT ? "flare_gather_rgba32f" : "flare_gather_rgba16f";
+  d.bindings = {SB, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, SB, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE};
   d.push_constant_bytes = sizeof(GlintFlarePush);
-  d.workgroup = {64, 1};
-  splat = detail::ComputePipeline(*context, d);
-  d.kernel_id = format == VK_FORMAT_R32G32B32A32_SFLOAT ? "flare_resolve_rgba32f" : "flare_resolve_rgba16f";
-  d.bindings = {SB, SB, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE};
-  d.workgroup = tile;
-  resolve = detail::ComputePipeline(*context, d);
-}
-
-void LensFlare::Impl::make_accumulation() {
-  if (accum_buffer.buffer()) return;
-  const VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
-  accum_buffer =
-      detail::OwnedBuffer(*context, VkDeviceSize(extent.width) * extent.height * 3 * sizeof(float), usage, false);
-  flags_buffer = detail::OwnedBuffer(*context, VkDeviceSize(tiles_x) * tiles_y * sizeof(uint32_t), usage, false);
-  accum = {accum_buffer.buffer(), 0, accum_buffer.size(), usage, VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE};
-  flags = {flags_buffer.buffer(), 0, flags_buffer.size(), usage, VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE};
-  accum_needs_clear = true;
+  d.workgroup = workgroup;
+  gather = detail::ComputePipeline(*context, d);
 }
 
 GlintFlarePush LensFlare::Impl::push(const FlareConfig& c) const {
@@ -468,10 +448,10 @@ GlintFlarePush LensFlare::Impl::push(const FlareConfig& c) const {
   p.ghost_pos2 = c.ghost_positions[2];
   p.ghost_pos3 = c.ghost_positions[3];
   p.ghost_pos4 = c.ghost_positions[4];
-  p.groups_per_instance = GLINT_FLARE_SPRITES * chunks;
-  p.tile_w = tile.x;
-  p.tile_h = tile.y;
-  p.tiles_x = tiles_x;
+  p.groups_per_instance = 1;
+  p.tile_w = workgroup.x;
+  p.tile_h = workgroup.y * GLINT_FLARE_GATHER_ROWS;
+  p.indirect_word = 0;  // set by record_compute
   return p;
 }
 
@@ -532,13 +512,21 @@ LensFlare::LensFlare(const Context& context, VkFormat color_format, VkExtent2D e
   m.device = context.device();
   m.format = color_format;
   m.extent = extent;
-  m.chunks = splat_chunks(context.info());
   VkPhysicalDeviceProperties props;
   vkGetPhysicalDeviceProperties(context.physical_device(), &props);
-  m.max_group_count_x = props.limits.maxComputeWorkGroupCount[0];
-  m.tile = detail::choose_workgroup_2d(context.info());
-  m.tiles_x = (extent.width + m.tile.x - 1) / m.tile.x;
-  m.tiles_y = (extent.height + m.tile.y - 1) / m.tile.y;
+  m.max_compute_instances = props.limits.maxStorageBufferRange / uint32_t(sizeof(GlintFlareInstance));
+  m.storage_alignment = std::max<VkDeviceSize>(1, props.limits.minStorageBufferOffsetAlignment);
+  // The gather's workgroup: 32x8 on GPUs (a 32x64 tile; on the H100 it beat 16x8, whose tiles bin
+  // every instance twice as often: docs/FLARE.md), the device's 2D choice (8x8) on CPU devices.
+  m.workgroup = detail::choose_workgroup_2d(context.info());
+  if (context.info().type != VK_PHYSICAL_DEVICE_TYPE_CPU && context.info().max_workgroup_invocations >= 256 &&
+      context.info().subgroup_size >= 32) {
+    m.workgroup = {32, 8};
+  }
+  if (m.workgroup.x * m.workgroup.y > GLINT_FLARE_GATHER_MAX_THREADS) m.workgroup = {16, 16};
+  const uint32_t tile_h = m.workgroup.y * GLINT_FLARE_GATHER_ROWS;
+  m.tiles_x = (extent.width + m.workgroup.x - 1) / m.workgroup.x;
+  m.tiles_y = (extent.height + tile_h - 1) / tile_h;
   m.sets = std::make_unique<SetPool>(context);
   m.make_atlas();
   m.make_raster_pipeline();
@@ -550,10 +538,10 @@ LensFlare::LensFlare(LensFlare&&) noexcept = default;
 LensFlare& LensFlare::operator=(LensFlare&&) noexcept = default;
 LensFlare::~LensFlare() = default;
 
-uint32_t LensFlare::groups_per_instance() const { return GLINT_FLARE_SPRITES * impl_->chunks; }
-uint32_t LensFlare::max_compute_instances() const { return impl_->max_group_count_x / groups_per_instance(); }
+uint32_t LensFlare::groups_per_instance() const { return 1; }
+uint32_t LensFlare::max_compute_instances() const { return impl_->max_compute_instances; }
 void LensFlare::record_setup(VkCommandBuffer cmd) { impl_->record_setup(cmd); }
-void LensFlare::prepare_compute() { impl_->make_accumulation(); }
+void LensFlare::prepare_compute() {}  // the gather owns no buffers
 VkFormat LensFlare::color_format() const { return impl_->format; }
 VkExtent2D LensFlare::extent() const { return impl_->extent; }
 
@@ -634,65 +622,51 @@ void LensFlare::record_compute(VkCommandBuffer cmd, Image& color, Buffer& instan
   Impl& m = *impl_;
   m.check_inputs("LensFlare::record_compute", color, VK_IMAGE_USAGE_STORAGE_BIT, "VK_IMAGE_USAGE_STORAGE_BIT",
                  instances, indirect, config);
+  if (!(indirect.usage & VK_BUFFER_USAGE_STORAGE_BUFFER_BIT)) {
+    throw Error(ErrorCode::missing_usage,
+                "LensFlare::record_compute: indirect buffer lacks VK_BUFFER_USAGE_STORAGE_BUFFER_BIT usage (the "
+                "compute path reads the instance count from it)");
+  }
   if (instances.size != VK_WHOLE_SIZE && instances.size / sizeof(GlintFlareInstance) > max_compute_instances()) {
-    throw Error(
-        ErrorCode::invalid_argument,
-        concat("LensFlare::record_compute: the instances buffer holds ", instances.size / sizeof(GlintFlareInstance),
-               " instances; the device dispatches at most ", max_compute_instances(), " (", m.max_group_count_x,
-               " workgroups / ", groups_per_instance(), " per instance)"));
+    throw Error(ErrorCode::invalid_argument,
+                concat("LensFlare::record_compute: the instances buffer holds ", instances.size / sizeof(GlintFlareInstance),
+                       " instances; one storage-buffer descriptor holds at most ", max_compute_instances()));
   }
   if (!config.enabled || config.intensity == 0.0f) return;  // adds nothing: record nothing
   m.record_setup(cmd);
-  m.make_accumulation();  // first use only
-  detail::Barriers b;
-  if (m.accum_needs_clear) {  // once: later frames find both zeroed by flare_resolve
-    b.use(m.accum, VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);  // vkCmdFillBuffer
-    b.use(m.flags, VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);
-    b.flush(cmd);
-    vkCmdFillBuffer(cmd, m.accum.buffer, 0, VK_WHOLE_SIZE, 0);
-    vkCmdFillBuffer(cmd, m.flags.buffer, 0, VK_WHOLE_SIZE, 0);
-    m.accum_needs_clear = false;
-  }
 
-  VkDescriptorSet splat_set;
-  if (auto it = m.splat_sets.find(key_of(instances)); it != m.splat_sets.end()) {
-    splat_set = it->second;
+  // The indirect arguments are read as words from a storage-buffer binding whose offset is rounded
+  // down to minStorageBufferOffsetAlignment; the push constant says where group_count_x is.
+  const VkDeviceSize args_offset = indirect.offset + offsetof(GlintFlareIndirect, group_count_x);
+  const VkDeviceSize bound_offset = args_offset - args_offset % m.storage_alignment;
+  const Buffer indirect_words{indirect.buffer, bound_offset, args_offset - bound_offset + sizeof(uint32_t),
+                              indirect.usage,  indirect.stage,  indirect.access};
+  const GatherKey key{key_of(instances), key_of(indirect_words), color.view};
+  VkDescriptorSet set;
+  if (auto it = m.gather_sets.find(key); it != m.gather_sets.end()) {
+    set = it->second;
   } else {
-    splat_set = m.sets->allocate(m.splat.set_layout());
+    set = m.sets->allocate(m.gather.set_layout());
     Write img{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
               {},
               {m.sampler, m.atlas.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL}};
-    write_set(m.device, splat_set, {buffer_write(instances), img, buffer_write(m.accum), buffer_write(m.flags)});
-    m.splat_sets.emplace(key_of(instances), splat_set);
-  }
-  VkDescriptorSet resolve_set;
-  if (auto it = m.resolve_sets.find(color.view); it != m.resolve_sets.end()) {
-    resolve_set = it->second;
-  } else {
-    resolve_set = m.sets->allocate(m.resolve.set_layout());
-    Write img{VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, {}, {VK_NULL_HANDLE, color.view, VK_IMAGE_LAYOUT_GENERAL}};
-    write_set(m.device, resolve_set, {buffer_write(m.accum), buffer_write(m.flags), img});
-    m.resolve_sets.emplace(color.view, resolve_set);
+    Write dst{VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, {}, {VK_NULL_HANDLE, color.view, VK_IMAGE_LAYOUT_GENERAL}};
+    write_set(m.device, set, {buffer_write(instances), img, buffer_write(indirect_words), dst});
+    m.gather_sets.emplace(key, set);
   }
 
-  const GlintFlarePush p = m.push(config);
+  GlintFlarePush p = m.push(config);
+  p.indirect_word = uint32_t((args_offset - bound_offset) / sizeof(uint32_t));
+  detail::Barriers b;
   b.use(instances, kCompute, VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
-  b.use(indirect, kIndirect, VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT);
+  b.use(indirect, kCompute, VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
   b.use(m.atlas, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, kCompute, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT,
         GLINT_FLARE_ATLAS_LEVELS);
-  b.use(m.accum, kCompute, kStorageRW);
-  b.use(m.flags, kCompute, kStorageRW);
-  b.flush(cmd);
-  m.splat.dispatch_indirect(cmd, splat_set, p, indirect.buffer,
-                            indirect.offset + offsetof(GlintFlareIndirect, group_count_x));
-  if (profiler) profiler->mark(cmd, "flare splat");
-
-  b.use(m.accum, kCompute, kStorageRW);
-  b.use(m.flags, kCompute, kStorageRW);
   b.use(color, VK_IMAGE_LAYOUT_GENERAL, kCompute, kStorageRW);
   b.flush(cmd);
-  m.resolve.dispatch(cmd, resolve_set, p, m.extent.width, m.extent.height);
-  if (profiler) profiler->mark(cmd, "flare resolve");
+  // One workgroup per tile: tiles_x by tiles_y groups (dispatch() takes invocations).
+  m.gather.dispatch(cmd, set, p, m.tiles_x * m.workgroup.x, m.tiles_y * m.workgroup.y);
+  if (profiler) profiler->mark(cmd, "flare gather");
 }
 
 }  // namespace glint

@@ -4,7 +4,7 @@
 // draw for all lights. The instance buffer is read by gl_InstanceIndex (no vertex buffers); each
 // instance expands to GLINT_FLARE_SPRITES screen-aligned rectangles, gl_VertexIndex / 6 picking
 // the sprite and gl_VertexIndex % 6 the corner. The rectangle is drawn one pixel larger on every
-// side; flare.frag decides coverage with the same test as the compute splat.
+// side; flare.frag decides coverage with the same test as the compute gather.
 #include "flare_look.glsl"
 
 layout(std430, binding = 0) readonly buffer Instances { GlintFlareInstance instances[]; };

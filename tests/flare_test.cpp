@@ -591,6 +591,45 @@ TEST_F(FlareTest, RasterAndComputeGiveTheSameImageWithinTolerance) {
   }
 }
 
+// The compute gather bins instances in batches of one per invocation and builds the listed sprites
+// in chunks of one per invocation (flare_gather.comp): 300 lights give several batches, and the
+// tiles near the centre, where every light's t = 1 ghost lands, list more sprites than a chunk
+// holds. The indirect arguments sit at an offset that is not a multiple of the storage-buffer
+// alignment, so the count is read through the rounded-down binding.
+TEST_F(FlareTest, ComputeGathersManyLightsInBatchesAndChunks) {
+  LensFlare flare(context(), kF32, {kW, kH});
+  const reference::FlareAtlas atlas = read_atlas(flare);
+  const CpuImage background = random_hdr(kW, kH, 61);
+  auto lights = random_instances(300, 23);
+  for (auto& g : lights) g.size_px = 2.0f + 0.2f * g.size_px;  // small, so the image stays readable
+  FlareInputs in(lights, uint32_t(lights.size()), flare.groups_per_instance());
+  // Move the arguments 20 bytes into the buffer (a multiple of 4, not of any storage alignment).
+  detail::OwnedBuffer shifted(context(), 64, in.indirect_view.usage, false);
+  Buffer shifted_view{shifted.buffer(), 20, sizeof(GlintFlareIndirect), in.indirect_view.usage,
+                      VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE};
+  const FlareConfig config;
+  auto color = make_color(background, kF32);
+  context().run_once([&](VkCommandBuffer cmd) {
+    in.record_upload(cmd);
+    detail::Barriers b;
+    b.use(shifted_view, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);
+    b.flush(cmd);
+    VkBufferCopy c{in.instances.size(), 20, sizeof(GlintFlareIndirect)};  // the staged arguments
+    vkCmdCopyBuffer(cmd, in.staging.buffer(), shifted.buffer(), 1, &c);
+    flare.record_compute(cmd, color.state, in.instances_view, shifted_view, config);
+  });
+  const CpuImage gpu = detail::download(context(), color.state);
+  const auto ref = reference::flare_composite(background, lights, uint32_t(lights.size()), config, atlas,
+                                              sampler_precision());
+  uint32_t most = 0;
+  for (uint32_t n : ref.count) most = std::max(most, n);
+  EXPECT_GT(most, 64u) << "no pixel is covered by more sprites than a chunk of the gather holds";
+  const Deviation d = compare(gpu, ref, kF32);
+  EXPECT_EQ(d.outside, 0u) << d.first;
+  std::printf("flare compute, 300 lights: %u sprites on the busiest pixel, worst |error| / tolerance %.3f\n", most,
+              d.worst_ratio);
+}
+
 TEST_F(FlareTest, ZeroInstancesAndDisabledLeaveTheImageBitIdentical) {
   for (VkFormat format : {kF16, kF32}) {
     LensFlare flare(context(), format, {kW, kH});

@@ -1,6 +1,6 @@
 // Light-entity anamorphic lens flares, the drawing half (issue 5, seed 004): an element atlas
 // generated on the GPU, and two ways to draw every visible light's flare into an HDR image — one
-// instanced vkCmdDrawIndirect (raster path) or a vkCmdDispatchIndirect splat (compute path) that
+// instanced vkCmdDrawIndirect (raster path) or a per-screen-tile gather (compute path) that
 // gives the same image within a stated tolerance. The visibility half (Hi-Z, cull, occlusion,
 // compaction) writes the two buffers this class reads: GlintFlareInstance[] and GlintFlareIndirect
 // (kernels/common/flare_types.h). docs/FLARE.md describes the look, the atlas and the tolerance;
@@ -75,20 +75,23 @@ struct FlareAtlasInfo {
 ///   instance_count (from `indirect`) are drawn; an index past the buffer's range is skipped.
 /// - `indirect`: one GlintFlareIndirect (32 bytes) with INDIRECT_BUFFER usage; `offset` a multiple
 ///   of 4. The raster path reads its VkDrawIndirectCommand (vertex_count must be
-///   vertices_per_instance(), first_vertex and first_instance 0), the compute path its
-///   VkDispatchIndirectCommand (group_count_x = instance_count * groups_per_instance(), y = z = 1).
+///   vertices_per_instance(), first_vertex and first_instance 0); the compute path reads
+///   group_count_x / groups_per_instance() as the instance count from a shader (the cull writes
+///   group_count_x = instance_count * groups_per_instance()), so for it the buffer also needs
+///   STORAGE_BUFFER usage.
 /// Both buffers' state fields say what last wrote them (the cull's COMPUTE_SHADER / SHADER_WRITE,
-/// or a transfer); glint records the barrier to DRAW_INDIRECT / INDIRECT_COMMAND_READ and to the
-/// shader read, and updates the state fields.
+/// or a transfer); glint records the barrier to the reads (raster: DRAW_INDIRECT /
+/// INDIRECT_COMMAND_READ and the vertex shader's storage read; compute: the compute shader's storage
+/// read of both) and updates the state fields.
 ///
 /// Recording creates no Vulkan object and updates no descriptor after the first use of a given
-/// (instances, color view) pair; each new pair gets its descriptor sets once.
+/// instances buffer (raster) or (instances, indirect, color view) triple (compute); each new one
+/// gets its descriptor set once.
 class LensFlare {
  public:
   /// Creates the pipelines and the atlas for drawing into `color_format` images of `extent`.
   /// Standalone contexts generate the atlas here (one submit); adopted contexts record its
-  /// generation in the first record_*() (or in record_setup()). The compute path's accumulation
-  /// buffer (12 bytes per pixel) is made on its first use (or by prepare_compute()).
+  /// generation in the first record_*() (or in record_setup()). The compute path owns no buffers.
   /// Throws Error(unsupported_format) for other formats or a format the device cannot blend
   /// (raster) / store (compute), Error(unsupported_size) for a zero or too large extent.
   LensFlare(const Context& context, VkFormat color_format, VkExtent2D extent);
@@ -99,18 +102,20 @@ class LensFlare {
   ~LensFlare();
 
   /// What the compaction must write into GlintFlareIndirect: vertex_count (the draw) and, per
-  /// instance, groups_per_instance workgroups (the dispatch). Constant for this LensFlare.
+  /// instance, groups_per_instance into group_count_x (read by the compute path). Constant for
+  /// this LensFlare (1 since the compute path gathers per screen tile).
   static constexpr uint32_t vertices_per_instance() { return 9 * 6; }
   uint32_t groups_per_instance() const;
-  /// The most instances the compute path can draw in one dispatch on this device
-  /// (maxComputeWorkGroupCount[0] / groups_per_instance()); record_compute() refuses an instance
-  /// buffer whose range holds more.
+  /// The most instances the compute path can read through one storage-buffer descriptor on this
+  /// device (maxStorageBufferRange / 48); record_compute() refuses an instance buffer whose range
+  /// holds more.
   uint32_t max_compute_instances() const;
 
   /// Records the atlas generation if it has not been recorded yet (adopted contexts; a no-op on
   /// standalone ones). record_*() call it themselves; call it earlier to keep the first frame short.
   void record_setup(VkCommandBuffer cmd);
-  /// Makes the compute path's accumulation buffer, so the first record_compute() allocates nothing.
+  /// Does nothing: the compute path no longer has an accumulation buffer. Kept for source
+  /// compatibility.
   void prepare_compute();
 
   /// Raster path: one vkCmdDrawIndirect of all instances inside vkCmdBeginRendering (dynamic
@@ -120,8 +125,9 @@ class LensFlare {
   void record_raster(VkCommandBuffer cmd, Image& color, Buffer& instances, Buffer& indirect, const FlareConfig& config,
                      Profiler* profiler = nullptr);
 
-  /// Compute path: flare_splat (vkCmdDispatchIndirect) accumulates into an fp32 buffer, then
-  /// flare_resolve adds the tiles that were touched to `color`. Same image as record_raster within
+  /// Compute path: one dispatch of flare_gather, a workgroup per screen tile, that reads the
+  /// instance count from `indirect`, bins the sprites that touch its tile, sums their light in fp32
+  /// and adds it to the lit pixels of `color`. Same image as record_raster within
   /// docs/FLARE.md's tolerance. Throws Error before recording anything for a bad argument.
   void record_compute(VkCommandBuffer cmd, Image& color, Buffer& instances, Buffer& indirect, const FlareConfig& config,
                       Profiler* profiler = nullptr);

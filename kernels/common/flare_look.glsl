@@ -1,5 +1,5 @@
 // The look of one light's flare, shared by the raster path (flare.vert computes the sprites,
-// flare.frag shades them) and the compute splat (flare_splat.comp does both), so both paths
+// flare.frag shades them) and the compute gather (flare_gather.comp does both), so both paths
 // evaluate exactly the same function. docs/FLARE.md describes it; host/reference/flare_reference.cpp
 // is its float64 twin. `precise` keeps the compiler from contracting or reordering these
 // expressions differently in the vertex and compute stages.
@@ -114,8 +114,42 @@ GlintFlareSprite glint_flare_sprite(GlintFlareInstance inst, uint slot, GlintFla
   return s;
 }
 
+// A conservative screen rectangle (x0, y0, x1, y1) around the sprite in `slot`, for binning: it
+// contains every pixel centre glint_flare_shade can light, with 2 px to spare, so it may be computed
+// without `precise` and without the level. Empty (x0 > x1) for some instances that draw nothing
+// (the rest are listed and then drawn as nothing by glint_flare_sprite).
+vec4 glint_flare_bounds(GlintFlareInstance inst, uint slot, GlintFlarePush p) {
+  const vec4 nothing = vec4(1.0, 1.0, -1.0, -1.0);
+  if (!(inst.size_px > 0.0 && inst.visible_fraction > 0.0 && inst.intensity > 0.0)) return nothing;
+  vec2 light = vec2(inst.center_x_px, inst.center_y_px);
+  vec2 centre = light;
+  vec2 extent;
+  if (slot == GLINT_FLARE_SLOT_MAIN) {
+    extent = vec2(GLINT_FLARE_MAIN_SCALE);
+  } else if (slot == GLINT_FLARE_SLOT_STREAK) {
+    extent = vec2(p.streak_length, GLINT_FLARE_STREAK_HEIGHT);
+  } else if (slot == GLINT_FLARE_SLOT_HALO) {
+    extent = vec2(GLINT_FLARE_HALO_SCALE);
+  } else if (slot == GLINT_FLARE_SLOT_STARBURST) {
+    extent = vec2(GLINT_FLARE_STARBURST_SCALE);
+  } else {
+    uint k = slot - GLINT_FLARE_SLOT_GHOST0;
+    float t = k == 0u ? p.ghost_pos0 : k == 1u ? p.ghost_pos1 : k == 2u ? p.ghost_pos2 : k == 3u ? p.ghost_pos3 : p.ghost_pos4;
+    extent = vec2(k == 0u   ? GLINT_FLARE_GHOST_SCALE_0
+                  : k == 1u ? GLINT_FLARE_GHOST_SCALE_1
+                  : k == 2u ? GLINT_FLARE_GHOST_SCALE_2
+                  : k == 3u ? GLINT_FLARE_GHOST_SCALE_3
+                            : GLINT_FLARE_GHOST_SCALE_4);
+    centre = light + (0.5 * vec2(p.viewport_w, p.viewport_h) - light) * t;
+  }
+  vec2 half_size = 0.5 * extent * inst.size_px * vec2(p.anamorphic_ratio, 1.0);
+  // 2 px, plus a few ulp of the operands for far-off lights whose large sprites reach the screen.
+  half_size += 2.0 + 1e-6 * (abs(centre) + half_size);
+  return vec4(centre - half_size, centre + half_size);
+}
+
 // Premultiplied light that `s` adds at the pixel whose centre is `pixel` (gl_FragCoord.xy in the
-// raster path, (x, y) + 0.5 in the splat). Zero outside [lo, lo + size): this test, not the
+// raster path, (x, y) + 0.5 in the gather). Zero outside [lo, lo + size): this test, not the
 // rasterizer's coverage, decides which pixels a sprite touches, so both paths agree exactly.
 vec4 glint_flare_shade(GlintFlareSprite s, vec2 pixel, sampler2D atlas) {
   if (!(s.size.x > 0.0)) return vec4(0.0);

@@ -1,6 +1,6 @@
 // The drawing half of the lens flares (issue 5, seed 004), declared once for GLSL and C++ (STYLE
 // rule 2): the element atlas layout, the sprites every light expands to, and the push constants
-// shared by flare.vert, flare.frag, flare_splat.comp and flare_resolve.comp. docs/FLARE.md explains
+// shared by flare.vert, flare.frag and flare_gather.comp. docs/FLARE.md explains
 // every number here. The visibility half meets the drawing half only in flare_types.h.
 #ifndef GLINT_FLARE_PARAMS_H
 #define GLINT_FLARE_PARAMS_H
@@ -68,6 +68,15 @@
 #define GLINT_FLARE_GHOST_GAIN_3 0.3
 #define GLINT_FLARE_GHOST_GAIN_4 0.45
 
+// ---- Compute path (flare_gather.comp) ------------------------------------------------------------
+// One workgroup per screen tile; each invocation shades GLINT_FLARE_GATHER_ROWS pixels of one column
+// (rows a workgroup height apart), so a 32x8 workgroup gathers a 32x64 tile (1020 tiles at 1080p).
+// Larger tiles bin each instance against fewer tiles; the rows share one binning and one sprite
+// setup per tile.
+// Shared lists are sized for at most GLINT_FLARE_GATHER_MAX_THREADS invocations (18 KiB).
+#define GLINT_FLARE_GATHER_ROWS 8u
+#define GLINT_FLARE_GATHER_MAX_THREADS 256u
+
 // Push constants of every flare kernel (88 bytes; the per-frame settings of FlareConfig, already
 // combined on the host: tint is (1, 1, 1) when the tint is off).
 struct GlintFlarePush {
@@ -89,10 +98,10 @@ struct GlintFlarePush {
   GLINT_FLOAT ghost_pos2;
   GLINT_FLOAT ghost_pos3;
   GLINT_FLOAT ghost_pos4;
-  GLINT_UINT groups_per_instance;  // compute splat: workgroups per instance (slots * chunks)
-  GLINT_UINT tile_w;               // compute: the resolve's tile (its workgroup) in pixels
-  GLINT_UINT tile_h;
-  GLINT_UINT tiles_x;  // tiles per row
+  GLINT_UINT groups_per_instance;  // compute: group_count_x / groups_per_instance = instance count
+  GLINT_UINT tile_w;               // compute: the gather's tile in pixels (workgroup x)
+  GLINT_UINT tile_h;               // (workgroup y * GLINT_FLARE_GATHER_ROWS)
+  GLINT_UINT indirect_word;        // compute: index of group_count_x in the bound indirect words
 };
 
 // Push constants of flare_atlas.comp (12 bytes).

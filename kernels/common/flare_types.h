@@ -1,8 +1,8 @@
 // The buffers that connect the lens-flare stages (issue 5, seed 004), declared once for GLSL and
 // C++ (STYLE rule 2): the caller's light list, the instance buffer that the cull/occlusion/
 // compaction kernel appends visible lights to, the indirect arguments it writes, its statistics,
-// and one result per input light. The raster draw (vkCmdDrawIndirect) and the compute splat
-// (vkCmdDispatchIndirect) both read GlintFlareInstance and GlintFlareIndirect and nothing else
+// and one result per input light. The raster draw (vkCmdDrawIndirect) and the compute gather
+// (which reads group_count_x) both read GlintFlareInstance and GlintFlareIndirect and nothing else
 // from the visibility stage, so the two halves meet only here.
 // GLSL: declare buffers as `layout(std430) buffer X { GlintFlareInstance instances[]; };`.
 // Only 4-byte scalars, so std430 and C++ layouts agree; the C++ side static_asserts them
