@@ -1,5 +1,6 @@
 #include "core/pipeline.h"
 
+#include "core/barriers.h"
 #include "core/context_state.h"
 #include "core/kernel_table.h"
 
@@ -119,6 +120,7 @@ void ComputePipeline::dispatch_raw(VkCommandBuffer cmd, VkDescriptorSet set, con
     throw Error(ErrorCode::invalid_argument,
                 concat("kernel ", id_, ": push constants are ", bytes, " bytes, pipeline expects ", push_bytes_));
   }
+  count_recorded_command();
   vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_);
   vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, layout_, 0, 1, &set, 0, nullptr);
   if (bytes) vkCmdPushConstants(cmd, layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, bytes, push);
