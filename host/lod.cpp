@@ -106,8 +106,9 @@ void LodBatch::record(VkCommandBuffer cmd, Buffer& queries, Buffer& levels, uint
       throw Error(ErrorCode::missing_usage, concat("LodBatch::record: ", role, " buffer lacks VK_BUFFER_USAGE_STORAGE_BUFFER_BIT usage"));
     }
     if (b.size != VK_WHOLE_SIZE && b.size < need) {
-      throw Error(ErrorCode::invalid_argument, concat("LodBatch::record: ", role, " buffer holds ", b.size,
-                                                      " bytes; ", count, " queries need ", need));
+      throw Error(ErrorCode::invalid_argument, concat("LodBatch::record: ", role, " buffer holds ", b.size, " bytes; ",
+                                                      count, " queries need ", need, ": accepted at least ", need,
+                                                      " bytes"));
     }
   };
   check(queries, "queries", VkDeviceSize(count) * sizeof(LodQuery));
