@@ -114,7 +114,8 @@ void LodBatch::record(VkCommandBuffer cmd, Buffer& queries, Buffer& levels, uint
     }
     if (b.size != VK_WHOLE_SIZE && b.size < need) {
       throw Error(ErrorCode::invalid_argument, concat("LodBatch::record: ", role, " buffer holds ", b.size, " bytes; ",
-                                                      count, " queries need ", need));
+                                                      count, " queries need ", need, ": accepted at least ", need,
+                                                      " bytes"));
     }
   };
   check(queries, "queries", VkDeviceSize(count) * sizeof(LodQuery));

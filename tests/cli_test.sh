@@ -78,6 +78,9 @@ bad bloom "$scene" "$tmp/x.exr" --iterations -1
 bad bloom "$scene" "$tmp/x.exr" --radius 0.1
 bad bloom "$scene" "$tmp/x.exr" --radius inf
 bad bloom "$scene" "$tmp/x.exr" --filter box
+bad bloom "$scene" "$tmp/x.exr" --intensity 1e40
+bad bloom "$scene" "$tmp/x.exr" --iterations 4294967296
+bad bloom "$scene" "$tmp/x.exr" --knee -inf
 bad bloom "$scene" "$tmp/x.exr" --png "$tmp/x.png" --exposure 0
 bad bloom "$scene" "$tmp/x.exr" --device 99
 bad bloom "$scene" "$tmp/x.exr" --device no-such-gpu
@@ -100,6 +103,37 @@ head -c $((size / 2)) "$scene" >"$tmp/half.exr"
 bad bloom "$tmp/half.exr" "$tmp/x.exr"
 head -c 40 "$scene" >"$tmp/header.exr"
 bad bloom "$tmp/header.exr" "$tmp/x.exr"
+# Truncated at many lengths, and single corrupted bytes through the header and the pixel data.
+for len in 1 4 8 9 16 64 100 200 300 $((size - 1)); do
+  head -c "$len" "$scene" >"$tmp/cut.exr"
+  bad bloom "$tmp/cut.exr" "$tmp/x.exr"
+done
+for at in 8 12 20 40 80 120 200 300 $((size / 3)) $((size - 8)); do
+  cp "$scene" "$tmp/flip.exr"
+  printf '\xff' | dd of="$tmp/flip.exr" bs=1 seek="$at" conv=notrunc status=none
+  "$GLINT" bloom "$tmp/flip.exr" "$tmp/x.exr" >"$tmp/out" 2>"$tmp/err"
+  rc=$?
+  # A flipped byte in pixel data may still decode: then it must succeed cleanly, else fail cleanly.
+  if ((rc == 0)); then [[ ! -s "$tmp/err" ]] || fail "flip at $at: exit 0 with stderr"; else bad bloom "$tmp/flip.exr" "$tmp/x.exr"; fi
+done
+# Hostile headers: a data window of 10^9 pixels a side, and an attribute that declares 2 GiB.
+python3 - "$scene" "$tmp" <<'PY'
+import struct, sys
+data = bytearray(open(sys.argv[1], "rb").read())
+i = data.index(b"dataWindow\0box2i\0") + len(b"dataWindow\0box2i\0") + 4
+huge = bytearray(data); huge[i + 8:i + 12] = struct.pack("<i", 10**9)
+open(sys.argv[2] + "/huge.exr", "wb").write(huge)
+j = data.index(b"compression\0compression\0") + len(b"compression\0compression\0")
+big = bytearray(data); big[j:j + 4] = struct.pack("<i", 2**31 - 1)
+open(sys.argv[2] + "/bigattr.exr", "wb").write(big)
+neg = bytearray(data); neg[j:j + 4] = struct.pack("<i", -5)
+open(sys.argv[2] + "/negattr.exr", "wb").write(neg)
+PY
+bad bloom "$tmp/huge.exr" "$tmp/x.exr"
+grep -qE 'larger than glint reads|exceeds the maximum width' "$tmp/err" || fail "huge data window: $(cat "$tmp/err")"
+bad bloom "$tmp/bigattr.exr" "$tmp/x.exr"
+grep -q 'corrupt header' "$tmp/err" || fail "2 GiB attribute: $(cat "$tmp/err")"
+bad bloom "$tmp/negattr.exr" "$tmp/x.exr"
 bad bloom "$scene" "$tmp/no/such/dir/x.exr"
 bad bloom "$scene" "$tmp"
 bad bloom "$scene" "$tmp/x.exr" --png "$tmp/no/such/dir/x.png"
@@ -141,6 +175,15 @@ bad lod --levels 13 --aniso 0.5 "$tmp/q.csv" "$tmp/x.csv"
 bad lod --levels 13 --padding -3 "$tmp/q.csv" "$tmp/x.csv"
 bad lod --levels 13 --atlas 0x4 "$tmp/q.csv" "$tmp/x.csv"
 bad lod --levels 13 "$tmp/missing.csv" "$tmp/x.csv"
+bad lod --levels 18 "$tmp/q.csv" "$tmp/x.csv"
+bad lod --levels 13 --aniso 100 "$tmp/q.csv" "$tmp/x.csv"
+bad lod --levels 13 --bias nan "$tmp/q.csv" "$tmp/x.csv"
+bad lod --levels 13 --bias 17 "$tmp/q.csv" "$tmp/x.csv"
+bad lod --levels 13 --atlas 70000x16 "$tmp/q.csv" "$tmp/x.csv"
+bad lod --levels 13 --atlas 16 "$tmp/q.csv" "$tmp/x.csv"
+bad lod --levels 13 --padding inf "$tmp/q.csv" "$tmp/x.csv"
+: >"$tmp/empty.csv"
+ok lod --levels 13 "$tmp/empty.csv" "$tmp/empty_out.csv"  # no queries, no rows: not an error
 printf '1,2,3\n' >"$tmp/short.csv"
 bad lod --levels 13 "$tmp/short.csv" "$tmp/x.csv"
 printf '0.1,0,0,0.1,nan?,4,0,0\n' >"$tmp/junk.csv"

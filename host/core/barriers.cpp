@@ -1,5 +1,7 @@
 #include "core/barriers.h"
 
+#include <atomic>
+
 namespace glint::detail {
 
 void Barriers::use(Image& image, VkImageLayout layout, VkPipelineStageFlags2 stage, VkAccessFlags2 access,
@@ -99,8 +101,16 @@ void Barriers::queue_read_chain(VkPipelineStageFlags2 readers, VkPipelineStageFl
   }
 }
 
+namespace {
+std::atomic<uint64_t> g_recorded_commands{0};
+}
+
+uint64_t recorded_commands() { return g_recorded_commands.load(); }
+void count_recorded_command() { g_recorded_commands.fetch_add(1, std::memory_order_relaxed); }
+
 void Barriers::flush(VkCommandBuffer cmd) {
   if (pending_.empty() && pending_buffers_.empty()) return;
+  count_recorded_command();
   VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
   dep.imageMemoryBarrierCount = static_cast<uint32_t>(pending_.size());
   dep.pImageMemoryBarriers = pending_.data();

@@ -4,6 +4,7 @@
 
 #include <glint/glint.h>
 
+#include <cstdint>
 #include <vector>
 
 namespace glint::detail {
@@ -28,6 +29,13 @@ class Barriers {
   std::vector<VkImageMemoryBarrier2> pending_;
   std::vector<VkBufferMemoryBarrier2> pending_buffers_;
 };
+
+/// Commands glint has recorded into any command buffer since the process started. Every vkCmd* call
+/// of the library goes through Barriers::flush, ComputePipeline::dispatch (one per dispatch) or
+/// Profiler::reset/mark, and each counts here; transfer.cpp (tools only) does not. Tests use it to
+/// prove that a record() that throws recorded nothing.
+uint64_t recorded_commands();
+void count_recorded_command();
 
 inline constexpr VkAccessFlags2 kWriteAccess =
     VK_ACCESS_2_SHADER_WRITE_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT | VK_ACCESS_2_TRANSFER_WRITE_BIT |

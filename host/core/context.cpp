@@ -1,5 +1,6 @@
 // Context: standalone (own instance and device) or adopted (the engine's), device selection,
 // validation messages, run_once for tools, and the timestamp profiler.
+#include "core/barriers.h"
 #include "core/check.h"
 #include "core/context_state.h"
 
@@ -49,6 +50,12 @@ uint32_t ContextState::memory_type(uint32_t type_bits, VkMemoryPropertyFlags fla
 }
 
 namespace {
+std::atomic<uint64_t> g_validation_messages{0};
+}
+
+uint64_t validation_messages_all_contexts() { return g_validation_messages.load(); }
+
+namespace {
 
 VKAPI_ATTR VkBool32 VKAPI_CALL on_validation_message(
     VkDebugUtilsMessageSeverityFlagBitsEXT severity, VkDebugUtilsMessageTypeFlagsEXT,
@@ -61,6 +68,7 @@ VKAPI_ATTR VkBool32 VKAPI_CALL on_validation_message(
     state->validation_log.push_back(text);
   }
   state->validation_count++;
+  g_validation_messages++;
   std::fprintf(stderr, "glint: validation: %s\n", text.c_str());
   return VK_FALSE;
 }
@@ -463,7 +471,9 @@ Profiler::~Profiler() {
 
 void Profiler::reset(VkCommandBuffer cmd) {
   labels_.clear();
-  if (pool_) vkCmdResetQueryPool(cmd, pool_, 0, capacity_);
+  if (!pool_) return;
+  detail::count_recorded_command();
+  vkCmdResetQueryPool(cmd, pool_, 0, capacity_);
 }
 
 void Profiler::mark(VkCommandBuffer cmd, const std::string& label) {
@@ -471,6 +481,7 @@ void Profiler::mark(VkCommandBuffer cmd, const std::string& label) {
   if (labels_.size() >= capacity_) {
     throw Error(ErrorCode::invalid_argument, concat("Profiler: more than ", capacity_, " marks in one frame"));
   }
+  detail::count_recorded_command();
   vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, pool_, static_cast<uint32_t>(labels_.size()));
   labels_.push_back(label);
 }

@@ -55,4 +55,9 @@ struct ContextState {
   std::map<std::string, std::shared_ptr<void>> cache;
 };
 
+/// Validation messages seen by every context of the process, including those that arrive while a
+/// context is being destroyed (the object tracker reports leaked objects in vkDestroyDevice, after
+/// which the context's own count is gone). Tests of leaks compare it before and after.
+uint64_t validation_messages_all_contexts();
+
 }  // namespace glint::detail

@@ -1,11 +1,12 @@
 #include "core/pipeline.h"
 
+#include "core/barriers.h"
+#include "core/context_state.h"
+#include "core/kernel_table.h"
+
 #include <cstdio>
 #include <cstdlib>
 #include <utility>
-
-#include "core/context_state.h"
-#include "core/kernel_table.h"
 
 namespace glint::detail {
 
@@ -120,6 +121,7 @@ void ComputePipeline::bind_and_push(VkCommandBuffer cmd, VkDescriptorSet set, co
     throw Error(ErrorCode::invalid_argument,
                 concat("kernel ", id_, ": push constants are ", bytes, " bytes, pipeline expects ", push_bytes_));
   }
+  count_recorded_command();
   vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_);
   vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, layout_, 0, 1, &set, 0, nullptr);
   if (bytes) vkCmdPushConstants(cmd, layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, bytes, push);

@@ -51,6 +51,54 @@ void limit_openexr_sizes() {
   (void)done;
 }
 
+// Walks the attribute list of every header (OpenEXR file layout: magic, version, then per header
+// "name\0type\0" + int32 size + value, ended by an empty name; multi-part files end the header list
+// with an empty header) and rejects a size that is negative or runs past the end of the file.
+// OpenEXR 3.1 allocates an attribute's declared size before reading it (OpaqueAttribute), so a
+// 40-byte file could otherwise make it allocate up to 2 GiB; found by fuzz/fuzz_exr.cpp. OpenEXR
+// parses known types (chlist, ...) by content rather than by the declared size, so a corrupt file
+// can still lead it to a different, huge declared size that this walk never saw: that allocation is
+// virtual (never written before the read fails) and ends in Error(io_failure) like any other.
+void check_header_sizes(const std::string& path, uint64_t file_bytes, bool multi_part) {
+  std::ifstream in(path, std::ios::binary);
+  in.seekg(8);  // magic number and version field, already checked by isOpenExrFile
+  uint64_t pos = 8;
+  auto read_name = [&](std::string& name) {
+    name.clear();
+    for (char c; in.get(c);) {
+      ++pos;
+      if (c == '\0') return true;
+      if (name.size() >= 255) fail(path, "corrupt header: an attribute name is longer than 255 bytes");
+      name += c;
+    }
+    fail(path, "truncated header (the file ends inside the attribute list)");
+  };
+  for (int header = 0;; ++header) {
+    if (header > 1024) fail(path, "corrupt header: more than 1024 parts");
+    std::string name, type;
+    int attributes = 0;
+    for (;; ++attributes) {
+      read_name(name);
+      if (name.empty()) break;
+      if (attributes > 4096) fail(path, "corrupt header: more than 4096 attributes");
+      read_name(type);
+      unsigned char size_bytes[4];
+      if (!in.read(reinterpret_cast<char*>(size_bytes), 4)) fail(path, "truncated header (in attribute " + name + ")");
+      pos += 4;
+      const int32_t size = int32_t(uint32_t(size_bytes[0]) | uint32_t(size_bytes[1]) << 8 |
+                                   uint32_t(size_bytes[2]) << 16 | uint32_t(size_bytes[3]) << 24);
+      if (size < 0 || uint64_t(size) > file_bytes - pos) {
+        fail(path, "corrupt header: attribute " + name + " declares " + std::to_string(size) + " bytes, but " +
+                       std::to_string(file_bytes - pos) + " remain in the file");
+      }
+      in.seekg(size, std::ios::cur);
+      pos += uint64_t(size);
+    }
+    // A single-part file has one header; a multi-part list ends with an empty header.
+    if (!multi_part || attributes == 0) return;
+  }
+}
+
 // Checks what the filesystem can tell before OpenEXR opens the file, for precise messages.
 void check_input_file(const std::string& path) {
   namespace fs = std::filesystem;
@@ -72,6 +120,7 @@ void check_input_file(const std::string& path) {
     fail(path, "not an OpenEXR file (no OpenEXR magic number and version)");
   }
   if (deep) fail(path, "deep OpenEXR files are not supported");
+  check_header_sizes(path, bytes, multi_part);
 }
 
 // Data window size, checked against the limits before anything is allocated.

@@ -1,0 +1,208 @@
+// Draws docs/STABILITY.md's pictures and prints its tables: the flicker of a moving sub-pixel
+// firefly per filter with and without the Karis guard, and the size of a point's bloom as a
+// fraction of the image width at 720p, 1080p and 2160p. The tests (tests/stability_test.cpp)
+// check the same numbers with the same code (host/analysis/light_stats.h).
+//
+//   build/bench/glint_stability_report [--out DIR]     (DIR default docs/stability)
+#include <glint/bloom.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "analysis/light_stats.h"
+#include "core/resources.h"
+#include "core/transfer.h"
+#include "io/png_io.h"
+
+namespace glint {
+namespace {
+
+// Input and output images live as long as the Bloom that caches descriptor sets for their views:
+// a destroyed view's handle can come back for a new view (lavapipe reuses them), and Bloom would
+// then use the set it made for the old one.
+struct Frame {
+  detail::OwnedImage in, out;
+  Frame(const Context& ctx, VkExtent2D e)
+      : in(ctx, e, VK_FORMAT_R32G32B32A32_SFLOAT, detail::kToolImageUsage),
+        out(ctx, e, VK_FORMAT_R32G32B32A32_SFLOAT, detail::kToolImageUsage) {}
+  CpuImage run(const Context& ctx, Bloom& bloom, const CpuImage& input) {
+    detail::upload(ctx, in.state, input);
+    ctx.run_once([&](VkCommandBuffer cmd) { bloom.record(cmd, in.state, out.state); });
+    return detail::download(ctx, out.state);
+  }
+};
+
+const char* filter_name(BloomFilter f) {
+  return f == BloomFilter::cod13 ? "cod13" : f == BloomFilter::dual ? "dual" : "gauss9";
+}
+
+struct FireflySeries {
+  std::vector<double> energy, centroid_error;
+};
+
+// A 1e4 point moving right by a quarter pixel per frame over 64 frames (16 px).
+FireflySeries firefly(const Context& ctx, const BloomConfig& config, float value, uint32_t w, uint32_t h) {
+  Frame frame(ctx, {w, h});
+  Bloom bloom(ctx, config);
+  FireflySeries s;
+  for (int f = 0; f < 64; ++f) {
+    const double x = 100.0 + 0.25 * f, y = h / 2.0;
+    const CpuImage in = analysis::subpixel_point(w, h, x, y, value);
+    const CpuImage out = frame.run(ctx, bloom, in);
+    const auto st = analysis::light_stats(analysis::added_light(out, in), w, h);
+    s.energy.push_back(st.energy);
+    s.centroid_error.push_back(st.cx - x);
+  }
+  return s;
+}
+
+// Energy of each frame relative to the series' mean, one line per setting, on a 0.4..1.6 scale
+// (grey lines at 1.0 +- 2%). Colours in docs/STABILITY.md. Drawn with values of 100 so that the
+// tonemapped PNG shows saturated colours.
+void draw_chart(const std::vector<std::pair<std::string, std::vector<double>>>& series, const std::string& path) {
+  const uint32_t w = 640, h = 320;
+  CpuImage img(w, h, 0.0f);
+  auto put = [&](int x, int y, const float* c) {
+    if (x < 0 || y < 0 || x >= int(w) || y >= int(h)) return;
+    for (int k = 0; k < 3; ++k) img.at(x, y)[k] = c[k];
+  };
+  const float grey[3] = {0.3f, 0.3f, 0.3f};
+  auto y_of = [&](double v) { return int(std::lround((1.6 - v) / 1.2 * (h - 1))); };
+  for (double v : {0.98, 1.0, 1.02})
+    for (uint32_t x = 0; x < w; ++x) put(int(x), y_of(v), grey);
+  const float colours[][3] = {{100, 0, 0},  {100, 100, 0}, {0, 100, 0},  {0, 100, 100},   {0, 0, 100},  {100, 0, 100},
+                              {100, 40, 0}, {40, 100, 0},  {0, 40, 100}, {100, 100, 100}, {60, 0, 100}, {100, 0, 40}};
+  for (size_t s = 0; s < series.size(); ++s) {
+    const auto& v = series[s].second;
+    const float* c = colours[s % 12];
+    for (size_t i = 0; i + 1 < v.size(); ++i) {
+      const int x0 = int(i * (w - 1) / (v.size() - 1)), x1 = int((i + 1) * (w - 1) / (v.size() - 1));
+      const int y0 = y_of(v[i]), y1 = y_of(v[i + 1]);
+      const int steps = std::max(std::abs(x1 - x0), std::abs(y1 - y0)) + 1;
+      for (int t = 0; t <= steps; ++t) {
+        const int x = x0 + (x1 - x0) * t / steps, y = y0 + (y1 - y0) * t / steps;
+        put(x, y, c);
+        put(x, y + 1, c);
+      }
+    }
+    std::printf("chart colour %zu (%g,%g,%g): %s\n", s, c[0], c[1], c[2], series[s].first.c_str());
+  }
+  io::write_png_tonemapped(path, img, 1.0f);
+}
+
+// Frames 0, 1, 2 (x = 0, 0.25, 0.5 px) of the 1e4 firefly for the default settings (top row) and
+// with the Karis guard off (bottom row), each crop 96x48 around the point.
+void filmstrip(const Context& ctx, const std::string& path) {
+  const uint32_t w = 256, h = 128, cw = 96, ch = 48;
+  CpuImage strip(3 * cw, 2 * ch, 0.0f);
+  for (int row = 0; row < 2; ++row) {
+    BloomConfig c;
+    c.firefly_guard = row == 0;
+    c.intensity = 1.0f;
+    Frame frame(ctx, {w, h});
+    Bloom bloom(ctx, c);
+    for (int f = 0; f < 3; ++f) {
+      const CpuImage in = analysis::subpixel_point(w, h, 100.0 + 0.25 * f, h / 2.0, 1e4f);
+      const CpuImage out = frame.run(ctx, bloom, in);
+      for (uint32_t y = 0; y < ch; ++y)
+        for (uint32_t x = 0; x < cw; ++x) {
+          const float* p = out.at(100 - cw / 2 + x, h / 2 - ch / 2 + y);
+          float* q = strip.at(f * cw + x, row * ch + y);
+          for (int k = 0; k < 4; ++k) q[k] = p[k];
+        }
+    }
+  }
+  io::write_png_tonemapped(path, strip, 0.5f);
+}
+
+int main_impl(int argc, char** argv) {
+  std::string out_dir = "docs/stability";
+  for (int i = 1; i < argc; ++i) {
+    if (!std::strcmp(argv[i], "--out") && i + 1 < argc) out_dir = argv[++i];
+  }
+  const Context ctx = Context::create();
+  std::printf("device: %s\n\n", ctx.info().name.c_str());
+  std::printf(
+      "| filter | Karis | max_brightness | value | energy spread | max step | centroid jitter px | mean energy "
+      "|\n|---|---|---|---|---|---|---|---|\n");
+  std::vector<std::pair<std::string, std::vector<double>>> chart;
+  for (float maxb : {1000.0f, 8000.0f}) {
+    for (float value : {1e4f, 1e3f}) {
+      for (BloomFilter f : {BloomFilter::cod13, BloomFilter::dual, BloomFilter::gauss9}) {
+        for (bool karis : {true, false}) {
+          BloomConfig c;
+          c.filter = f;
+          c.firefly_guard = karis;
+          c.max_brightness = maxb;
+          const auto s = firefly(ctx, c, value, 256, 128);
+          const auto ev = analysis::relative_variation(s.energy);
+          double lo = 1e9, hi = -1e9;
+          for (double e : s.centroid_error) lo = std::min(lo, e), hi = std::max(hi, e);
+          if (maxb == 1000.0f) {
+            std::vector<double> rel;
+            double m = 0;
+            for (double e : s.energy) m += e / s.energy.size();
+            for (double e : s.energy) rel.push_back(e / m);
+            chart.emplace_back(std::string(filter_name(f)) + (karis ? " Karis" : "") + (value > 5000 ? " 1e4" : " 1e3"),
+                               rel);
+          }
+          double mean = 0;
+          for (double e : s.energy) mean += e / s.energy.size();
+          std::printf("| %s | %s | %g | %g | %.4f | %.4f | %.3f | %.4g |\n", filter_name(f), karis ? "on" : "off", maxb,
+                      value, ev.spread, ev.max_step, hi - lo, mean);
+        }
+      }
+    }
+  }
+  draw_chart(chart, out_dir + "/firefly_energy.png");
+  filmstrip(ctx, out_dir + "/firefly_frames.png");
+  std::printf(
+      "\n| filter | iterations | size | r50 / width | r90 / width | sigma / width |\n|---|---|---|---|---|---|\n");
+  for (BloomFilter f : {BloomFilter::cod13, BloomFilter::dual, BloomFilter::gauss9}) {
+    struct Row {
+      VkExtent2D e;
+      uint32_t it;
+      float radius;
+    };
+    for (Row row :
+         {Row{{960, 540}, 4, 1.f}, Row{{1920, 1080}, 5, 1.f}, Row{{3840, 2160}, 6, 1.f}, Row{{1280, 720}, 5, 1.f},
+          Row{{1280, 720}, 5, 0.5f}, Row{{1280, 720}, 5, 0.7f}, Row{{1280, 720}, 4, 1.5f}, Row{{1280, 720}, 4, 2.f}}) {
+      {
+        const VkExtent2D e = row.e;
+        const uint32_t it = row.it;
+        BloomConfig c;
+        c.filter = f;
+        c.iterations = it;
+        c.radius = row.radius;
+        Frame frame(ctx, e);
+        Bloom bloom(ctx, c);
+        const double cx = e.width / 2, cy = e.height / 2;
+        const CpuImage in = analysis::subpixel_point(e.width, e.height, cx, cy, 1000.0f);
+        const auto added = analysis::added_light(frame.run(ctx, bloom, in), in);
+        const auto st = analysis::light_stats(added, e.width, e.height);
+        const double r50 = analysis::radius_holding(added, e.width, e.height, cx, cy, 0.5);
+        const double r90 = analysis::radius_holding(added, e.width, e.height, cx, cy, 0.9);
+        std::printf("| %s | %u r%.2f | %ux%u | %.4f | %.4f | %.4f |\n", filter_name(f), it, row.radius, e.width,
+                    e.height, r50 / e.width, r90 / e.width, std::sqrt(st.xx + st.yy) / e.width);
+      }
+    }
+  }
+  return 0;
+}
+
+}  // namespace
+}  // namespace glint
+
+int main(int argc, char** argv) {
+  try {
+    return glint::main_impl(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "glint_stability_report: %s\n", e.what());
+    return 1;
+  }
+}

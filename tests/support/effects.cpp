@@ -1,0 +1,74 @@
+#include "support/effects.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "support/gpu_test.h"
+
+namespace glint::test {
+
+CpuImage run_bloom_once(const BloomConfig& config, const CpuImage& input, VkFormat format) {
+  auto in = make_image(input, format);
+  auto out = make_poisoned({input.width, input.height}, format);
+  Bloom bloom(context(), config);
+  context().run_once([&](VkCommandBuffer cmd) { bloom.record(cmd, in.state, out.state); });
+  return detail::download(context(), out.state);
+}
+
+// docs/BLOOM.md, per axis, in full-resolution pixels, with T(k) = W / w(k) the size of a level-k
+// texel (T(-1) = 1) and distances measured between texel centres in texel-centre coordinates:
+// - Down(k-1 -> k) reads source texels within D of the mapped position p, which is the centre of
+//   the destination texel: cod13 taps reach +-2 and bilinear adds 1 (D = 3); dual +-1 + 1 (D = 2);
+//   gauss9's area average reaches ratio/2 + 1/2 with ratio = w(k-1) / w(k). In pixels: D * T(k-1).
+// - gauss9 then blurs level k with taps at up to 4 * radius texels, read linearly: (4 radius + 1) T(k).
+// - Up(k+1 -> k) and the composite read the smaller image at p + radius * offset with bilinear
+//   taps: cod13 and dual offsets reach 1 (radius + 1 texels), gauss9 only bilinear(p) (1 texel):
+//   R * T(k+1), and R * T(0) for the composite.
+// A change at the input reaches level N-1 through every downsample and comes back to the output
+// through every upsample, so the footprint is the sum of all of these; +1 px for fp rounding of p.
+uint32_t bloom_footprint_px(VkExtent2D extent, const BloomConfig& config) {
+  const auto chain = bloom_mip_chain(extent, config.iterations);
+  double worst = 0.0;
+  for (int axis = 0; axis < 2; ++axis) {
+    const double full = axis == 0 ? extent.width : extent.height;
+    double prev_size = full, prev_texel = 1.0, reach = 0.0;
+    for (const LevelSize& l : chain) {
+      const double size = axis == 0 ? l.width : l.height;
+      const double texel = full / size;
+      const double ratio = prev_size / size;
+      double down = 3.0;
+      if (config.filter == BloomFilter::dual) down = 2.0;
+      if (config.filter == BloomFilter::gauss9) down = ratio / 2.0 + 0.5;
+      reach += down * prev_texel;
+      if (config.filter == BloomFilter::gauss9) reach += (4.0 * config.radius + 1.0) * texel;
+      const double up = config.filter == BloomFilter::gauss9 ? 1.0 : config.radius + 1.0;
+      reach += up * texel;
+      prev_size = size;
+      prev_texel = texel;
+    }
+    worst = std::max(worst, reach);
+  }
+  return static_cast<uint32_t>(std::ceil(worst)) + 1;
+}
+
+std::vector<ImageEffect> image_effects() {
+  std::vector<ImageEffect> effects;
+  const std::pair<const char*, BloomFilter> filters[] = {
+      {"bloom cod13", BloomFilter::cod13}, {"bloom dual", BloomFilter::dual}, {"bloom gauss9", BloomFilter::gauss9}};
+  for (const auto& [name, filter] : filters) {
+    BloomConfig config;
+    config.filter = filter;
+    config.precision = Precision::fp32;  // the reference tolerance of bloom_test for fp32 levels
+    ImageEffect e;
+    e.name = name;
+    e.run = [config](const CpuImage& input, VkFormat format) { return run_bloom_once(config, input, format); };
+    e.footprint_px = [config](VkExtent2D extent) { return bloom_footprint_px(extent, config); };
+    e.reference = [config](const CpuImage& input) { return reference::bloom(input, config); };
+    e.tolerance = 1e-3;
+    e.clamp = config.max_brightness;
+    effects.push_back(std::move(e));
+  }
+  return effects;
+}
+
+}  // namespace glint::test
