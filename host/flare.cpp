@@ -669,4 +669,10 @@ void LensFlare::record_compute(VkCommandBuffer cmd, Image& color, Buffer& instan
   if (profiler) profiler->mark(cmd, "flare gather");
 }
 
+void LensFlare::forget_caller_resources() {
+  impl_->raster_sets.clear();
+  impl_->gather_sets.clear();
+  impl_->sets = std::make_unique<SetPool>(*impl_->context);
+}
+
 }  // namespace glint

@@ -583,4 +583,12 @@ void LightCuller::record(VkCommandBuffer cmd, HiZPyramid& hiz, Image& depth, Buf
   if (profiler) profiler->mark(cmd, "cull finalize");
 }
 
+void HiZPyramid::forget_caller_resources() { impl_->sets.clear(); }
+
+void LightCuller::forget_caller_resources() {
+  impl_->sets.clear();
+  impl_->arenas.clear();
+  impl_->sets_left = 0;
+}
+
 }  // namespace glint

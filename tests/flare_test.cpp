@@ -112,6 +112,7 @@ CpuImage draw(LensFlare& flare, Path path, const CpuImage& background, VkFormat 
     in.record_upload(cmd);
     record(flare, path, cmd, color.state, in, config);
   });
+  flare.forget_caller_resources();  // `color` dies here, `in` may be remade
   return detail::download(context(), color.state);
 }
 

@@ -89,6 +89,13 @@ struct FlareAtlasInfo {
 /// gets its descriptor set once.
 class LensFlare {
  public:
+  /// Drops the descriptor sets cached for the caller's images/buffers passed to record(). Vulkan
+  /// may give a new object the handle of a destroyed one, and these sets are keyed by handle: call
+  /// this before destroying (or after destroying, before the next record() with) a view or buffer
+  /// that was passed to record(), once no submitted work uses it. Engines that keep their render
+  /// targets alive never need it. Creates nothing; the next record() makes the sets again.
+  void forget_caller_resources();
+
   /// Creates the pipelines and the atlas for drawing into `color_format` images of `extent`.
   /// Standalone contexts generate the atlas here (one submit); adopted contexts record its
   /// generation in the first record_*() (or in record_setup()). The compute path owns no buffers.
