@@ -25,6 +25,7 @@ namespace glint {
 using detail::check_range;
 using detail::concat;
 
+static_assert(sizeof(GlintFlareGatherArgsPush) == 16);
 static_assert(sizeof(GlintFlarePush) == 88,
               "GlintFlarePush layout changed: update kernels/common/flare_params.h users");
 static_assert(offsetof(GlintFlarePush, ghost_pos0) == 52);
@@ -192,8 +193,12 @@ struct LensFlare::Impl {
   VkPipelineLayout raster_layout = VK_NULL_HANDLE;
   VkPipeline raster_pipeline = VK_NULL_HANDLE;
 
-  // Compute path: one gather kernel, no buffers of its own.
-  detail::ComputePipeline gather;
+  // Compute path: the gather kernel, launched by vkCmdDispatchIndirect with arguments that
+  // flare_gather_args.comp writes from the instance count.
+  detail::ComputePipeline gather, gather_args;
+  detail::OwnedBuffer gather_args_buffer;
+  Buffer gather_args_state;
+  std::map<BufferKey, VkDescriptorSet> gather_args_sets;
 
   std::unique_ptr<SetPool> sets;
   std::map<BufferKey, VkDescriptorSet> raster_sets;
@@ -426,6 +431,16 @@ void LensFlare::Impl::make_compute_pipelines() {
   d.push_constant_bytes = sizeof(GlintFlarePush);
   d.workgroup = workgroup;
   gather = detail::ComputePipeline(*context, d);
+  detail::PipelineDesc a;
+  a.kernel_id = "flare_gather_args_main";
+  a.bindings = {SB, SB};
+  a.push_constant_bytes = sizeof(GlintFlareGatherArgsPush);
+  a.workgroup = {1, 1};
+  gather_args = detail::ComputePipeline(*context, a);
+  // The gather's VkDispatchIndirectCommand, written on the GPU each frame.
+  const VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT;
+  gather_args_buffer = detail::OwnedBuffer(*context, 16, usage, false);
+  gather_args_state = Buffer{gather_args_buffer.buffer(), 0, 16, usage, VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE};
 }
 
 GlintFlarePush LensFlare::Impl::push(const FlareConfig& c) const {
@@ -655,23 +670,39 @@ void LensFlare::record_compute(VkCommandBuffer cmd, Image& color, Buffer& instan
     m.gather_sets.emplace(key, set);
   }
 
+  VkDescriptorSet args_set;
+  if (auto it = m.gather_args_sets.find(key_of(indirect_words)); it != m.gather_args_sets.end()) {
+    args_set = it->second;
+  } else {
+    args_set = m.sets->allocate(m.gather_args.set_layout());
+    write_set(m.device, args_set, {buffer_write(indirect_words), buffer_write(m.gather_args_state)});
+    m.gather_args_sets.emplace(key_of(indirect_words), args_set);
+  }
+
   GlintFlarePush p = m.push(config);
   p.indirect_word = uint32_t((args_offset - bound_offset) / sizeof(uint32_t));
+  GlintFlareGatherArgsPush ap{p.indirect_word, p.groups_per_instance, m.tiles_x, m.tiles_y};
   detail::Barriers b;
-  b.use(instances, kCompute, VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
+  // 1. The launch arguments: every tile when any instance is visible, none otherwise.
   b.use(indirect, kCompute, VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
+  b.use(m.gather_args_state, kCompute, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+  b.flush(cmd);
+  m.gather_args.dispatch(cmd, args_set, ap, 1, 1);
+  // 2. The gather, one workgroup per tile, launched with vkCmdDispatchIndirect.
+  b.use(m.gather_args_state, kIndirect, VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT);
+  b.use(instances, kCompute, VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
   b.use(m.atlas, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, kCompute, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT,
         GLINT_FLARE_ATLAS_LEVELS);
   b.use(color, VK_IMAGE_LAYOUT_GENERAL, kCompute, kStorageRW);
   b.flush(cmd);
-  // One workgroup per tile: tiles_x by tiles_y groups (dispatch() takes invocations).
-  m.gather.dispatch(cmd, set, p, m.tiles_x * m.workgroup.x, m.tiles_y * m.workgroup.y);
+  m.gather.dispatch_indirect(cmd, set, p, m.gather_args_buffer.buffer(), 0);
   if (profiler) profiler->mark(cmd, "flare gather");
 }
 
 void LensFlare::forget_caller_resources() {
   impl_->raster_sets.clear();
   impl_->gather_sets.clear();
+  impl_->gather_args_sets.clear();
   impl_->sets = std::make_unique<SetPool>(*impl_->context);
 }
 

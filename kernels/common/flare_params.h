@@ -104,6 +104,14 @@ struct GlintFlarePush {
   GLINT_UINT indirect_word;        // compute: index of group_count_x in the bound indirect words
 };
 
+// Push constants of flare_gather_args.comp (16 bytes).
+struct GlintFlareGatherArgsPush {
+  GLINT_UINT indirect_word;        // index of group_count_x in the bound indirect words
+  GLINT_UINT groups_per_instance;  // group_count_x / this = instance count
+  GLINT_UINT tiles_x;              // the gather's grid when any instance is visible
+  GLINT_UINT tiles_y;
+};
+
 // Push constants of flare_atlas.comp (12 bytes).
 struct GlintFlareAtlasPush {
   GLINT_UINT level;  // 0: evaluate the elements; k > 0: 2x2 box of level k - 1
