@@ -4,10 +4,9 @@
 #   ./glint.sh demo [args]   install what is missing, build, run `glint demo [args]`
 #   ./glint.sh test [args]   install, build the suite with ASan+UBSan (build-asan) and run ctest
 #                            [args] on lavapipe with validation (leak checking for the CPU-only
-#                            tests) and the CLI smoke test there; build the library and CLI in
-#                            Release, run the CLI smoke test, install into a temporary prefix and
-#                            build and run tests/consumer against it through find_package(glint);
-#                            then each libFuzzer target for GLINT_FUZZ_SECONDS (default 20)
+#                            tests) and the CLI smoke test there, install into a temporary prefix
+#                            and build and run tests/consumer against it through find_package(glint);
+#                            then each libFuzzer target for GLINT_FUZZ_SECONDS (default 10)
 #   ./glint.sh fuzz [seconds] build the libFuzzer targets (clang, build-fuzz) and run each one for
 #                            `seconds` (default 600) on a copy of fuzz/corpus/<name>; crashes are
 #                            written to fuzz/findings/
@@ -17,7 +16,7 @@
 #   GLINT_DEVICE      device for the CLI and tests (index or name part); when set, or when
 #                     VK_DRIVER_FILES / VK_ICD_FILENAMES is set, `test` does not force lavapipe
 #   GLINT_VALIDATION  `test` exports 1 unless it is already set
-#   GLINT_FUZZ_SECONDS  seconds per fuzz target in `test` (default 20; 0 skips the fuzz run)
+#   GLINT_FUZZ_SECONDS  seconds per fuzz target in `test` (default 10; 0 skips the fuzz run)
 #   GLINT_SKIP_ASAN   set to 1 to run the suite in the Release build instead (quick local runs)
 set -euo pipefail
 cd "$(dirname "$0")"
@@ -82,9 +81,10 @@ build() { cmake --build "$BUILD_DIR" -j"$(nproc)" "$@"; }
 # RSS checks of tests/api_errors_test.cpp (ApiMemory.*), which run in both builds.
 asan_test() {
   local dir=build-asan
-  # Release (-O2) with line tables only (-g1): symbolized sanitizer reports at a fraction of the
-  # compile time of full debug information.
-  [[ -f "$dir/CMakeCache.txt" ]] || cmake -S . -B "$dir" -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_FLAGS=-g1 \
+  # -O1 with line tables only (-g1): symbolized sanitizer reports at a fraction of the compile time
+  # of -O3 and full debug information (this build is CI's critical path on 2 cores).
+  [[ -f "$dir/CMakeCache.txt" ]] || cmake -S . -B "$dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+    -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" \
     -DGLINT_SANITIZE=ON -DGLINT_BUILD_TESTS=ON -DGLINT_BUILD_BENCH=OFF -DGLINT_BUILD_CLI=ON -DGLINT_WERROR=ON
   cmake --build "$dir" -j"$(nproc)"
   local ubsan="print_stacktrace=1:halt_on_error=1"
@@ -132,13 +132,14 @@ use_lavapipe_unless_told_otherwise() {
   fi
 }
 
+# consumer_check [BUILD]: installs BUILD (default $BUILD_DIR) and builds tests/consumer against it.
 consumer_check() {
-  local tmp
+  local from="${1:-$BUILD_DIR}" tmp
   tmp="$(mktemp -d)"
   # shellcheck disable=SC2064  # expand $tmp now
   trap "rm -rf '$tmp'" EXIT
   log "installing into $tmp/prefix and building tests/consumer with find_package(glint)"
-  cmake --install "$BUILD_DIR" --prefix "$tmp/prefix" >"$tmp/install.log" ||
+  cmake --install "$from" --prefix "$tmp/prefix" >"$tmp/install.log" ||
     { cat "$tmp/install.log" >&2; die "cmake --install failed"; }
   cmake -S tests/consumer -B "$tmp/build" -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH="$tmp/prefix" \
     >"$tmp/configure.log" 2>&1 || { cat "$tmp/configure.log" >&2; die "configuring tests/consumer failed"; }
@@ -168,18 +169,18 @@ case "$cmd" in
       configure GLINT_BUILD_TESTS GLINT_BUILD_CLI
       build
       ctest --test-dir "$BUILD_DIR" --output-on-failure --no-tests=error -j"$(nproc)" "$@"
+      log "CLI smoke test"
+      tests/cli_test.sh "$BUILD_DIR/host/glint"
+      consumer_check
     else
-      # The suite runs once, in the ASan+UBSan build (every test, validation on); the Release
-      # build makes only what users run (library, CLI) for the CLI smoke test and the consumer.
-      # Building the tests twice would double the CI's compile time on 2 cores.
+      # Everything runs once, in the ASan+UBSan build (build-asan): the suite with validation, the
+      # CLI smoke test, and the consumer, which links the sanitized library (the exported target
+      # carries the sanitizer link flags). Building a second, Release copy of the suite would
+      # double the CI's compile time on 2 cores; `demo` and `bench` use the Release build.
       asan_test "$@"
-      configure GLINT_BUILD_CLI
-      build --target glint_cli
+      consumer_check build-asan
     fi
-    log "CLI smoke test (Release build)"
-    tests/cli_test.sh "$BUILD_DIR/host/glint"
-    consumer_check
-    if [[ "${GLINT_FUZZ_SECONDS:-20}" != 0 ]]; then run_fuzz "${GLINT_FUZZ_SECONDS:-20}"; fi
+    if [[ "${GLINT_FUZZ_SECONDS:-10}" != 0 ]]; then run_fuzz "${GLINT_FUZZ_SECONDS:-10}"; fi
     log "all tests passed"
     ;;
   fuzz)

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "reference/blur_reference.h"
 #include "support/gpu_test.h"
 
 namespace glint::test {
@@ -51,6 +52,50 @@ uint32_t bloom_footprint_px(VkExtent2D extent, const BloomConfig& config) {
   return static_cast<uint32_t>(std::ceil(worst)) + 1;
 }
 
+// docs/BLUR.md, in input pixels, per method (+1 px for fp rounding of mapped positions):
+// - separable: the taps reach R = radius pixels.
+// - pyramid with k levels: each binomial downsample j reads source texels within 1.75 texels of
+//   level j-1 of the destination texel's centre (bilinear taps at +-0.75 around it), i.e. 2 texels
+//   of 2^(j-1) px; the level blur reaches ceil(4 sigma_k) texels of 2^k px; the cubic B-spline
+//   reads 2 texels of 2^k px on each side.
+// - dual with k levels and offset o: a downsample reads bilinear taps at +-o around the mapped
+//   centre (o + 1.5 texels of its source level), an upsample at +-o (o + 1.5 texels of its
+//   smaller source level); a change travels down every level and back up.
+uint32_t gauss_footprint_px(const BlurChoice& c) {
+  double reach = 0.0;
+  if (c.method == BlurMethod::separable) {
+    reach = c.radius;
+  } else if (c.method == BlurMethod::pyramid) {
+    const double s = std::ldexp(1.0, static_cast<int>(c.levels));
+    reach = 2.0 * (s - 1.0) + (std::ceil(4.0 * c.level_sigma) + 2.0) * s;
+  } else {
+    for (uint32_t j = 1; j <= c.levels; ++j) {
+      reach +=
+          (c.dual_offset + 1.5) * (std::ldexp(1.0, static_cast<int>(j) - 1) + std::ldexp(1.0, static_cast<int>(j)));
+    }
+  }
+  return static_cast<uint32_t>(std::ceil(reach)) + 1;
+}
+
+namespace {
+
+CpuImage run_gauss_once(const GaussianBlurConfig& config, const CpuImage& input, VkFormat format) {
+  auto in = make_image(input, format);
+  auto out = make_poisoned({input.width, input.height}, format);
+  GaussianBlur blur(context(), config);
+  context().run_once([&](VkCommandBuffer cmd) { blur.record(cmd, in.state, out.state); });
+  return detail::download(context(), out.state);
+}
+
+// The plan a GaussianBlur makes for `extent`, without recording anything.
+BlurChoice plan_for(const GaussianBlurConfig& config, VkExtent2D extent) {
+  GaussianBlur blur(context(), config);
+  blur.prepare(extent);
+  return blur.choice();
+}
+
+}  // namespace
+
 std::vector<ImageEffect> image_effects() {
   std::vector<ImageEffect> effects;
   const std::pair<const char*, BloomFilter> filters[] = {
@@ -66,6 +111,41 @@ std::vector<ImageEffect> image_effects() {
     e.reference = [config](const CpuImage& input) { return reference::bloom(input, config); };
     e.tolerance = 1e-3;
     e.clamp = config.max_brightness;
+    effects.push_back(std::move(e));
+  }
+  const std::tuple<const char*, BlurMethod, float> blurs[] = {{"gauss separable sigma 2", BlurMethod::separable, 2.0f},
+                                                              {"gauss pyramid sigma 8", BlurMethod::pyramid, 8.0f},
+                                                              {"gauss dual sigma 6", BlurMethod::dual, 6.0f}};
+  for (const auto& [name, method, sigma] : blurs) {
+    GaussianBlurConfig config;
+    config.method = method;
+    config.sigma_px = sigma;
+    config.precision = Precision::fp32;
+    ImageEffect e;
+    e.name = name;
+    e.run = [config](const CpuImage& input, VkFormat format) { return run_gauss_once(config, input, format); };
+    e.footprint_px = [config](VkExtent2D extent) { return gauss_footprint_px(plan_for(config, extent)); };
+    e.reference = [config](const CpuImage& input) {
+      const BlurChoice c = plan_for(config, {input.width, input.height});
+      blur_plan::Plan p;
+      p.sigma_px = config.sigma_px;
+      p.radius = c.radius;
+      p.levels = c.levels;
+      p.level_sigma = c.level_sigma;
+      p.dual_offset = c.dual_offset;
+      if (c.method == BlurMethod::pyramid) {
+        p.method = blur_plan::Method::pyramid;
+        return reference::gaussian_pyramid(input, p, false, reference::kBlurMaxValueFp32);
+      }
+      if (c.method == BlurMethod::dual) {
+        p.method = blur_plan::Method::dual;
+        return reference::gaussian_dual(input, p, false, reference::kBlurMaxValueFp32);
+      }
+      return reference::gaussian_separable(input, config.sigma_px, false, reference::kBlurMaxValueFp32);
+    };
+    // fp32 storage: fp32 arithmetic plus positions near 16384 carry ulp(x) ~ 1e-3 texel (blur_test).
+    e.tolerance = 2e-3;
+    e.clamp = 0.0f;  // no fp16 intermediates in these entries
     effects.push_back(std::move(e));
   }
   return effects;

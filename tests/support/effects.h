@@ -4,6 +4,7 @@
 #pragma once
 
 #include <glint/bloom.h>
+#include <glint/blur.h>
 
 #include <functional>
 #include <string>
@@ -32,12 +33,16 @@ struct ImageEffect {
   float clamp = 0.0f;
 };
 
-/// Every image effect in the tables: bloom with each filter (defaults otherwise).
-/// Blur (issue 3) and flares (issue 5) add their entries here.
+/// Every image effect in the tables: bloom with each filter (defaults otherwise) and the Gaussian
+/// blur with each method (issue 3). Flares (issue 5) draw from a light list, not an image: their
+/// robustness cases live in flare_e2e_test.cpp and occlusion_test.cpp.
 std::vector<ImageEffect> image_effects();
 
 /// Bloom's footprint from docs/BLOOM.md (exposed for its own test of the derivation).
 uint32_t bloom_footprint_px(VkExtent2D extent, const BloomConfig& config);
+
+/// The Gaussian blur's footprint from docs/BLUR.md for the method and parameters `blur` chose.
+uint32_t gauss_footprint_px(const BlurChoice& choice);
 
 /// Runs one Bloom on the test context (fresh images; output poisoned with NaN).
 CpuImage run_bloom_once(const BloomConfig& config, const CpuImage& input, VkFormat format);
