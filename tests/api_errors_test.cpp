@@ -12,6 +12,7 @@
 // A new effect joins by adding its rows to api_cases() (configs: every field out of range and NaN;
 // images/buffers: format, usage, zero size, above the device maximum, mismatched extents).
 #include <glint/bloom.h>
+#include <glint/blur.h>
 #include <glint/lod.h>
 #include <unistd.h>
 
@@ -48,6 +49,8 @@ struct Fixture {
   detail::OwnedBuffer queries{context(), 64 * sizeof(LodQuery), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, false};
   detail::OwnedBuffer levels{context(), 64 * sizeof(float), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, false};
   Bloom bloom{context()};
+  BlurPyramid pyramid{context()};
+  GaussianBlur gauss{context()};
   LodBatch lod{context()};
 
   Buffer buffer(const detail::OwnedBuffer& b) const {
@@ -185,6 +188,95 @@ std::vector<ApiCase> api_cases() {
                        fx.bloom.record(cmd, *images[0], *images[1]);
                      }});
   }
+
+  // Blur (issue 3): config fields, prepare sizes and images, as for bloom. In-place rows do not
+  // apply (GaussianBlur refuses input == output with its own row; BlurPyramid writes its own
+  // levels).
+  struct PyramidField {
+    const char* name;
+    std::function<void(BlurPyramidConfig&)> set;
+  };
+  const std::vector<PyramidField> pyramid_fields = {
+      {"sigma_texels[0]", [](BlurPyramidConfig& c) { c.sigma_texels[0] = 0.1f; }},
+      {"sigma_texels[1]", [](BlurPyramidConfig& c) { c.sigma_texels[1] = 5.0f; }},
+      {"sigma_texels[2]", [](BlurPyramidConfig& c) { c.sigma_texels[2] = kNaN; }},
+      {"precision", [](BlurPyramidConfig& c) { c.precision = static_cast<Precision>(2); }},
+  };
+  for (const PyramidField& f : pyramid_fields) {
+    BlurPyramidConfig bad;
+    f.set(bad);
+    const std::vector<std::string> msg = {std::string("BlurPyramidConfig::") + f.name, "accepted"};
+    cases.push_back({std::string("BlurPyramid(config) ") + f.name, ErrorCode::invalid_argument, msg,
+                     [bad](Fixture&, VkCommandBuffer, auto&, auto&) { BlurPyramid b(context(), bad); }});
+    cases.push_back({std::string("BlurPyramid::set_config ") + f.name, ErrorCode::invalid_argument, msg,
+                     [bad](Fixture& fx, VkCommandBuffer, auto&, auto&) { fx.pyramid.set_config(bad); }});
+  }
+  struct GaussField {
+    const char* name;
+    std::function<void(GaussianBlurConfig&)> set;
+  };
+  const std::vector<GaussField> gauss_fields = {
+      {"sigma_px", [](GaussianBlurConfig& c) { c.sigma_px = 0.4f; }},
+      {"sigma_px", [](GaussianBlurConfig& c) { c.sigma_px = 65.0f; }},
+      {"sigma_px", [](GaussianBlurConfig& c) { c.sigma_px = kNaN; }},
+      {"max_relative_error", [](GaussianBlurConfig& c) { c.max_relative_error = 0.0f; }},
+      {"max_relative_error", [](GaussianBlurConfig& c) { c.max_relative_error = 2.0f; }},
+      {"max_relative_error", [](GaussianBlurConfig& c) { c.max_relative_error = kNaN; }},
+      {"method", [](GaussianBlurConfig& c) { c.method = static_cast<BlurMethod>(4); }},
+      {"precision", [](GaussianBlurConfig& c) { c.precision = static_cast<Precision>(2); }},
+      {"linear_sampling", [](GaussianBlurConfig& c) { c.linear_sampling = true; }},  // needs separable
+  };
+  for (const GaussField& f : gauss_fields) {
+    GaussianBlurConfig bad;
+    f.set(bad);
+    const std::vector<std::string> msg = {std::string("GaussianBlurConfig::") + f.name, "accepted"};
+    const std::vector<std::string> linear_msg = {"GaussianBlurConfig::linear_sampling", "needs method separable"};
+    const auto& m = std::string(f.name) == "linear_sampling" ? linear_msg : msg;
+    cases.push_back({std::string("GaussianBlur(config) ") + f.name, ErrorCode::invalid_argument, m,
+                     [bad](Fixture&, VkCommandBuffer, auto&, auto&) { GaussianBlur b(context(), bad); }});
+    cases.push_back({std::string("GaussianBlur::set_config ") + f.name, ErrorCode::invalid_argument, m,
+                     [bad](Fixture& fx, VkCommandBuffer, auto&, auto&) { fx.gauss.set_config(bad); }});
+  }
+  for (VkExtent2D e :
+       {VkExtent2D{0, 16}, VkExtent2D{16, 0}, VkExtent2D{max_dim + 1, 16}, VkExtent2D{16, max_dim + 1}}) {
+    const std::string size = std::to_string(e.width) + "x" + std::to_string(e.height);
+    const std::string range = "accepted 1 to " + std::to_string(max_dim);
+    cases.push_back({"BlurPyramid::prepare " + size,
+                     ErrorCode::unsupported_size,
+                     {"BlurPyramid::prepare", range},
+                     [e](Fixture& fx, VkCommandBuffer, auto&, auto&) { fx.pyramid.prepare(e); }});
+    cases.push_back({"GaussianBlur::prepare " + size,
+                     ErrorCode::unsupported_size,
+                     {"GaussianBlur::prepare", range},
+                     [e](Fixture& fx, VkCommandBuffer, auto&, auto&) { fx.gauss.prepare(e); }});
+  }
+  for (const ImageRow& row : image_rows) {
+    const std::string what = row.what;
+    if (what == "in place with two formats") continue;
+    std::vector<std::string> msg = row.message;
+    msg.insert(msg.begin(), "GaussianBlur::record");
+    cases.push_back({"GaussianBlur::record " + what, row.code, msg,
+                     [edit = row.edit](Fixture& fx, VkCommandBuffer cmd, std::vector<Image*>& images, auto&) {
+                       edit(fx, *images[0], *images[1]);
+                       fx.gauss.record(cmd, *images[0], *images[1]);
+                     }});
+    if (what.rfind("input", 0) == 0 || what.rfind("unorm input", 0) == 0 || what.rfind("zero-width input", 0) == 0 ||
+        what.rfind("null input", 0) == 0) {
+      std::vector<std::string> pmsg = row.message;
+      pmsg.insert(pmsg.begin(), "BlurPyramid::record");
+      cases.push_back({"BlurPyramid::record " + what, row.code, pmsg,
+                       [edit = row.edit](Fixture& fx, VkCommandBuffer cmd, std::vector<Image*>& images, auto&) {
+                         edit(fx, *images[0], *images[1]);
+                         fx.pyramid.record(cmd, *images[0]);
+                       }});
+    }
+  }
+  cases.push_back({"GaussianBlur::record in place",
+                   ErrorCode::invalid_argument,
+                   {"GaussianBlur::record", "different images"},
+                   [](Fixture& fx, VkCommandBuffer cmd, std::vector<Image*>& images, auto&) {
+                     fx.gauss.record(cmd, *images[0], *images[0]);
+                   }});
 
   // LodAtlasConfig fields, through validate(), lod_level() and LodBatch::record.
   struct LodField {
