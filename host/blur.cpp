@@ -85,7 +85,7 @@ constexpr VkAccessFlags2 kStorageWrite = VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT;
 constexpr VkImageLayout kGeneral = VK_IMAGE_LAYOUT_GENERAL;
 constexpr VkImageLayout kReadOnly = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
 constexpr uint32_t kLineSegment = 256;  // blur_line.comp: outputs per workgroup along the line
-constexpr uint32_t kFusedMaxRadius = 12;
+using blur_plan::kFusedMaxRadius;       // one constant for the planner and the driver
 
 VkFormat precision_format(Precision p) {
   return p == Precision::fp32 ? VK_FORMAT_R32G32B32A32_SFLOAT : VK_FORMAT_R16G16B16A16_SFLOAT;
@@ -392,7 +392,6 @@ struct BlurPyramid::Impl {
   StepProgram prog;
   VkExtent2D extent{0, 0};
   std::array<VkExtent2D, 3> sizes{};
-  VkFormat prepared_input_format = VK_FORMAT_UNDEFINED;
 
   VkFormat level_format() const { return precision_format(config.precision); }
 

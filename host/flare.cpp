@@ -178,9 +178,7 @@ struct LensFlare::Impl {
   uint32_t tiles_x = 0, tiles_y = 0;     // gather tiles: workgroup x by workgroup y * GATHER_ROWS
 
   // Atlas: one image with every level, a view of all levels (sampling) and one per level (storage).
-  Image atlas;  // state tracks all levels together
-  VkDeviceMemory atlas_memory = VK_NULL_HANDLE;
-  std::vector<VkImageView> level_views;
+  detail::OwnedImage atlas_image;  // state tracks all levels together
   VkSampler sampler = VK_NULL_HANDLE;
   bool atlas_generated = false;
   detail::ComputePipeline atlas_pipeline;
@@ -211,10 +209,6 @@ struct LensFlare::Impl {
     if (raster_set_layout) vkDestroyDescriptorSetLayout(device, raster_set_layout, nullptr);
     sets.reset();
     if (sampler) vkDestroySampler(device, sampler, nullptr);
-    for (VkImageView v : level_views) vkDestroyImageView(device, v, nullptr);
-    if (atlas.view) vkDestroyImageView(device, atlas.view, nullptr);
-    if (atlas.image) vkDestroyImage(device, atlas.image, nullptr);
-    if (atlas_memory) vkFreeMemory(device, atlas_memory, nullptr);
   }
 
   void make_atlas();
@@ -229,45 +223,13 @@ struct LensFlare::Impl {
 void LensFlare::Impl::make_atlas() {
   auto& s = context->state();
   const uint32_t levels = GLINT_FLARE_ATLAS_LEVELS;
-  atlas.format = VK_FORMAT_R16G16B16A16_SFLOAT;  // HDR tiles scaled by bright lights: 8 bits would band
-  atlas.extent = {GLINT_FLARE_ATLAS_WIDTH, GLINT_FLARE_ATLAS_HEIGHT};
-  // TRANSFER_SRC and _DST: tests read every level back and poison it before generation.
-  atlas.usage = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT |
-                VK_IMAGE_USAGE_TRANSFER_DST_BIT;
-  VkImageCreateInfo info{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
-  info.imageType = VK_IMAGE_TYPE_2D;
-  info.format = atlas.format;
-  info.extent = {atlas.extent.width, atlas.extent.height, 1};
-  info.mipLevels = levels;
-  info.arrayLayers = 1;
-  info.samples = VK_SAMPLE_COUNT_1_BIT;
-  info.tiling = VK_IMAGE_TILING_OPTIMAL;
-  info.usage = atlas.usage;
-  info.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
-  detail::vk_check(vkCreateImage(device, &info, nullptr, &atlas.image), "vkCreateImage (flare atlas)");
-  s.count_object();
-  VkMemoryRequirements req;
-  vkGetImageMemoryRequirements(device, atlas.image, &req);
-  VkMemoryAllocateInfo alloc{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
-  alloc.allocationSize = req.size;
-  alloc.memoryTypeIndex = s.memory_type(req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
-  detail::vk_check(vkAllocateMemory(device, &alloc, nullptr, &atlas_memory), "vkAllocateMemory (flare atlas)");
-  s.count_object();
-  detail::vk_check(vkBindImageMemory(device, atlas.image, atlas_memory, 0), "vkBindImageMemory");
-  VkImageViewCreateInfo view{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
-  view.image = atlas.image;
-  view.viewType = VK_IMAGE_VIEW_TYPE_2D;
-  view.format = atlas.format;
-  view.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, levels, 0, 1};
-  detail::vk_check(vkCreateImageView(device, &view, nullptr, &atlas.view), "vkCreateImageView");
-  s.count_object();
-  for (uint32_t k = 0; k < levels; ++k) {
-    view.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, k, 1, 0, 1};
-    VkImageView v = VK_NULL_HANDLE;
-    detail::vk_check(vkCreateImageView(device, &view, nullptr, &v), "vkCreateImageView");
-    s.count_object();
-    level_views.push_back(v);
-  }
+  // RGBA16F: HDR tiles scaled by bright lights: 8 bits would band. TRANSFER_SRC and _DST: tests
+  // read every level back and poison it before generation.
+  atlas_image =
+      detail::OwnedImage(*context, {GLINT_FLARE_ATLAS_WIDTH, GLINT_FLARE_ATLAS_HEIGHT}, VK_FORMAT_R16G16B16A16_SFLOAT,
+                         VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT |
+                             VK_IMAGE_USAGE_TRANSFER_DST_BIT,
+                         levels);
   // Trilinear, clamp to edge (the atlas border is padding), no anisotropy: the level comes from the
   // shader's explicit atlas-aware LOD (textureLod), identical in both paths.
   VkSamplerCreateInfo si{VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO};
@@ -289,8 +251,8 @@ void LensFlare::Impl::make_atlas() {
   atlas_sets_arena = detail::DescriptorArena(*context, levels);
   const VkImageLayout G = VK_IMAGE_LAYOUT_GENERAL;
   for (uint32_t k = 0; k < levels; ++k) {
-    atlas_sets.push_back(
-        atlas_sets_arena.make_set(atlas_pipeline, {{level_views[k == 0 ? 0 : k - 1], G}, {level_views[k], G}}));
+    atlas_sets.push_back(atlas_sets_arena.make_set(
+        atlas_pipeline, {{atlas_image.level_view(k == 0 ? 0 : k - 1), G}, {atlas_image.level_view(k), G}}));
   }
 }
 
@@ -300,12 +262,13 @@ void LensFlare::Impl::record_setup(VkCommandBuffer cmd) {
   detail::Barriers b;
   const VkImageLayout G = VK_IMAGE_LAYOUT_GENERAL;
   for (uint32_t k = 0; k < levels; ++k) {
-    b.use(atlas, G, kCompute, kStorageRW, levels);  // level k - 1 written -> read; level k written
+    b.use(atlas_image.state, G, kCompute, kStorageRW, levels);  // level k - 1 written -> read; level k written
     b.flush(cmd);
-    GlintFlareAtlasPush p{k, std::max(1u, atlas.extent.width >> k), std::max(1u, atlas.extent.height >> k)};
+    GlintFlareAtlasPush p{k, std::max(1u, atlas_image.state.extent.width >> k),
+                          std::max(1u, atlas_image.state.extent.height >> k)};
     atlas_pipeline.dispatch(cmd, atlas_sets[k], p, p.width, p.height);
   }
-  b.use(atlas, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+  b.use(atlas_image.state, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
         VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
         VK_ACCESS_2_SHADER_SAMPLED_READ_BIT, levels);
   b.flush(cmd);
@@ -562,11 +525,11 @@ VkExtent2D LensFlare::extent() const { return impl_->extent; }
 
 FlareAtlasInfo LensFlare::atlas() const {
   FlareAtlasInfo a;
-  a.image = impl_->atlas.image;
-  a.view = impl_->atlas.view;
-  a.format = impl_->atlas.format;
-  a.width = impl_->atlas.extent.width;
-  a.height = impl_->atlas.extent.height;
+  a.image = impl_->atlas_image.state.image;
+  a.view = impl_->atlas_image.state.view;
+  a.format = impl_->atlas_image.state.format;
+  a.width = impl_->atlas_image.state.extent.width;
+  a.height = impl_->atlas_image.state.extent.height;
   a.levels = GLINT_FLARE_ATLAS_LEVELS;
   a.padding_texels = GLINT_FLARE_ATLAS_PADDING;
   a.generated = impl_->atlas_generated;
@@ -593,7 +556,7 @@ void LensFlare::record_raster(VkCommandBuffer cmd, Image& color, Buffer& instanc
     set = m.sets->allocate(m.raster_set_layout);
     Write img{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
               {},
-              {m.sampler, m.atlas.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL}};
+              {m.sampler, m.atlas_image.state.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL}};
     write_set(m.device, set, {buffer_write(instances), img});
     m.raster_sets.emplace(key_of(instances), set);
   }
@@ -601,7 +564,7 @@ void LensFlare::record_raster(VkCommandBuffer cmd, Image& color, Buffer& instanc
   detail::Barriers b;
   b.use(instances, VK_PIPELINE_STAGE_2_VERTEX_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
   b.use(indirect, kIndirect, VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT);
-  b.use(m.atlas, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
+  b.use(m.atlas_image.state, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
         VK_ACCESS_2_SHADER_SAMPLED_READ_BIT, GLINT_FLARE_ATLAS_LEVELS);
   b.use(color, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
         VK_ACCESS_2_COLOR_ATTACHMENT_READ_BIT | VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT);
@@ -643,9 +606,10 @@ void LensFlare::record_compute(VkCommandBuffer cmd, Image& color, Buffer& instan
                 "compute path reads the instance count from it)");
   }
   if (instances.size != VK_WHOLE_SIZE && instances.size / sizeof(GlintFlareInstance) > max_compute_instances()) {
-    throw Error(ErrorCode::invalid_argument,
-                concat("LensFlare::record_compute: the instances buffer holds ", instances.size / sizeof(GlintFlareInstance),
-                       " instances; one storage-buffer descriptor holds at most ", max_compute_instances()));
+    throw Error(
+        ErrorCode::invalid_argument,
+        concat("LensFlare::record_compute: the instances buffer holds ", instances.size / sizeof(GlintFlareInstance),
+               " instances; one storage-buffer descriptor holds at most ", max_compute_instances()));
   }
   if (!config.enabled || config.intensity == 0.0f) return;  // adds nothing: record nothing
   m.record_setup(cmd);
@@ -654,8 +618,8 @@ void LensFlare::record_compute(VkCommandBuffer cmd, Image& color, Buffer& instan
   // down to minStorageBufferOffsetAlignment; the push constant says where group_count_x is.
   const VkDeviceSize args_offset = indirect.offset + offsetof(GlintFlareIndirect, group_count_x);
   const VkDeviceSize bound_offset = args_offset - args_offset % m.storage_alignment;
-  const Buffer indirect_words{indirect.buffer, bound_offset, args_offset - bound_offset + sizeof(uint32_t),
-                              indirect.usage,  indirect.stage,  indirect.access};
+  const Buffer indirect_words{indirect.buffer, bound_offset,   args_offset - bound_offset + sizeof(uint32_t),
+                              indirect.usage,  indirect.stage, indirect.access};
   const GatherKey key{key_of(instances), key_of(indirect_words), color.view};
   VkDescriptorSet set;
   if (auto it = m.gather_sets.find(key); it != m.gather_sets.end()) {
@@ -664,7 +628,7 @@ void LensFlare::record_compute(VkCommandBuffer cmd, Image& color, Buffer& instan
     set = m.sets->allocate(m.gather.set_layout());
     Write img{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
               {},
-              {m.sampler, m.atlas.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL}};
+              {m.sampler, m.atlas_image.state.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL}};
     Write dst{VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, {}, {VK_NULL_HANDLE, color.view, VK_IMAGE_LAYOUT_GENERAL}};
     write_set(m.device, set, {buffer_write(instances), img, buffer_write(indirect_words), dst});
     m.gather_sets.emplace(key, set);
@@ -691,7 +655,7 @@ void LensFlare::record_compute(VkCommandBuffer cmd, Image& color, Buffer& instan
   // 2. The gather, one workgroup per tile, launched with vkCmdDispatchIndirect.
   b.use(m.gather_args_state, kIndirect, VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT);
   b.use(instances, kCompute, VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
-  b.use(m.atlas, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, kCompute, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT,
+  b.use(m.atlas_image.state, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, kCompute, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT,
         GLINT_FLARE_ATLAS_LEVELS);
   b.use(color, VK_IMAGE_LAYOUT_GENERAL, kCompute, kStorageRW);
   b.flush(cmd);

@@ -115,10 +115,7 @@ struct HiZPyramid::Impl {
   uint32_t levels = 0;
   // The pyramid: one R32F image with max(1, levels) mips, a sampling view of all mips and a storage
   // view per mip.
-  VkImage image = VK_NULL_HANDLE;
-  VkDeviceMemory memory = VK_NULL_HANDLE;
-  std::vector<VkImageView> level_views;
-  Image state;
+  detail::OwnedImage pyramid;
   detail::OwnedBuffer counters;  // one word per dispatch
   Buffer counter_state;
   bool counters_cleared = false;
@@ -146,63 +143,18 @@ struct HiZPyramid::Impl {
     sets.clear();
     VkDevice device = context ? context->device() : VK_NULL_HANDLE;
     if (!device) return;
-    for (VkImageView v : level_views) vkDestroyImageView(device, v, nullptr);
-    level_views.clear();
     if (sampler) vkDestroySampler(device, sampler, nullptr);
     sampler = VK_NULL_HANDLE;
-    if (state.view) vkDestroyImageView(device, state.view, nullptr);
-    if (image) vkDestroyImage(device, image, nullptr);
-    if (memory) vkFreeMemory(device, memory, nullptr);
-    state = Image{};
-    image = VK_NULL_HANDLE;
-    memory = VK_NULL_HANDLE;
+    pyramid.reset();
   }
 
   void make_image() {
-    auto& s = context->state();
-    VkDevice device = context->device();
-    const uint32_t mips = std::max(1u, levels);
     const VkExtent2D e0{std::max(1u, config.extent.width >> 1), std::max(1u, config.extent.height >> 1)};
-    VkImageCreateInfo info{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
-    info.imageType = VK_IMAGE_TYPE_2D;
-    info.format = VK_FORMAT_R32_SFLOAT;
-    info.extent = {e0.width, e0.height, 1};
-    info.mipLevels = mips;
-    info.arrayLayers = 1;
-    info.samples = VK_SAMPLE_COUNT_1_BIT;
-    info.tiling = VK_IMAGE_TILING_OPTIMAL;
     // Transfer usage lets tools read the pyramid back and tests poison it.
-    info.usage = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT |
-                 VK_IMAGE_USAGE_TRANSFER_DST_BIT;
-    info.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
-    detail::vk_check(vkCreateImage(device, &info, nullptr, &image), "vkCreateImage (Hi-Z pyramid)");
-    s.count_object();
-    VkMemoryRequirements req;
-    vkGetImageMemoryRequirements(device, image, &req);
-    VkMemoryAllocateInfo alloc{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
-    alloc.allocationSize = req.size;
-    alloc.memoryTypeIndex = s.memory_type(req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
-    detail::vk_check(vkAllocateMemory(device, &alloc, nullptr, &memory), "vkAllocateMemory (Hi-Z pyramid)");
-    s.count_object();
-    detail::vk_check(vkBindImageMemory(device, image, memory, 0), "vkBindImageMemory");
-    VkImageViewCreateInfo view{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
-    view.image = image;
-    view.viewType = VK_IMAGE_VIEW_TYPE_2D;
-    view.format = VK_FORMAT_R32_SFLOAT;
-    view.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, mips, 0, 1};
-    detail::vk_check(vkCreateImageView(device, &view, nullptr, &state.view), "vkCreateImageView (Hi-Z)");
-    s.count_object();
-    for (uint32_t m = 0; m < mips; ++m) {
-      view.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, m, 1, 0, 1};
-      VkImageView v = VK_NULL_HANDLE;
-      detail::vk_check(vkCreateImageView(device, &view, nullptr, &v), "vkCreateImageView (Hi-Z level)");
-      s.count_object();
-      level_views.push_back(v);
-    }
-    state.image = image;
-    state.format = VK_FORMAT_R32_SFLOAT;
-    state.extent = e0;
-    state.usage = info.usage;
+    pyramid = detail::OwnedImage(*context, e0, VK_FORMAT_R32_SFLOAT,
+                                 VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT |
+                                     VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
+                                 std::max(1u, levels));
   }
 
   // The dispatches that build `levels` levels: each reduces its base through up to 6 levels by
@@ -246,7 +198,7 @@ struct HiZPyramid::Impl {
       for (uint32_t k = 1; k <= GLINT_HIZ_MAX_LEVELS; ++k) {
         // Levels not built bind the last built one: never accessed, but every binding needs a view.
         const uint32_t m = std::min(k, std::max(1u, levels)) - 1;
-        b[k].image = {level_views[m], VK_IMAGE_LAYOUT_GENERAL};
+        b[k].image = {pyramid.level_view(m), VK_IMAGE_LAYOUT_GENERAL};
       }
       b[GLINT_HIZ_MAX_LEVELS + 1].buffer = counter_state;
       for (uint32_t i = 0; i < 2; ++i) {
@@ -291,7 +243,8 @@ HiZPyramid::HiZPyramid(const Context& context, const HiZConfig& config) : impl_(
   d.workgroup = {256, 1};  // the kernel's local size is fixed at 256 (64x64 tiles)
   for (uint32_t i = 0; i < 2; ++i) {
     const uint32_t base = i == 0 ? 0u : GLINT_HIZ_TILE_LEVELS;
-    const bool used = std::any_of(m.passes.begin(), m.passes.end(), [&](const Impl::Pass& p) { return p.push.base_level == base; });
+    const bool used =
+        std::any_of(m.passes.begin(), m.passes.end(), [&](const Impl::Pass& p) { return p.push.base_level == base; });
     if (!used) continue;
     d.specialization = {base};  // constant_id 2
     m.pipelines[i] = detail::ComputePipeline(context, d);
@@ -304,8 +257,8 @@ HiZPyramid::~HiZPyramid() = default;
 
 const HiZConfig& HiZPyramid::config() const { return impl_->config; }
 uint32_t HiZPyramid::levels() const { return impl_->levels; }
-Image& HiZPyramid::image() { return impl_->state; }
-const Image& HiZPyramid::image() const { return impl_->state; }
+Image& HiZPyramid::image() { return impl_->pyramid.state; }
+const Image& HiZPyramid::image() const { return impl_->pyramid.state; }
 
 uint64_t HiZPyramid::min_bytes_moved() const {
   const auto& c = impl_->config;
@@ -349,12 +302,12 @@ void HiZPyramid::record(VkCommandBuffer cmd, Image& depth, Profiler* profiler) {
     m.counters_cleared = true;
   }
   b.use(depth, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, kCompute, kSampled);
-  b.use(m.state, VK_IMAGE_LAYOUT_GENERAL, kCompute, kStorageRead | kStorageWrite, std::max(1u, m.levels));
+  b.use(m.pyramid.state, VK_IMAGE_LAYOUT_GENERAL, kCompute, kStorageRead | kStorageWrite, std::max(1u, m.levels));
   b.use(m.counter_state, kCompute, kStorageRead | kStorageWrite);
   b.flush(cmd);
   for (size_t i = 0; i < m.passes.size(); ++i) {
     if (i > 0) {  // the next pass reads the level the previous one wrote
-      b.use(m.state, VK_IMAGE_LAYOUT_GENERAL, kCompute, kStorageRead | kStorageWrite, std::max(1u, m.levels));
+      b.use(m.pyramid.state, VK_IMAGE_LAYOUT_GENERAL, kCompute, kStorageRead | kStorageWrite, std::max(1u, m.levels));
       b.flush(cmd);
     }
     const auto& p = m.passes[i];

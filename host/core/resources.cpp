@@ -1,33 +1,40 @@
 #include "core/resources.h"
 
+#include <utility>
+
 #include "core/check.h"
 #include "core/context_state.h"
-
-#include <utility>
 
 namespace glint::detail {
 
 uint32_t texel_bytes(VkFormat format) {
   switch (format) {
-    case VK_FORMAT_R16G16B16A16_SFLOAT: return 8;
-    case VK_FORMAT_R32G32B32A32_SFLOAT: return 16;
-    case VK_FORMAT_R8G8B8A8_UNORM: return 4;
+    case VK_FORMAT_R16G16B16A16_SFLOAT:
+      return 8;
+    case VK_FORMAT_R32G32B32A32_SFLOAT:
+      return 16;
+    case VK_FORMAT_R8G8B8A8_UNORM:
+      return 4;
     case VK_FORMAT_R32_SFLOAT:
     case VK_FORMAT_D32_SFLOAT:
-    case VK_FORMAT_R32_UINT: return 4;
-    case VK_FORMAT_R16_SFLOAT: return 2;
-    default: throw Error(ErrorCode::unsupported_format, concat("texel size of ", format_name(format), " is unknown"));
+    case VK_FORMAT_R32_UINT:
+      return 4;
+    case VK_FORMAT_R16_SFLOAT:
+      return 2;
+    default:
+      throw Error(ErrorCode::unsupported_format, concat("texel size of ", format_name(format), " is unknown"));
   }
 }
 
-OwnedImage::OwnedImage(const Context& context, VkExtent2D extent, VkFormat format, VkImageUsageFlags usage) {
+OwnedImage::OwnedImage(const Context& context, VkExtent2D extent, VkFormat format, VkImageUsageFlags usage,
+                       uint32_t levels) {
   device_ = context.device();
   auto& s = context.state();
   VkImageCreateInfo info{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
   info.imageType = VK_IMAGE_TYPE_2D;
   info.format = format;
   info.extent = {extent.width, extent.height, 1};
-  info.mipLevels = 1;
+  info.mipLevels = levels;
   info.arrayLayers = 1;
   info.samples = VK_SAMPLE_COUNT_1_BIT;
   info.tiling = VK_IMAGE_TILING_OPTIMAL;
@@ -38,6 +45,7 @@ OwnedImage::OwnedImage(const Context& context, VkExtent2D extent, VkFormat forma
   state.format = format;
   state.extent = extent;
   state.usage = usage;
+  levels_ = levels;
   try {
     VkMemoryRequirements req;
     vkGetImageMemoryRequirements(device_, state.image, &req);
@@ -52,9 +60,17 @@ OwnedImage::OwnedImage(const Context& context, VkExtent2D extent, VkFormat forma
     view.viewType = VK_IMAGE_VIEW_TYPE_2D;
     view.format = format;
     const bool depth = format == VK_FORMAT_D32_SFLOAT;
-    view.subresourceRange = {static_cast<VkImageAspectFlags>(depth ? VK_IMAGE_ASPECT_DEPTH_BIT : VK_IMAGE_ASPECT_COLOR_BIT), 0, 1, 0, 1};
+    const auto aspect = static_cast<VkImageAspectFlags>(depth ? VK_IMAGE_ASPECT_DEPTH_BIT : VK_IMAGE_ASPECT_COLOR_BIT);
+    view.subresourceRange = {aspect, 0, levels, 0, 1};
     vk_check(vkCreateImageView(device_, &view, nullptr, &state.view), "vkCreateImageView");
     s.count_object();
+    for (uint32_t k = 0; levels > 1 && k < levels; ++k) {
+      view.subresourceRange = {aspect, k, 1, 0, 1};
+      VkImageView v = VK_NULL_HANDLE;
+      vk_check(vkCreateImageView(device_, &view, nullptr, &v), "vkCreateImageView (level)");
+      s.count_object();
+      level_views_.push_back(v);
+    }
   } catch (...) {
     reset();
     throw;
@@ -67,12 +83,15 @@ OwnedImage& OwnedImage::operator=(OwnedImage&& other) noexcept {
     device_ = std::exchange(other.device_, VK_NULL_HANDLE);
     memory_ = std::exchange(other.memory_, VK_NULL_HANDLE);
     state = std::exchange(other.state, Image{});
+    levels_ = std::exchange(other.levels_, 0);
+    level_views_ = std::exchange(other.level_views_, {});
   }
   return *this;
 }
 
 void OwnedImage::reset() {
   if (device_) {
+    for (VkImageView v : level_views_) vkDestroyImageView(device_, v, nullptr);
     if (state.view) vkDestroyImageView(device_, state.view, nullptr);
     if (state.image) vkDestroyImage(device_, state.image, nullptr);
     if (memory_) vkFreeMemory(device_, memory_, nullptr);
@@ -80,6 +99,8 @@ void OwnedImage::reset() {
   device_ = VK_NULL_HANDLE;
   memory_ = VK_NULL_HANDLE;
   state = Image{};
+  levels_ = 0;
+  level_views_.clear();
 }
 
 OwnedBuffer::OwnedBuffer(const Context& context, VkDeviceSize size, VkBufferUsageFlags usage, bool host_visible) {
@@ -97,7 +118,8 @@ OwnedBuffer::OwnedBuffer(const Context& context, VkDeviceSize size, VkBufferUsag
     vkGetBufferMemoryRequirements(device_, buffer_, &req);
     VkMemoryAllocateInfo alloc{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
     alloc.allocationSize = req.size;
-    VkMemoryPropertyFlags flags = host_visible ? VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT : VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT;
+    VkMemoryPropertyFlags flags =
+        host_visible ? VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT : VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT;
     alloc.memoryTypeIndex = s.memory_type(req.memoryTypeBits, flags);
     coherent_ = (s.memory.memoryTypes[alloc.memoryTypeIndex].propertyFlags & VK_MEMORY_PROPERTY_HOST_COHERENT_BIT) != 0;
     vk_check(vkAllocateMemory(device_, &alloc, nullptr, &memory_), "vkAllocateMemory (buffer)");

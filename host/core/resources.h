@@ -4,14 +4,17 @@
 #include <glint/glint.h>
 
 #include <cstddef>
+#include <vector>
 
 namespace glint::detail {
 
-/// A 2D single-mip image with its memory and a view; `state` tracks its last use for barriers.
+/// A 2D image with its memory and a view of all its mips; `state` tracks its last use for
+/// barriers. With levels > 1 (a mip chain, e.g. the Hi-Z pyramid or the flare atlas) it also has one
+/// view per level, for kernels that write one level each.
 class OwnedImage {
  public:
   OwnedImage() = default;
-  OwnedImage(const Context& context, VkExtent2D extent, VkFormat format, VkImageUsageFlags usage);
+  OwnedImage(const Context& context, VkExtent2D extent, VkFormat format, VkImageUsageFlags usage, uint32_t levels = 1);
   OwnedImage(OwnedImage&& other) noexcept { *this = std::move(other); }
   OwnedImage& operator=(OwnedImage&& other) noexcept;
   OwnedImage(const OwnedImage&) = delete;
@@ -20,6 +23,9 @@ class OwnedImage {
 
   void reset();
   explicit operator bool() const { return state.image != VK_NULL_HANDLE; }
+  uint32_t levels() const { return levels_; }
+  /// A view of mip `k` alone (levels > 1), or the view of the whole image (levels == 1).
+  VkImageView level_view(uint32_t k) const { return level_views_.empty() ? state.view : level_views_.at(k); }
   /// The image as effects see it; the state fields are shared with this object by reference.
   Image& image() { return state; }
   const Image& image() const { return state; }
@@ -29,6 +35,8 @@ class OwnedImage {
  private:
   VkDevice device_ = VK_NULL_HANDLE;
   VkDeviceMemory memory_ = VK_NULL_HANDLE;
+  uint32_t levels_ = 0;
+  std::vector<VkImageView> level_views_;
 };
 
 /// A buffer with its memory, optionally host-visible and mapped.

@@ -22,15 +22,3 @@ vec3 bilinear(texture2D t, vec2 p, ivec2 size) {
 vec2 map_position(ivec2 xy, ivec2 dst, ivec2 src) {
   return (vec2(xy) + 0.5) * (vec2(src) / vec2(dst)) - 0.5;
 }
-
-// bilinear() for all four channels.
-vec4 bilinear4(texture2D t, vec2 p, ivec2 size) {
-  vec2 f = floor(p);
-  vec2 w = p - f;
-  ivec2 i0 = ivec2(f);
-  vec4 a = fetch_clamped(t, i0, size);
-  vec4 b = fetch_clamped(t, i0 + ivec2(1, 0), size);
-  vec4 c = fetch_clamped(t, i0 + ivec2(0, 1), size);
-  vec4 d = fetch_clamped(t, i0 + ivec2(1, 1), size);
-  return mix(mix(a, b, w.x), mix(c, d, w.x), w.y);
-}
