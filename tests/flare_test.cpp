@@ -153,15 +153,7 @@ reference::FlareAtlas read_atlas(const LensFlare& flare) {
           VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
           VK_ACCESS_2_SHADER_SAMPLED_READ_BIT, a.levels);
     b.flush(cmd);
-    VkMemoryBarrier2 host{VK_STRUCTURE_TYPE_MEMORY_BARRIER_2};
-    host.srcStageMask = VK_PIPELINE_STAGE_2_COPY_BIT;
-    host.srcAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;
-    host.dstStageMask = VK_PIPELINE_STAGE_2_HOST_BIT;
-    host.dstAccessMask = VK_ACCESS_2_HOST_READ_BIT;
-    VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
-    dep.memoryBarrierCount = 1;
-    dep.pMemoryBarriers = &host;
-    vkCmdPipelineBarrier2(cmd, &dep);
+    detail::record_host_read_barrier(cmd);
   });
   staging.invalidate();
   const auto* half = static_cast<const uint16_t*>(staging.mapped());
@@ -606,8 +598,9 @@ TEST_F(FlareTest, ComputeGathersManyLightsInBatchesAndChunks) {
   FlareInputs in(lights, uint32_t(lights.size()), flare.groups_per_instance());
   // Move the arguments 20 bytes into the buffer (a multiple of 4, not of any storage alignment).
   detail::OwnedBuffer shifted(context(), 64, in.indirect_view.usage, false);
-  Buffer shifted_view{shifted.buffer(), 20, sizeof(GlintFlareIndirect), in.indirect_view.usage,
-                      VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE};
+  Buffer shifted_view{shifted.buffer(),           20,
+                      sizeof(GlintFlareIndirect), in.indirect_view.usage,
+                      VK_PIPELINE_STAGE_2_NONE,   VK_ACCESS_2_NONE};
   const FlareConfig config;
   auto color = make_color(background, kF32);
   context().run_once([&](VkCommandBuffer cmd) {
@@ -620,8 +613,8 @@ TEST_F(FlareTest, ComputeGathersManyLightsInBatchesAndChunks) {
     flare.record_compute(cmd, color.state, in.instances_view, shifted_view, config);
   });
   const CpuImage gpu = detail::download(context(), color.state);
-  const auto ref = reference::flare_composite(background, lights, uint32_t(lights.size()), config, atlas,
-                                              sampler_precision());
+  const auto ref =
+      reference::flare_composite(background, lights, uint32_t(lights.size()), config, atlas, sampler_precision());
   uint32_t most = 0;
   for (uint32_t n : ref.count) most = std::max(most, n);
   EXPECT_GT(most, 64u) << "no pixel is covered by more sprites than a chunk of the gather holds";

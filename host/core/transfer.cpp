@@ -73,13 +73,7 @@ OwnedBuffer make_readback_staging(const Context& context, const Image& image) {
   return OwnedBuffer(context, texels * texel_bytes(image.format), VK_BUFFER_USAGE_TRANSFER_DST_BIT, true);
 }
 
-void record_readback(VkCommandBuffer cmd, Image& image, const OwnedBuffer& staging) {
-  Barriers b;
-  b.use(image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
-  b.flush(cmd);
-  VkBufferImageCopy region = whole(image);
-  vkCmdCopyImageToBuffer(cmd, image.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, staging.buffer(), 1, &region);
-  // Make the copy visible to the host read after the submission.
+void record_host_read_barrier(VkCommandBuffer cmd) {
   VkMemoryBarrier2 host{VK_STRUCTURE_TYPE_MEMORY_BARRIER_2};
   host.srcStageMask = VK_PIPELINE_STAGE_2_COPY_BIT;
   host.srcAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;
@@ -89,6 +83,15 @@ void record_readback(VkCommandBuffer cmd, Image& image, const OwnedBuffer& stagi
   dep.memoryBarrierCount = 1;
   dep.pMemoryBarriers = &host;
   vkCmdPipelineBarrier2(cmd, &dep);
+}
+
+void record_readback(VkCommandBuffer cmd, Image& image, const OwnedBuffer& staging) {
+  Barriers b;
+  b.use(image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
+  b.flush(cmd);
+  VkBufferImageCopy region = whole(image);
+  vkCmdCopyImageToBuffer(cmd, image.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, staging.buffer(), 1, &region);
+  record_host_read_barrier(cmd);
 }
 
 CpuImage read_staged(const OwnedBuffer& staging, const Image& image) {
@@ -142,15 +145,7 @@ std::vector<float> download_r32(const Context& context, Image& image, uint32_t l
         static_cast<VkImageAspectFlags>(depth ? VK_IMAGE_ASPECT_DEPTH_BIT : VK_IMAGE_ASPECT_COLOR_BIT), level, 0, 1};
     region.imageExtent = {extent.width, extent.height, 1};
     vkCmdCopyImageToBuffer(cmd, image.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, staging.buffer(), 1, &region);
-    VkMemoryBarrier2 host{VK_STRUCTURE_TYPE_MEMORY_BARRIER_2};
-    host.srcStageMask = VK_PIPELINE_STAGE_2_COPY_BIT;
-    host.srcAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;
-    host.dstStageMask = VK_PIPELINE_STAGE_2_HOST_BIT;
-    host.dstAccessMask = VK_ACCESS_2_HOST_READ_BIT;
-    VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
-    dep.memoryBarrierCount = 1;
-    dep.pMemoryBarriers = &host;
-    vkCmdPipelineBarrier2(cmd, &dep);
+    record_host_read_barrier(cmd);
   });
   staging.invalidate();
   std::vector<float> out(texels);

@@ -47,6 +47,9 @@ void record_upload(VkCommandBuffer cmd, const OwnedBuffer& staging, Image& image
 OwnedBuffer make_readback_staging(const Context& context, const Image& image);
 /// Records the copy of mip 0 of a colour `image` into `staging` and the barrier to host reads.
 void record_readback(VkCommandBuffer cmd, Image& image, const OwnedBuffer& staging);
+/// Makes every earlier transfer write visible to host reads after the submission completes
+/// (COPY/TRANSFER_WRITE -> HOST/HOST_READ), the barrier every readback ends with.
+void record_host_read_barrier(VkCommandBuffer cmd);
 /// `image`'s texels (RGBA16F or RGBA32F) from a staging buffer a completed readback filled.
 CpuImage read_staged(const OwnedBuffer& staging, const Image& image);
 
