@@ -27,6 +27,7 @@ static_assert(offsetof(BloomPush, flags) == 36);
 static_assert(static_cast<uint32_t>(BloomFilter::cod13) == GLINT_BLOOM_COD13);
 static_assert(static_cast<uint32_t>(BloomFilter::dual) == GLINT_BLOOM_DUAL);
 static_assert(static_cast<uint32_t>(BloomFilter::gauss9) == GLINT_BLOOM_GAUSS9);
+static_assert(GLINT_BLOOM_SOURCE_MAX == 65504.0, "docs/BLOOM.md and bloom.h state the source clamp");
 
 void BloomConfig::validate() const {
   check_range("BloomConfig::threshold", threshold, 0.0, 65504.0);
@@ -39,6 +40,11 @@ void BloomConfig::validate() const {
   if (f > GLINT_BLOOM_GAUSS9) {
     throw Error(ErrorCode::invalid_argument,
                 concat("BloomConfig::filter = ", f, " is not a BloomFilter: accepted cod13, dual, gauss9"));
+  }
+  const auto g = static_cast<uint32_t>(firefly_guard);
+  if (g > static_cast<uint32_t>(FireflyGuard::karis_smooth)) {
+    throw Error(ErrorCode::invalid_argument,
+                concat("BloomConfig::firefly_guard = ", g, " is not a FireflyGuard: accepted off, karis, karis_smooth"));
   }
   const auto p = static_cast<uint32_t>(precision);
   if (p > 1)
@@ -70,12 +76,14 @@ constexpr VkAccessFlags2 kSampled = VK_ACCESS_2_SHADER_SAMPLED_READ_BIT;
 constexpr VkAccessFlags2 kStorageWrite = VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT;
 constexpr VkAccessFlags2 kStorageRead = VK_ACCESS_2_SHADER_STORAGE_READ_BIT;
 
-// Shared memory the tiled kernels declare for a workgroup (kernels/common/bloom_down_tiled.glsl and
-// bloom_up_tiled.glsl): vec4 windows of the source.
+// Shared memory the tiled kernels declare for a workgroup (kernels/common/bloom_down_tiled.glsl,
+// bloom_up_tiled.glsl and kernels/bloom_prefilter_smooth.comp): vec4 windows of the source.
 uint32_t bloom_shared_bytes(detail::Workgroup2D g) {
   const uint32_t down = ((2 * g.x + 4) * (2 * g.y + 4) + (2 * g.x + 3) * (2 * g.y + 3)) * 16;
   const uint32_t up = ((g.x + 10) * (g.y + 10) + g.x * (g.y + 10)) * 16;
-  return std::max(down, up);
+  const uint32_t apron = 2 * GLINT_BLOOM_SMOOTH_RADIUS;
+  const uint32_t smooth = ((2 * g.x + 6 + apron) * (2 * g.y + 6 + apron) + (2 * g.y + 6 + apron) * (2 * g.x + 6)) * 16;
+  return std::max({down, up, smooth});
 }
 
 // The device's preferred workgroup if its shared memory holds the tiles, else 8x8 (12 KiB).
@@ -137,7 +145,9 @@ struct Bloom::Impl {
     const std::string lv = format_variant(level_format());
     const auto S = VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE;
     const auto W = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
-    prefilter_down = detail::ComputePipeline(*context, desc("bloom_prefilter_down_" + lv, {S, W}));
+    const char* first = config.firefly_guard == FireflyGuard::karis_smooth ? "bloom_prefilter_smooth_"
+                                                                           : "bloom_prefilter_down_";
+    prefilter_down = detail::ComputePipeline(*context, desc(first + lv, {S, W}));
     down = detail::ComputePipeline(*context, desc("bloom_down_" + lv, {S, W}));
     blur = config.filter == BloomFilter::gauss9 ? detail::ComputePipeline(*context, desc("bloom_blur_" + lv, {S, W}))
                                                 : detail::ComputePipeline();
@@ -309,7 +319,7 @@ void Bloom::Impl::record(VkCommandBuffer cmd, Image& input, Image& output, Profi
   b.use(scene, scene_layout, kCompute, kSampled);
   b.use(levels[0].state, G, kCompute, kStorageWrite);
   b.flush(cmd);
-  prefilter_down.dispatch(cmd, sets.prefilter, push(full, chain[0], config.firefly_guard ? GLINT_BLOOM_FLAG_KARIS : 0u),
+  prefilter_down.dispatch(cmd, sets.prefilter, push(full, chain[0], config.firefly_guard == FireflyGuard::karis ? GLINT_BLOOM_FLAG_KARIS : 0u),
                           chain[0].width, chain[0].height);
   if (gauss) blur_level(0);
   if (profiler) profiler->mark(cmd, "bloom bright-pass + down 0");
@@ -360,12 +370,14 @@ void Bloom::set_config(const BloomConfig& config) {
   config.validate();
   const BloomConfig old = impl_->config;
   impl_->config = config;
-  const bool shape_changed =
-      old.iterations != config.iterations || old.filter != config.filter || old.precision != config.precision;
+  const bool smooth_changed = (old.firefly_guard == FireflyGuard::karis_smooth) !=
+                              (config.firefly_guard == FireflyGuard::karis_smooth);
+  const bool pipelines_changed = old.filter != config.filter || old.precision != config.precision || smooth_changed;
+  const bool shape_changed = old.iterations != config.iterations || pipelines_changed;
   if (!shape_changed) return;
   const VkExtent2D size = impl_->extent;
   impl_->release_pyramid();
-  if (old.filter != config.filter || old.precision != config.precision) impl_->make_pipelines();
+  if (pipelines_changed) impl_->make_pipelines();
   if (size.width) impl_->make_pyramid(size);
 }
 

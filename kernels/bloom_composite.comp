@@ -3,6 +3,8 @@
 #extension GL_EXT_samplerless_texture_functions : require
 // The last upsample fused with the composite: out = scene + intensity / N * Up(A0)
 // (docs/BLOOM.md "Composite"). Fusing saves a full-resolution bloom image write and read.
+// A NaN scene channel becomes 0 and the sum is clamped to +-OUTPUT_MAX (65504 for an RGBA16F
+// output, the largest float for RGBA32F), so the output is finite even where the scene is not.
 layout(local_size_x_id = 0, local_size_y_id = 1) in;
 
 layout(binding = 0) uniform texture2D scene;
@@ -23,5 +25,7 @@ void main() {
   vec4 s = texelFetch(scene, min(xy, size - 1), 0);  // issued first: its latency overlaps the tile work
   vec3 bloom = upsample_tiled(level0, ivec2(p.src_width, p.src_height), size, p.radius);
   if (any(greaterThanEqual(xy, size))) return;  // after the barriers inside upsample_tiled
-  imageStore(result, xy, vec4(s.rgb + p.composite_scale * bloom, s.a));
+  s = mix(s, vec4(0.0), isnan(s));
+  vec4 o = vec4(s.rgb + p.composite_scale * bloom, s.a);
+  imageStore(result, xy, clamp(o, vec4(-OUTPUT_MAX), vec4(OUTPUT_MAX)));
 }

@@ -2,8 +2,8 @@
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_samplerless_texture_functions : require
 // Bright-pass fused into the first downsample: full-resolution scene -> pyramid level 0.
-// Implements docs/BLOOM.md "Prefilter" (seed 001's soft knee) and "Downsample" with the Karis
-// guard (Jimenez 2014). Fusing saves writing and re-reading a full-resolution bright-pass image.
+// Implements docs/BLOOM.md "Prefilter" (seed 001's soft knee) and "Downsample" with the per-box
+// Karis guard (Jimenez 2014) or none; kernels/bloom_prefilter_smooth.comp does karis_smooth. Fusing saves writing and re-reading a full-resolution bright-pass image.
 layout(local_size_x_id = 0, local_size_y_id = 1) in;
 
 layout(binding = 0) uniform texture2D scene;
@@ -12,10 +12,10 @@ layout(binding = 1, DST_FORMAT) uniform writeonly image2D level0;
 #include "bloom_params.h"
 layout(push_constant) uniform Push { BloomPush p; };
 
-vec3 sanitize(vec3 c, float max_brightness);
+vec3 sanitize(vec3 c);
 vec3 soft_threshold(vec3 c, float threshold, float knee);
 vec3 source_texel(ivec2 ij) {
-  vec3 c = sanitize(texelFetch(scene, ij, 0).rgb, p.max_brightness);
+  vec3 c = sanitize(texelFetch(scene, ij, 0).rgb);
   return soft_threshold(c, p.threshold, p.knee);
 }
 
@@ -28,5 +28,5 @@ void main() {
   bool inside = all(lessThan(xy, dst_size));
   g_src_size = ivec2(p.src_width, p.src_height);
   vec3 c = downsample_any(xy, dst_size, inside, (p.flags & GLINT_BLOOM_FLAG_KARIS) != 0u);
-  if (inside) imageStore(level0, xy, vec4(c, 1.0));
+  if (inside) imageStore(level0, xy, vec4(min(c, vec3(p.max_brightness)), 1.0));
 }

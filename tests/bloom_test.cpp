@@ -6,9 +6,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 
 #include "core/half.h"
 #include "reference/bloom_reference.h"
+#include "support/effects.h"
 #include "support/gpu_test.h"
 
 namespace glint::test {
@@ -213,25 +215,62 @@ TEST_F(BloomTest, DimPixelsFarFromBrightOnesAreUnchanged) {
   // Random dim background (luma < threshold - knee = 0.5) and one bright pixel near a corner.
   std::mt19937 rng(5);
   std::uniform_real_distribution<float> dim(0.0f, 0.45f);
-  CpuImage input(640, 360);
+  CpuImage input(720, 480);
   for (float& v : input.rgba) v = dim(rng);
   for (int c = 0; c < 3; ++c) input.at(10, 10)[c] = 500.0f;
   for (BloomFilter filter : kFilters) {
     BloomConfig config;
     config.filter = filter;
     const CpuImage gpu = run_bloom(config, input);
-    // Footprint of 5 levels at radius 1 (docs/BLOOM.md taps): each downsample reaches 3.5 source
-    // texels, 3.5 * (1 + 2 + ... + 16) * 2 = 217 px at most; each upsample reaches radius + 1 texels
-    // of the smaller level, 2 * (4 + 8 + 16 + 32) + 4 = 124 px. 260 px is beyond both.
+    // Footprint of the taps of docs/BLOOM.md (the karis_smooth prefilter, every downsample and
+    // upsample), derived in support/effects.cpp (over 400 px for gauss9 here).
+    const uint32_t reach = 10 + bloom_footprint_px({input.width, input.height}, config);
+    ASSERT_LT(reach, input.height) << filter_name(filter);
     size_t changed_far = 0, changed_near = 0;
     for (uint32_t y = 0; y < input.height; ++y)
       for (uint32_t x = 0; x < input.width; ++x) {
         const bool differs = std::memcmp(gpu.at(x, y), input.at(x, y), 16) != 0;
-        const bool far = x > 260 || y > 260;
+        const bool far = x > reach || y > reach;
         (far ? changed_far : changed_near) += differs;
       }
     EXPECT_EQ(changed_far, 0u) << filter_name(filter);
     EXPECT_GT(changed_near, 100u) << filter_name(filter) << ": the bright pixel must bloom";
+  }
+}
+
+// Issue 6, "Range": the output is finite everywhere, also where the scene itself is not. A NaN
+// scene channel counts as 0; the sum is clamped to +-65504 for an RGBA16F output (so a bright
+// scene plus bloom does not round to Inf) and to +-FLT_MAX for RGBA32F (docs/BLOOM.md "Composite").
+TEST_F(BloomTest, NonFiniteAndHugeScenePixelsGiveAFiniteOutput) {
+  const float inf = INFINITY, nan = std::nanf("");
+  CpuImage input = random_hdr(48, 40, 21, 0.0f, 4.0f);
+  const float bad[][4] = {{nan, 1, 2, nan}, {inf, -inf, 0, 1}, {65400, 65400, 65400, 1}, {-inf, nan, inf, inf}};
+  for (uint32_t i = 0; i < 4; ++i)
+    for (int c = 0; c < 4; ++c) input.at(8 + 10 * i, 20)[c] = bad[i][c];
+  BloomConfig config;
+  config.intensity = 1.0f;
+  for (VkFormat out_format : {kF16, kF32}) {
+    const CpuImage gpu = run_bloom(config, input, kF32, out_format);
+    const float limit = out_format == kF16 ? 65504.0f : std::numeric_limits<float>::max();
+    for (float v : gpu.rgba) ASSERT_TRUE(std::isfinite(v)) << (out_format == kF16 ? "rgba16f" : "rgba32f");
+    // NaN -> 0 before the add: the NaN channels of pixel 0 equal the bloom alone, which the
+    // neighbouring finite pixel shows to be positive; +Inf -> the limit; 65400 + bloom clamps to
+    // 65504 in RGBA16F (it would round to Inf) and stays above 65400 in RGBA32F.
+    const float* p0 = gpu.at(8, 20);
+    EXPECT_GT(p0[0], 0.0f);
+    EXPECT_LT(p0[0], 100.0f);
+    EXPECT_EQ(p0[3], 0.0f);
+    EXPECT_EQ(gpu.at(18, 20)[0], limit);
+    EXPECT_EQ(gpu.at(18, 20)[1], -limit);
+    EXPECT_EQ(gpu.at(28, 20)[0], out_format == kF16 ? 65504.0f : gpu.at(28, 20)[0]);
+    EXPECT_GT(gpu.at(28, 20)[0], 65400.0f);
+    EXPECT_EQ(gpu.at(38, 20)[0], -limit);
+    EXPECT_EQ(gpu.at(38, 20)[2], limit);
+    // The reference (fp16 levels, the RGBA32F limit) agrees at the NaN pixel: 0 plus its bloom.
+    if (out_format == kF32) {
+      const auto ref = reference::bloom(input, config, /*round_intermediates_to_half=*/true);
+      EXPECT_NEAR(p0[0], ref.at(8, 20)[0], 5e-3 * std::abs(ref.at(8, 20)[0]));
+    }
   }
 }
 

@@ -22,6 +22,8 @@ namespace glint::reference {
 namespace {
 
 constexpr BloomFilter kFilters[] = {BloomFilter::cod13, BloomFilter::dual, BloomFilter::gauss9};
+constexpr FireflyGuard kGuards[] = {FireflyGuard::off, FireflyGuard::karis, FireflyGuard::karis_smooth};
+int guard_id(FireflyGuard g) { return static_cast<int>(g); }
 
 std::string name_of(BloomFilter f) {
   switch (f) {
@@ -42,7 +44,7 @@ BloomConfig identity_prefilter_config(BloomFilter filter) {
   c.threshold = 0.0f;
   c.soft_knee = 0.0f;
   c.filter = filter;
-  c.firefly_guard = false;
+  c.firefly_guard = FireflyGuard::off;
   c.iterations = 1;
   return c;
 }
@@ -248,6 +250,7 @@ TEST(BloomReferencePrefilter, ContinuousAndMonotonicAcrossTheKnee) {
 }
 
 TEST(BloomReferencePrefilter, SanitizesNaNNegativeAndInf) {
+  // Source texels clamp to 65504 whatever max_brightness is (that one clamps level 0).
   BloomConfig config = identity_prefilter_config(BloomFilter::cod13);
   config.max_brightness = 1000.0f;
   const double nan = std::numeric_limits<double>::quiet_NaN();
@@ -255,11 +258,44 @@ TEST(BloomReferencePrefilter, SanitizesNaNNegativeAndInf) {
   const auto a = prefiltered(config, nan, -3.0, inf);
   EXPECT_EQ(a[0], 0.0);
   EXPECT_EQ(a[1], 0.0);
-  EXPECT_DOUBLE_EQ(a[2], 1000.0);
+  EXPECT_DOUBLE_EQ(a[2], 65504.0);
   const auto b = prefiltered(config, 5000.0, 1.0, -inf);
-  EXPECT_DOUBLE_EQ(b[0], 1000.0);
+  EXPECT_DOUBLE_EQ(b[0], 5000.0);
   EXPECT_DOUBLE_EQ(b[1], 1.0);
   EXPECT_EQ(b[2], 0.0);
+  const auto c = prefiltered(config, 1e9, 70000.0, 65504.0);
+  EXPECT_DOUBLE_EQ(c[0], 65504.0);
+  EXPECT_DOUBLE_EQ(c[1], 65504.0);
+  EXPECT_DOUBLE_EQ(c[2], 65504.0);
+}
+
+TEST(BloomReferenceLevels, MaxBrightnessClampsLevel0PerChannel) {
+  // A uniform 4000 image: level 0 is 4000 everywhere before the clamp, max_brightness 1000 after;
+  // level 1 is the mean of level 0, so also 1000. A per-pixel clamp would give the same here; the
+  // point below tells them apart: one pixel of 4000 in black gives a level-0 peak under 1000.
+  for (FireflyGuard guard : kGuards) {
+    BloomConfig config = identity_prefilter_config(BloomFilter::cod13);
+    config.firefly_guard = guard;
+    config.iterations = 2;
+    config.max_brightness = 1000.0f;
+    CpuImage flat(16, 16, 0.0f);
+    for (uint32_t y = 0; y < 16; ++y)
+      for (uint32_t x = 0; x < 16; ++x) set_rgb(flat, x, y, 4000, 500, 4000);
+    const auto levels = downsampled_levels(flat, config);
+    for (const DoubleImage& level : levels)
+      for (size_t i = 0; i < level.rgba.size(); i += 4) {
+        EXPECT_NEAR(level.rgba[i], 1000.0, 1e-9) << guard_id(guard);
+        EXPECT_NEAR(level.rgba[i + 1], 500.0, 1e-9) << guard_id(guard);
+      }
+    CpuImage point(16, 16, 0.0f);
+    set_rgb(point, 8, 8, 4000, 4000, 4000);
+    config.firefly_guard = FireflyGuard::off;
+    double sum = 0.0;
+    const auto point_levels = downsampled_levels(point, config);
+    for (double v : point_levels[0].rgba) sum += v;
+    // Energy of level 0 (RGB, plus 64 alphas of 1) is a quarter of the point's: nothing clipped.
+    EXPECT_NEAR(sum - 64.0, 3 * 4000.0 / 4.0, 1e-6);
+  }
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -391,9 +427,9 @@ TEST(BloomReferenceLevels, KarisGuardWeightsBoxesByInverseLuma) {
   CpuImage in(2, 1, 0.0f);
   set_rgb(in, 1, 0, 3, 3, 3);
   BloomConfig config = identity_prefilter_config(BloomFilter::gauss9);
-  config.firefly_guard = false;
+  config.firefly_guard = FireflyGuard::off;
   const auto off = downsampled_levels(in, config);
-  config.firefly_guard = true;
+  config.firefly_guard = FireflyGuard::karis;
   const auto on = downsampled_levels(in, config);
   ASSERT_EQ(on.size(), 1u);
   for (size_t k = 0; k < 3; ++k) {
@@ -413,7 +449,7 @@ TEST(BloomReferenceLevels, KarisGuardUsesLumaOfTheBoxMean) {
   CpuImage in(2, 1, 0.0f);
   set_rgb(in, 1, 0, 3, 0, 6);
   BloomConfig config = identity_prefilter_config(BloomFilter::gauss9);
-  config.firefly_guard = true;
+  config.firefly_guard = FireflyGuard::karis;
   const DoubleImage l0 = downsampled_levels(in, config)[0];
   EXPECT_NEAR(l0.rgba[0], 3.0 / 3.071, 1e-12);
   EXPECT_NEAR(l0.rgba[1], 0.0, 1e-12);
@@ -442,13 +478,56 @@ TEST(BloomReferenceLevels, Gauss9AreaDownsampleAtOddSize) {
   }
 }
 
+TEST(BloomReferenceLevels, KarisSmoothIsKarisOfTheBinomialFilteredSource) {
+  // karis_smooth = the per-box Karis downsample of the source filtered by the 2-D binomial
+  // C(10, a) C(10, b) / 1024^2 with clamp to edge. Filter here directly in 2-D (not separably, as
+  // the reference and the kernel do), feed the result back with an identity prefilter and per-box
+  // Karis, and compare. Odd size so that the general (non 2:1) downsample is covered as well.
+  const CpuImage in = random_hdr(23, 18, 43);
+  double c10[11];
+  for (int m = 0; m <= 10; ++m) {
+    double c = 1.0;
+    for (int i = 1; i <= m; ++i) c = c * (11 - i) / i;
+    c10[m] = c / 1024.0;
+  }
+  for (BloomFilter filter : kFilters) {
+    BloomConfig config = identity_prefilter_config(filter);
+    config.firefly_guard = FireflyGuard::karis_smooth;
+    const DoubleImage smooth = downsampled_levels(in, config)[0];
+    CpuImage filtered(in.width, in.height, 0.0f);
+    for (int y = 0; y < int(in.height); ++y)
+      for (int x = 0; x < int(in.width); ++x)
+        for (int k = 0; k < 4; ++k) {
+          double sum = 0.0;
+          for (int b = -5; b <= 5; ++b)
+            for (int a = -5; a <= 5; ++a) {
+              const int i = std::clamp(x + a, 0, int(in.width) - 1), j = std::clamp(y + b, 0, int(in.height) - 1);
+              sum += c10[a + 5] * c10[b + 5] * in.at(i, j)[k];
+            }
+          filtered.at(x, y)[k] = static_cast<float>(sum);
+        }
+    config.firefly_guard = FireflyGuard::karis;
+    const DoubleImage box = downsampled_levels(filtered, config)[0];
+    config.firefly_guard = FireflyGuard::karis;
+    const DoubleImage raw = downsampled_levels(in, config)[0];
+    double err = 0.0, norm = 0.0, differs = 0.0;
+    for (size_t i = 0; i < box.rgba.size(); ++i) {
+      err = std::max(err, std::abs(smooth.rgba[i] - box.rgba[i]));
+      differs = std::max(differs, std::abs(smooth.rgba[i] - raw.rgba[i]));
+      norm = std::max(norm, std::abs(box.rgba[i]));
+    }
+    EXPECT_LT(err, 1e-6 * norm) << name_of(filter);      // float rounding of the fed-back image
+    EXPECT_GT(differs, 1e-2 * norm) << name_of(filter);  // and the prefilter does change level 0
+  }
+}
+
 TEST(BloomReferenceLevels, KarisGuardOnlyOnTheFirstDownsample) {
   // Level 1 of a guarded pyramid must be the plain (unguarded) downsample of its level 0. Feed
   // level 0 back in as an image with an identity prefilter: its level 0 is then Down(level 0).
   const CpuImage in = random_hdr(64, 48, 41);
   BloomConfig config;
   config.iterations = 2;
-  config.firefly_guard = true;
+  config.firefly_guard = FireflyGuard::karis;
   const auto levels = downsampled_levels(in, config);
   ASSERT_EQ(levels.size(), 2u);
   const DoubleImage& l0 = levels[0];
@@ -457,7 +536,7 @@ TEST(BloomReferenceLevels, KarisGuardOnlyOnTheFirstDownsample) {
 
   BloomConfig plain = identity_prefilter_config(BloomFilter::cod13);
   const DoubleImage unguarded = downsampled_levels(l0_image, plain)[0];
-  plain.firefly_guard = true;
+  plain.firefly_guard = FireflyGuard::karis;
   const DoubleImage guarded = downsampled_levels(l0_image, plain)[0];
   ASSERT_EQ(unguarded.width, levels[1].width);
   ASSERT_EQ(unguarded.height, levels[1].height);
@@ -472,7 +551,7 @@ TEST(BloomReferenceLevels, KarisGuardOnlyOnTheFirstDownsample) {
   EXPECT_GT(diff_if_guarded, 1e-3 * norm);  // a guard at level 1 would be visible
 
   // And the guard does change level 0.
-  config.firefly_guard = false;
+  config.firefly_guard = FireflyGuard::off;
   const auto off = downsampled_levels(in, config);
   double diff0 = 0.0;
   for (size_t i = 0; i < l0.rgba.size(); ++i) diff0 = std::max(diff0, std::abs(l0.rgba[i] - off[0].rgba[i]));
@@ -552,7 +631,7 @@ TEST(BloomReferenceBloom, UniformImageStaysUniform) {
   };
   for (BloomFilter filter : kFilters) {
     for (const Size s : {Size{17, 9}, Size{3, 5}, Size{1, 1}, Size{1, 17}, Size{17, 1}, Size{64, 48}}) {
-      for (bool guard : {true, false}) {
+      for (FireflyGuard guard : kGuards) {
         BloomConfig config;
         config.filter = filter;
         config.firefly_guard = guard;
@@ -573,7 +652,7 @@ TEST(BloomReferenceBloom, UniformImageStaysUniform) {
             for (size_t k = 0; k < 3; ++k) {
               const double want = double(c[k]) + double(config.intensity) * pf[k];
               ASSERT_NEAR(out.at(x, y)[k], want, 1e-12 * want)
-                  << name_of(filter) << " " << s.w << "x" << s.h << " guard " << guard << " at " << x << "," << y;
+                  << name_of(filter) << " " << s.w << "x" << s.h << " guard " << guard_id(guard) << " at " << x << "," << y;
               // fp16 storage rounds each stored value the same way everywhere: still uniform.
               ASSERT_EQ(half.at(x, y)[k], half.at(0, 0)[k]);
               ASSERT_NEAR(half.at(x, y)[k], want, 2e-3 * want);
@@ -653,7 +732,7 @@ TEST(BloomReferenceBloom, HalfModeStoresTheGauss9HorizontalPass) {
 TEST(BloomReferenceBloom, BrighterPointAddsMoreEnergy) {
   const CpuImage bg = dark_background(48, 40, 71);
   for (BloomFilter filter : kFilters) {
-    for (bool guard : {true, false}) {
+    for (FireflyGuard guard : kGuards) {
       BloomConfig config;
       config.filter = filter;
       config.firefly_guard = guard;
@@ -665,7 +744,7 @@ TEST(BloomReferenceBloom, BrighterPointAddsMoreEnergy) {
         if (b < 0.5f) {
           EXPECT_EQ(e, 0.0) << name_of(filter) << ": a point below threshold - knee must add nothing";
         } else {
-          EXPECT_GT(e, prev) << name_of(filter) << " guard " << guard << " brightness " << b;
+          EXPECT_GT(e, prev) << name_of(filter) << " guard " << guard_id(guard) << " brightness " << b;
         }
         prev = e;
       }
@@ -680,12 +759,17 @@ TEST(BloomReferenceBloom, FireflyGuardDampensAnIsolatedFirefly) {
     set_rgb(in, 30, 33, 1000, 1000, 1000);
     BloomConfig config;
     config.filter = filter;
-    config.firefly_guard = false;
+    config.firefly_guard = FireflyGuard::off;
     const double off = total(added_light(bloom(in, config), in));
-    config.firefly_guard = true;
+    config.firefly_guard = FireflyGuard::karis;
     const double on = total(added_light(bloom(in, config), in));
     EXPECT_GT(on, 0.0) << name_of(filter);
     EXPECT_LT(on, 0.5 * off) << name_of(filter);
+    // The smoothed guard trades suppression for stability (docs/STABILITY.md): it still dampens.
+    config.firefly_guard = FireflyGuard::karis_smooth;
+    const double smooth = total(added_light(bloom(in, config), in));
+    EXPECT_GT(smooth, on) << name_of(filter);
+    EXPECT_LT(smooth, 0.9 * off) << name_of(filter);
   }
 }
 

@@ -96,13 +96,13 @@ void draw_chart(const std::vector<std::pair<std::string, std::vector<double>>>& 
 }
 
 // Frames 0, 1, 2 (x = 0, 0.25, 0.5 px) of the 1e4 firefly for the default settings (top row) and
-// with the Karis guard off (bottom row), each crop 96x48 around the point.
+// with the per-box Karis guard (bottom row), each crop 96x48 around the point.
 void filmstrip(const Context& ctx, const std::string& path) {
   const uint32_t w = 256, h = 128, cw = 96, ch = 48;
   CpuImage strip(3 * cw, 2 * ch, 0.0f);
   for (int row = 0; row < 2; ++row) {
     BloomConfig c;
-    c.firefly_guard = row == 0;
+    c.firefly_guard = row == 0 ? FireflyGuard::karis_smooth : FireflyGuard::karis;
     c.intensity = 1.0f;
     Frame frame(ctx, {w, h});
     Bloom bloom(ctx, c);
@@ -120,6 +120,10 @@ void filmstrip(const Context& ctx, const std::string& path) {
   io::write_png_tonemapped(path, strip, 0.5f);
 }
 
+const char* guard_name(FireflyGuard g) {
+  return g == FireflyGuard::karis_smooth ? "karis_smooth" : g == FireflyGuard::karis ? "karis" : "off";
+}
+
 int main_impl(int argc, char** argv) {
   std::string out_dir = "docs/stability";
   for (int i = 1; i < argc; ++i) {
@@ -128,32 +132,32 @@ int main_impl(int argc, char** argv) {
   const Context ctx = Context::create();
   std::printf("device: %s\n\n", ctx.info().name.c_str());
   std::printf(
-      "| filter | Karis | max_brightness | value | energy spread | max step | centroid jitter px | mean energy "
+      "| filter | firefly_guard | max_brightness | value | energy spread | max step | centroid jitter px | mean energy "
       "|\n|---|---|---|---|---|---|---|---|\n");
   std::vector<std::pair<std::string, std::vector<double>>> chart;
   for (float maxb : {1000.0f, 8000.0f}) {
     for (float value : {1e4f, 1e3f}) {
       for (BloomFilter f : {BloomFilter::cod13, BloomFilter::dual, BloomFilter::gauss9}) {
-        for (bool karis : {true, false}) {
+        for (FireflyGuard guard : {FireflyGuard::karis_smooth, FireflyGuard::karis, FireflyGuard::off}) {
           BloomConfig c;
           c.filter = f;
-          c.firefly_guard = karis;
+          c.firefly_guard = guard;
           c.max_brightness = maxb;
           const auto s = firefly(ctx, c, value, 256, 128);
           const auto ev = analysis::relative_variation(s.energy);
           double lo = 1e9, hi = -1e9;
           for (double e : s.centroid_error) lo = std::min(lo, e), hi = std::max(hi, e);
-          if (maxb == 1000.0f) {
+          if (maxb == 1000.0f && value > 5000) {
             std::vector<double> rel;
             double m = 0;
             for (double e : s.energy) m += e / s.energy.size();
             for (double e : s.energy) rel.push_back(e / m);
-            chart.emplace_back(std::string(filter_name(f)) + (karis ? " Karis" : "") + (value > 5000 ? " 1e4" : " 1e3"),
+            chart.emplace_back(std::string(filter_name(f)) + " " + guard_name(guard) + (value > 5000 ? " 1e4" : " 1e3"),
                                rel);
           }
           double mean = 0;
           for (double e : s.energy) mean += e / s.energy.size();
-          std::printf("| %s | %s | %g | %g | %.4f | %.4f | %.3f | %.4g |\n", filter_name(f), karis ? "on" : "off", maxb,
+          std::printf("| %s | %s | %g | %g | %.4f | %.4f | %.3f | %.4g |\n", filter_name(f), guard_name(guard), maxb,
                       value, ev.spread, ev.max_step, hi - lo, mean);
         }
       }

@@ -331,6 +331,33 @@ void upsample_at(const DoubleImage& small, double px, double py, BloomFilter fil
   }
 }
 
+// docs/BLOOM.md "Karis guard", karis_smooth: P filtered by the 11-tap binomial C(10, k) / 1024
+// horizontally, then vertically, reading clamp-to-edge (the GPU keeps it in shared memory, never
+// stored, so it is never rounded).
+DoubleImage binomial_smoothed(const DoubleImage& p) {
+  constexpr int kRadius = 5;
+  double weight[2 * kRadius + 1];
+  for (int m = 0; m <= 2 * kRadius; ++m) {
+    double c = 1.0;  // C(10, m)
+    for (int i = 1; i <= m; ++i) c = c * (2 * kRadius - i + 1) / i;
+    weight[m] = c / 1024.0;
+  }
+  DoubleImage rows = make_level(p.width, p.height), out = make_level(p.width, p.height);
+  for (uint32_t y = 0; y < p.height; ++y)
+    for (uint32_t x = 0; x < p.width; ++x)
+      for (int m = -kRadius; m <= kRadius; ++m) {
+        const double* s = fetch(p, int64_t(x) + m, y);
+        for (int k = 0; k < 3; ++k) rows.at(x, y)[k] += weight[m + kRadius] * s[k];
+      }
+  for (uint32_t y = 0; y < p.height; ++y)
+    for (uint32_t x = 0; x < p.width; ++x)
+      for (int m = -kRadius; m <= kRadius; ++m) {
+        const double* s = fetch(rows, x, int64_t(y) + m);
+        for (int k = 0; k < 3; ++k) out.at(x, y)[k] += weight[m + kRadius] * s[k];
+      }
+  return out;
+}
+
 }  // namespace
 
 // -------------------------------------------------------------------------------------------------
@@ -341,12 +368,13 @@ double luma(double r, double g, double b) { return 0.2126 * r + 0.7152 * g + 0.0
 
 // docs/BLOOM.md "Prefilter".
 void prefilter(const BloomConfig& config, const double in_rgb[3], double out_rgb[3]) {
-  // 1. Sanitize: NaN and negatives become 0, then clamp to max_brightness (+Inf included).
-  const double max_brightness = config.max_brightness;
+  // 1. Sanitize: NaN and negatives become 0, then clamp to 65504 (+Inf and 1e9 included).
+  //    max_brightness clamps level 0 instead (downsampled_levels).
+  constexpr double kSourceMax = 65504.0;
   double c[3];
   for (int k = 0; k < 3; ++k) {
     const double v = in_rgb[k];
-    c[k] = (std::isnan(v) || v < 0.0) ? 0.0 : std::min(v, max_brightness);
+    c[k] = (std::isnan(v) || v < 0.0) ? 0.0 : std::min(v, kSourceMax);
   }
   // 2. Soft threshold: knee = threshold * soft_knee; soft = clamp(l - t + knee, 0, 2 knee);
   //    contribution = soft^2 / (4 knee + 1e-4); factor = max(l - t, contribution) / max(l, 1e-4).
@@ -360,7 +388,7 @@ void prefilter(const BloomConfig& config, const double in_rgb[3], double out_rgb
   for (int k = 0; k < 3; ++k) out_rgb[k] = c[k] * factor;
 }
 
-// docs/BLOOM.md "Mip chain" and "Downsample": level 0 = Down(P) (Karis if firefly_guard),
+// docs/BLOOM.md "Mip chain" and "Downsample": level 0 = Down(P) (Karis per firefly_guard),
 // level k = Down(level k-1); for gauss9 each level is then blurred horizontally, stored, blurred
 // vertically, stored, and that blurred level is what the next downsample reads.
 std::vector<DoubleImage> downsampled_levels(const CpuImage& input, const BloomConfig& config, bool round_half) {
@@ -374,7 +402,15 @@ std::vector<DoubleImage> downsampled_levels(const CpuImage& input, const BloomCo
     // Level 0 reads the prefiltered full-resolution image P, which is not stored on the GPU
     // (the prefilter is fused into the first downsample), so it is never rounded.
     const DoubleImage p = prefiltered_image(input, config);
-    levels.push_back(downsample(p, chain[0], config.filter, config.firefly_guard));
+    if (config.firefly_guard == FireflyGuard::karis_smooth) {
+      levels.push_back(downsample(binomial_smoothed(p), chain[0], config.filter, true));
+    } else {
+      levels.push_back(downsample(p, chain[0], config.filter, config.firefly_guard == FireflyGuard::karis));
+    }
+    // Level 0 is clamped per channel to max_brightness before it is stored.
+    DoubleImage& level0 = levels.back();
+    for (size_t i = 0; i < level0.rgba.size(); i += 4)
+      for (size_t k = 0; k < 3; ++k) level0.rgba[i + k] = std::min(level0.rgba[i + k], double(config.max_brightness));
   }
   for (size_t k = 0; k < chain.size(); ++k) {
     if (k > 0) levels.push_back(downsample(levels[k - 1], chain[k], config.filter, false));
@@ -401,6 +437,8 @@ DoubleImage upsample(const DoubleImage& small, uint32_t width, uint32_t height, 
 }
 
 // docs/BLOOM.md "Upsample and accumulate" and "Composite".
+constexpr double kFloatMax = std::numeric_limits<float>::max();
+
 DoubleImage bloom(const CpuImage& input, const BloomConfig& config, bool round_intermediates_to_half) {
   validate(input, config);
   DoubleImage out;
@@ -432,7 +470,11 @@ DoubleImage bloom(const CpuImage& input, const BloomConfig& config, bool round_i
   }
 
   // out = scene + (intensity / N) * Up(A(0)), RGB only; alpha stays the scene's. Fused with the
-  // last upsample like bloom_composite.comp, so no full-resolution bloom image is held.
+  // last upsample like bloom_composite.comp, so no full-resolution bloom image is held. A NaN scene
+  // channel counts as 0 and the result is clamped to +-FLT_MAX (the RGBA32F output's rule; an
+  // RGBA16F output clamps to +-65504, which the GPU does when it stores).
+  for (double& v : out.rgba)
+    if (std::isnan(v)) v = 0.0;
   const DoubleImage& a0 = levels[0];
   const double scale = double(config.intensity) / double(n);
   for (uint32_t y = 0; y < out.height; ++y) {
@@ -442,6 +484,7 @@ DoubleImage bloom(const CpuImage& input, const BloomConfig& config, bool round_i
       upsample_at(a0, map_coord(x, out.width, a0.width), py, config.filter, radius, up);
       double* o = out.at(x, y);
       for (int c = 0; c < 3; ++c) o[c] += scale * up[c];
+      for (int c = 0; c < 4; ++c) o[c] = std::clamp(o[c], -kFloatMax, kFloatMax);
     }
   }
   return out;

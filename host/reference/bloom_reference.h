@@ -39,7 +39,7 @@ DoubleImage bloom(const CpuImage& input, const BloomConfig& config, bool round_i
 /// Rec. 709 luma (docs/BLOOM.md "Notation").
 double luma(double r, double g, double b);
 
-/// Sanitize (NaN and negatives to 0, clamp to max_brightness) and soft threshold
+/// Sanitize (NaN and negatives to 0, clamp to 65504) and soft threshold
 /// (docs/BLOOM.md "Prefilter"). `in_rgb` and `out_rgb` may alias.
 void prefilter(const BloomConfig& config, const double in_rgb[3], double out_rgb[3]);
 

@@ -17,8 +17,18 @@ enum class BloomFilter : uint32_t {
   gauss9 = 2,  //!< area downsample + the seed's separable 9-tap Gaussian per level.
 };
 
+/// How the first downsample keeps isolated bright pixels ("fireflies") from dominating the bloom
+/// (docs/BLOOM.md "Karis guard"; docs/STABILITY.md measures each).
+enum class FireflyGuard : uint32_t {
+  off = 0,           //!< plain weighted mean
+  karis = 1,         //!< Karis average of raw 2x2 boxes (Jimenez 2014): strongest suppression, but a
+                     //!< point moving by sub-pixel steps flickers (44 to 94 % energy variation)
+  karis_smooth = 2,  //!< Karis average of boxes of a binomially prefiltered source (sigma 1.58 px):
+                     //!< steady under sub-pixel motion (under 2 %), milder suppression. Default.
+};
+
 /// Bloom settings. Defaults are seed 001's; ranges are checked by validate(), which throws.
-/// Shape fields (iterations, filter, precision) decide images and pipelines: changing them through
+/// Shape fields (iterations, filter, firefly_guard, precision) decide images and pipelines: changing them through
 /// Bloom::set_config() rebuilds those. The other fields are per-frame push constants.
 struct BloomConfig {
   float threshold = 1.0f;                   //!< luminance where bloom starts (0 to 65504)
@@ -27,9 +37,11 @@ struct BloomConfig {
   uint32_t iterations = 5;                  //!< pyramid levels (1 to 8); reduced at small sizes [shape]
   float radius = 1.0f;                      //!< scales the upsample (or Gaussian) footprint (0.25 to 4)
   BloomFilter filter = BloomFilter::cod13;  //!< [shape]
-  bool firefly_guard = true;                //!< Karis average on the first downsample
-  float max_brightness = 1000.0f;           //!< per-channel clamp before the bright-pass (1e-3 to 8000);
-                                            //!< also what +Inf becomes. Keeps fp16 levels finite.
+  FireflyGuard firefly_guard = FireflyGuard::karis_smooth;  //!< on the first downsample [shape]
+  float max_brightness = 1000.0f;           //!< per-channel clamp of pyramid level 0 (1e-3 to 8000):
+                                            //!< bounds the light any small area adds, keeps fp16
+                                            //!< levels finite. Source texels are first clamped to
+                                            //!< 65504 (what +Inf and 1e9 become).
   Precision precision = Precision::fp16;    //!< intermediate storage [shape]
 
   /// Throws Error(invalid_argument) naming the first field that is out of range or NaN.

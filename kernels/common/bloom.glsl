@@ -8,11 +8,13 @@ layout(constant_id = 2) const uint FILTER = GLINT_BLOOM_COD13;
 
 float luma(vec3 c) { return dot(c, vec3(0.2126, 0.7152, 0.0722)); }
 
-// NaN and negatives to 0, then clamp each channel (so +Inf becomes max_brightness).
-vec3 sanitize(vec3 c, float max_brightness) {
+// NaN and negatives to 0, then clamp each channel to GLINT_BLOOM_SOURCE_MAX (so +Inf and 1e9
+// become 65504). max_brightness is applied later, to level 0 (docs/BLOOM.md "Prefilter"): a
+// per-pixel clamp below the brightness of a point depends on how the point splits over pixels.
+vec3 sanitize(vec3 c) {
   bvec3 bad = isnan(c);
   c = mix(c, vec3(0.0), bad);
-  return clamp(c, vec3(0.0), vec3(max_brightness));
+  return clamp(c, vec3(0.0), vec3(GLINT_BLOOM_SOURCE_MAX));
 }
 
 // Seed 001's soft knee, knee relative to threshold (docs/BLOOM.md, "Prefilter").

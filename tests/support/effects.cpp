@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "bloom_params.h"
 #include "reference/blur_reference.h"
 #include "support/gpu_test.h"
 
@@ -33,6 +34,8 @@ uint32_t bloom_footprint_px(VkExtent2D extent, const BloomConfig& config) {
   for (int axis = 0; axis < 2; ++axis) {
     const double full = axis == 0 ? extent.width : extent.height;
     double prev_size = full, prev_texel = 1.0, reach = 0.0;
+    // karis_smooth filters the source with an 11-tap binomial before the first downsample.
+    if (config.firefly_guard == FireflyGuard::karis_smooth) reach += GLINT_BLOOM_SMOOTH_RADIUS;
     for (const LevelSize& l : chain) {
       const double size = axis == 0 ? l.width : l.height;
       const double texel = full / size;

@@ -1,0 +1,90 @@
+#version 460
+#extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_samplerless_texture_functions : require
+#extension GL_EXT_control_flow_attributes : require
+// Bright-pass, binomial prefilter and Karis-guarded first downsample, for
+// firefly_guard = karis_smooth (docs/BLOOM.md "Karis guard"): full-resolution scene -> level 0.
+//
+// Why a prefilter: a Karis weight 1 / (1 + luma) computed on raw 2x2 boxes compresses every box a
+// bright point touches to about one unit, so the result counts the boxes, and that count changes
+// as the point moves by a fraction of a pixel (docs/STABILITY.md: 44 to 94 % energy flicker).
+// Weighing boxes of a source smoothed by an 11-tap binomial (sigma 1.58 px) first makes the boxes
+// a point touches change smoothly with its position.
+//
+// A workgroup computes the bright-passed source over its window plus the prefilter's apron into
+// shared memory, filters it horizontally then vertically there, and every invocation then runs
+// bloom.glsl's downsample() with source_texel() reading that filtered window. Any ratio the mip
+// chain makes (2:1, or up to 3:1 at odd sizes) fits the window (see kWindowW).
+layout(local_size_x_id = 0, local_size_y_id = 1) in;
+
+layout(binding = 0) uniform texture2D scene;
+layout(binding = 1, DST_FORMAT) uniform writeonly image2D level0;
+
+#include "bloom_params.h"
+layout(push_constant) uniform Push { BloomPush p; };
+
+// Window of the prefiltered source P a workgroup reads: with n outputs of a workgroup inside the
+// level and r = src/dst <= 2 + 1/dst, their taps span under 2n + 5 texels; one more for rounding.
+const uint kWindowW = 2u * gl_WorkGroupSize.x + 6u;
+const uint kWindowH = 2u * gl_WorkGroupSize.y + 6u;
+const int kRadius = GLINT_BLOOM_SMOOTH_RADIUS;
+const uint kRawW = kWindowW + 2u * uint(kRadius);
+const uint kRawH = kWindowH + 2u * uint(kRadius);
+const uint kGroupSize = gl_WorkGroupSize.x * gl_WorkGroupSize.y;
+const float kBinomial[11] = float[](1.0 / 1024.0, 10.0 / 1024.0, 45.0 / 1024.0, 120.0 / 1024.0,
+                                    210.0 / 1024.0, 252.0 / 1024.0, 210.0 / 1024.0, 120.0 / 1024.0,
+                                    45.0 / 1024.0, 10.0 / 1024.0, 1.0 / 1024.0);
+
+shared vec4 s_window[kRawW * kRawH];  // bright-passed source; then P, with row stride kWindowW
+shared vec4 s_rows[kRawH * kWindowW];  // horizontal pass
+
+ivec2 g_window;  // texel index of P window entry (0, 0)
+
+vec3 sanitize(vec3 c);
+vec3 soft_threshold(vec3 c, float threshold, float knee);
+
+// bloom.glsl's downsample() reads the source through this; ij is already clamped to the image.
+vec3 source_texel(ivec2 ij) {
+  ivec2 k = clamp(ij - g_window, ivec2(0), ivec2(kWindowW, kWindowH) - 1);
+  return s_window[uint(k.y) * kWindowW + uint(k.x)].rgb;
+}
+
+#include "bloom.glsl"
+
+vec3 bright_texel(ivec2 ij) {
+  ij = clamp(ij, ivec2(0), g_src_size - 1);
+  return soft_threshold(sanitize(texelFetch(scene, ij, 0).rgb), p.threshold, p.knee);
+}
+
+void main() {
+  ivec2 xy = ivec2(gl_GlobalInvocationID.xy);
+  ivec2 dst_size = ivec2(p.dst_width, p.dst_height);
+  g_src_size = ivec2(p.src_width, p.src_height);
+  ivec2 group_origin = ivec2(gl_GlobalInvocationID.xy - gl_LocalInvocationID.xy);
+  g_window = ivec2(floor(map_position(group_origin, dst_size, g_src_size))) - 2;
+  ivec2 raw_origin = g_window - kRadius;
+
+  for (uint i = gl_LocalInvocationIndex; i < kRawW * kRawH; i += kGroupSize)
+    s_window[i] = vec4(bright_texel(raw_origin + ivec2(i % kRawW, i / kRawW)), 0.0);
+  barrier();
+  // P(t) = sum_m C(10, m) / 1024 * B(clamp(t + m - 5)) per axis. Entries of texels outside the
+  // image are computed too but never read (source_texel gets clamped indices).
+  for (uint i = gl_LocalInvocationIndex; i < kRawH * kWindowW; i += kGroupSize) {
+    uint row = i / kWindowW, col = i % kWindowW;
+    vec4 sum = vec4(0.0);
+    [[unroll]] for (int m = 0; m <= 2 * kRadius; ++m) sum += kBinomial[m] * s_window[row * kRawW + col + uint(m)];
+    s_rows[i] = sum;
+  }
+  barrier();
+  for (uint i = gl_LocalInvocationIndex; i < kWindowH * kWindowW; i += kGroupSize) {
+    uint row = i / kWindowW, col = i % kWindowW;
+    vec4 sum = vec4(0.0);
+    [[unroll]] for (int m = 0; m <= 2 * kRadius; ++m) sum += kBinomial[m] * s_rows[(row + uint(m)) * kWindowW + col];
+    s_window[i] = sum;
+  }
+  barrier();
+
+  if (any(greaterThanEqual(xy, dst_size))) return;
+  vec3 c = downsample(xy, dst_size, true);
+  imageStore(level0, xy, vec4(min(c, vec3(p.max_brightness)), 1.0));
+}
