@@ -41,6 +41,10 @@ void BloomConfig::validate() const {
     throw Error(ErrorCode::invalid_argument,
                 concat("BloomConfig::filter = ", f, " is not a BloomFilter: accepted cod13, dual, gauss9"));
   }
+  if (level0_height != 0 && (level0_height < 8 || level0_height > 16384)) {
+    throw Error(ErrorCode::invalid_argument,
+                concat("BloomConfig::level0_height = ", level0_height, " is out of range: accepted 0 or 8 to 16384"));
+  }
   const auto g = static_cast<uint32_t>(firefly_guard);
   if (g > static_cast<uint32_t>(FireflyGuard::karis_smooth)) {
     throw Error(ErrorCode::invalid_argument,
@@ -52,9 +56,42 @@ void BloomConfig::validate() const {
                 concat("BloomConfig::precision = ", p, " is not a Precision: accepted fp16, fp32"));
 }
 
-std::vector<LevelSize> bloom_mip_chain(VkExtent2D input, uint32_t iterations) {
+namespace {
+
+// docs/BLOOM.md "Mip chain": with level0_height > 0, halve while the half is still taller than the
+// target, then one step to the target height, its width the input's aspect kept within [w/2, w] of
+// the last image so that every step has a ratio of 1 to 2 (plus one texel) per axis.
+struct FirstSteps {
+  std::vector<LevelSize> pre;
+  LevelSize level0;
+};
+
+FirstSteps first_steps(VkExtent2D input, uint32_t level0_height) {
+  FirstSteps f;
+  if (level0_height == 0) {
+    f.level0 = {std::max(1u, input.width / 2), std::max(1u, input.height / 2)};
+    return f;
+  }
+  const uint32_t h0 = std::min(level0_height, input.height);
+  LevelSize cur{input.width, input.height};
+  while (cur.height / 2 > h0) {
+    cur = {std::max(1u, cur.width / 2), cur.height / 2};
+    f.pre.push_back(cur);
+  }
+  const auto aspect_width = static_cast<uint32_t>(std::llround(double(input.width) * h0 / input.height));
+  f.level0 = {std::clamp(aspect_width, std::max(1u, cur.width / 2), cur.width), h0};
+  return f;
+}
+
+}  // namespace
+
+std::vector<LevelSize> bloom_pre_levels(VkExtent2D input, uint32_t level0_height) {
+  return first_steps(input, level0_height).pre;
+}
+
+std::vector<LevelSize> bloom_mip_chain(VkExtent2D input, uint32_t iterations, uint32_t level0_height) {
   std::vector<LevelSize> chain;
-  LevelSize level{std::max(1u, input.width / 2), std::max(1u, input.height / 2)};
+  LevelSize level = first_steps(input, level0_height).level0;
   chain.push_back(level);  // level 0 always exists, even when it is under 2 pixels
   while (chain.size() < iterations) {
     LevelSize next{std::max(1u, level.width / 2), std::max(1u, level.height / 2)};
@@ -112,6 +149,9 @@ struct Bloom::Impl {
   VkExtent2D extent{0, 0};
   std::vector<LevelSize> chain;
   bool was_clamped = false;
+  std::vector<LevelSize> pre_chain;            // level0_height's 2:1 steps before level 0
+  std::vector<detail::OwnedImage> pre_levels;
+  std::vector<VkDescriptorSet> pre_sets;        // pre_levels[k] -> pre_levels[k + 1] or level 0
   std::vector<detail::OwnedImage> levels;
   std::vector<detail::OwnedImage> temps;  // gauss9 horizontal pass, one per level
   detail::DescriptorArena internal_sets;
@@ -165,28 +205,38 @@ struct Bloom::Impl {
     caller_arenas.clear();
     caller_sets_left = 0;
     down_sets.clear();
+    pre_sets.clear();
     blur_h_sets.clear();
     blur_v_sets.clear();
     up_sets.clear();
     internal_sets.reset();
     levels.clear();
     temps.clear();
+    pre_levels.clear();
+    pre_chain.clear();
     extent = {0, 0};
   }
 
   void make_pyramid(VkExtent2D size) {
     release_pyramid();
-    chain = bloom_mip_chain(size, config.iterations);
+    chain = bloom_mip_chain(size, config.iterations, config.level0_height);
+    pre_chain = bloom_pre_levels(size, config.level0_height);
     was_clamped = chain.size() < config.iterations;
     const VkImageUsageFlags usage = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT;
     const bool gauss = config.filter == BloomFilter::gauss9;
+    for (const LevelSize& l : pre_chain) pre_levels.emplace_back(*context, VkExtent2D{l.width, l.height}, level_format(), usage);
     for (const LevelSize& l : chain) {
       levels.emplace_back(*context, VkExtent2D{l.width, l.height}, level_format(), usage);
       if (gauss) temps.emplace_back(*context, VkExtent2D{l.width, l.height}, level_format(), usage);
     }
     const uint32_t n = static_cast<uint32_t>(chain.size());
-    internal_sets = detail::DescriptorArena(*context, 4 * n + 1);
+    const auto m = static_cast<uint32_t>(pre_chain.size());
+    internal_sets = detail::DescriptorArena(*context, 4 * n + m + 1);
     const VkImageLayout G = VK_IMAGE_LAYOUT_GENERAL;  // pyramid images stay in GENERAL
+    for (uint32_t k = 0; k < m; ++k) {
+      const VkImageView next = k + 1 < m ? pre_levels[k + 1].state.view : levels[0].state.view;
+      pre_sets.push_back(internal_sets.make_set(down, {{pre_levels[k].state.view, G}, {next, G}}));
+    }
     for (uint32_t k = 1; k < n; ++k) {
       down_sets.push_back(internal_sets.make_set(down, {{levels[k - 1].state.view, G}, {levels[k].state.view, G}}));
     }
@@ -215,7 +265,8 @@ struct Bloom::Impl {
     const VkImageLayout G = VK_IMAGE_LAYOUT_GENERAL;
     const int o = out.format == VK_FORMAT_R32G32B32A32_SFLOAT ? 1 : 0;
     CallerSets s;
-    s.prefilter = arena.make_set(prefilter_down, {{in.view, in_layout}, {levels[0].state.view, G}});
+    const VkImageView first = pre_levels.empty() ? levels[0].state.view : pre_levels[0].state.view;
+    s.prefilter = arena.make_set(prefilter_down, {{in.view, in_layout}, {first, G}});
     s.composite = arena.make_set(composite[o], {{in.view, in_layout}, {levels[0].state.view, G}, {out.view, G}});
     s.copy = arena.make_set(copy[o], {{in.view, in_layout}, {out.view, G}});
     return caller_sets.emplace(key, s).first->second;
@@ -315,12 +366,23 @@ void Bloom::Impl::record(VkCommandBuffer cmd, Image& input, Image& output, Profi
                   chain[k].height);
   };
 
-  // 1. Bright-pass fused into the first downsample.
+  // 1. Bright-pass fused into the first downsample; with level0_height, 2:1 steps to level 0.
+  const uint32_t karis = config.firefly_guard == FireflyGuard::karis ? GLINT_BLOOM_FLAG_KARIS : 0u;
+  const auto m = static_cast<uint32_t>(pre_chain.size());
+  Image& first = m ? pre_levels[0].state : levels[0].state;
+  const LevelSize first_size = m ? pre_chain[0] : chain[0];
   b.use(scene, scene_layout, kCompute, kSampled);
-  b.use(levels[0].state, G, kCompute, kStorageWrite);
+  b.use(first, G, kCompute, kStorageWrite);
   b.flush(cmd);
-  prefilter_down.dispatch(cmd, sets.prefilter, push(full, chain[0], config.firefly_guard == FireflyGuard::karis ? GLINT_BLOOM_FLAG_KARIS : 0u),
-                          chain[0].width, chain[0].height);
+  prefilter_down.dispatch(cmd, sets.prefilter, push(full, first_size, karis), first_size.width, first_size.height);
+  for (uint32_t k = 0; k < m; ++k) {
+    Image& next = k + 1 < m ? pre_levels[k + 1].state : levels[0].state;
+    const LevelSize next_size = k + 1 < m ? pre_chain[k + 1] : chain[0];
+    b.use(pre_levels[k].state, G, kCompute, kSampled);
+    b.use(next, G, kCompute, kStorageWrite);
+    b.flush(cmd);
+    down.dispatch(cmd, pre_sets[k], push(pre_chain[k], next_size), next_size.width, next_size.height);
+  }
   if (gauss) blur_level(0);
   if (profiler) profiler->mark(cmd, "bloom bright-pass + down 0");
 
@@ -373,7 +435,8 @@ void Bloom::set_config(const BloomConfig& config) {
   const bool smooth_changed = (old.firefly_guard == FireflyGuard::karis_smooth) !=
                               (config.firefly_guard == FireflyGuard::karis_smooth);
   const bool pipelines_changed = old.filter != config.filter || old.precision != config.precision || smooth_changed;
-  const bool shape_changed = old.iterations != config.iterations || pipelines_changed;
+  const bool shape_changed =
+      old.iterations != config.iterations || old.level0_height != config.level0_height || pipelines_changed;
   if (!shape_changed) return;
   const VkExtent2D size = impl_->extent;
   impl_->release_pyramid();
@@ -413,6 +476,7 @@ uint64_t Bloom::min_bytes_moved(VkFormat input_format, VkFormat output_format) c
   const uint64_t level_bytes = impl_->config.precision == Precision::fp32 ? 16 : 8;
   uint64_t total = pixels * (in_bytes + out_bytes);
   for (const LevelSize& l : impl_->chain) total += 2 * uint64_t(l.width) * l.height * level_bytes;
+  for (const LevelSize& l : impl_->pre_chain) total += 2 * uint64_t(l.width) * l.height * level_bytes;
   return total;
 }
 

@@ -96,6 +96,8 @@ std::vector<ApiCase> api_cases() {
       {"max_brightness", [](BloomConfig& c) { c.max_brightness = 9000.0f; }},
       {"max_brightness", [](BloomConfig& c) { c.max_brightness = kNaN; }},
       {"firefly_guard", [](BloomConfig& c) { c.firefly_guard = static_cast<FireflyGuard>(3); }},
+      {"level0_height", [](BloomConfig& c) { c.level0_height = 4; }},
+      {"level0_height", [](BloomConfig& c) { c.level0_height = 20000; }},
       {"filter", [](BloomConfig& c) { c.filter = static_cast<BloomFilter>(3); }},
       {"precision", [](BloomConfig& c) { c.precision = static_cast<Precision>(2); }},
   };

@@ -167,6 +167,71 @@ TEST_F(BloomTest, MatchesReferenceForEveryFilterAndPrecision) {
   }
 }
 
+// Every firefly guard, with and without level0_height (pre-levels, a last step of ratio 1 to 2,
+// odd sizes, a level 0 as tall as the input), against the float64 reference. Compared on the light
+// added (out - in) so the scene cannot hide an error; fp32 levels, tolerance 1e-3 as above.
+TEST_F(BloomTest, MatchesReferenceForEveryGuardAndLevel0Height) {
+  struct Case {
+    uint32_t w, h, level0_height;
+  };
+  const Case cases[] = {{97, 61, 0}, {200, 150, 40}, {61, 97, 30}, {40, 30, 24}, {17, 9, 8}, {33, 20, 64}};
+  for (BloomFilter filter : kFilters) {
+    for (FireflyGuard guard : {FireflyGuard::off, FireflyGuard::karis, FireflyGuard::karis_smooth}) {
+      BloomConfig config;
+      config.filter = filter;
+      config.firefly_guard = guard;
+      config.precision = Precision::fp32;
+      config.iterations = 3;
+      config.intensity = 1.0f;
+      Bloom bloom(context(), config);  // one effect: set_config re-makes only the pyramid
+      for (const Case& c : cases) {
+        config.level0_height = c.level0_height;
+        bloom.set_config(config);
+        const CpuImage input = random_hdr(c.w, c.h, c.w * 7 + c.h);
+        const CpuImage gpu = run_bloom(bloom, input, kF32, kF32);
+        ASSERT_TRUE(all_finite(gpu)) << "unwritten (poisoned) texels remain";
+        const auto ref = reference::bloom(input, config);
+        double diff = 0.0, norm = 0.0;
+        for (size_t i = 0; i < gpu.rgba.size(); ++i) {
+          if (i % 4 == 3) continue;
+          const double want = ref.rgba[i] - input.rgba[i], got = double(gpu.rgba[i]) - input.rgba[i];
+          diff += (got - want) * (got - want);
+          norm += want * want;
+        }
+        EXPECT_GT(norm, 0.0);
+        EXPECT_LT(std::sqrt(diff / norm), 1e-3) << filter_name(filter) << " guard " << static_cast<int>(guard) << " "
+                                                << c.w << "x" << c.h << " level0_height " << c.level0_height;
+      }
+    }
+  }
+}
+
+// level0_height sizes (docs/BLOOM.md "Mip chain"): the same level 0 from 720p, 1080p and 2160p.
+TEST(BloomMipChain, Level0HeightStepsToTheSameLevel0) {
+  struct Case {
+    VkExtent2D in;
+    uint32_t level0_height;
+    std::vector<std::pair<uint32_t, uint32_t>> pre, chain;
+  };
+  const std::vector<Case> cases = {
+      {{1280, 720}, 540, {}, {{960, 540}, {480, 270}, {240, 135}}},
+      {{1920, 1080}, 540, {}, {{960, 540}, {480, 270}, {240, 135}}},
+      {{3840, 2160}, 540, {{1920, 1080}}, {{960, 540}, {480, 270}, {240, 135}}},
+      {{7680, 4320}, 540, {{3840, 2160}, {1920, 1080}}, {{960, 540}, {480, 270}, {240, 135}}},
+      {{1, 4097}, 540, {{1, 2048}, {1, 1024}}, {{1, 540}}},
+      {{640, 360}, 540, {}, {{640, 360}, {320, 180}, {160, 90}}},  // level 0 at most the input
+      {{1923, 1081}, 540, {}, {{961, 540}, {480, 270}, {240, 135}}},
+      {{1920, 1080}, 0, {}, {{960, 540}, {480, 270}, {240, 135}}},
+  };
+  for (const Case& c : cases) {
+    std::vector<std::pair<uint32_t, uint32_t>> pre, chain;
+    for (const LevelSize& l : bloom_pre_levels(c.in, c.level0_height)) pre.emplace_back(l.width, l.height);
+    for (const LevelSize& l : bloom_mip_chain(c.in, 3, c.level0_height)) chain.emplace_back(l.width, l.height);
+    EXPECT_EQ(pre, c.pre) << c.in.width << "x" << c.in.height;
+    EXPECT_EQ(chain, c.chain) << c.in.width << "x" << c.in.height;
+  }
+}
+
 // The error must come from the bloom, not be hidden by it: a wrong threshold is caught.
 TEST_F(BloomTest, ReferenceComparisonDetectsAWrongParameter) {
   const CpuImage input = random_hdr(64, 48, 11, 0.05f);

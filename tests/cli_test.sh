@@ -55,6 +55,7 @@ for filter in cod13 dual gauss9; do
   expect_file "$tmp/$filter.png"
 done
 ok bloom "$scene" "$tmp/fp32.exr" --fp32
+ok bloom "$scene" "$tmp/guard.exr" --firefly-guard karis --max-brightness 500 --level0-height 100
 ok bloom "$tmp/cod13.exr" "$tmp/again.exr"  # its own output is valid input
 ok demo --size 1x1 --out "$tmp/tiny"
 grep -q 'clamped' "$tmp/out" || fail "a 1x1 demo did not report clamped levels"
@@ -77,6 +78,9 @@ bad bloom "$scene" "$tmp/x.exr" --iterations 99
 bad bloom "$scene" "$tmp/x.exr" --iterations -1
 bad bloom "$scene" "$tmp/x.exr" --radius 0.1
 bad bloom "$scene" "$tmp/x.exr" --radius inf
+bad bloom "$scene" "$tmp/x.exr" --firefly-guard on
+bad bloom "$scene" "$tmp/x.exr" --level0-height 4
+bad bloom "$scene" "$tmp/x.exr" --max-brightness 9000
 bad bloom "$scene" "$tmp/x.exr" --filter box
 bad bloom "$scene" "$tmp/x.exr" --intensity 1e40
 bad bloom "$scene" "$tmp/x.exr" --iterations 4294967296

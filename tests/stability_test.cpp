@@ -140,6 +140,36 @@ TEST_F(StabilityTest, BloomExtentIsFixedInPixelsForFixedIterations) {
   }
 }
 
+// With level0_height the first steps bring every resolution to the same level 0 (here 960x540 at
+// 720p, 1080p and 2160p), so a point's bloom is the same fraction of the image width at all three:
+// issue 6 asks for 5%. Checked for the radii holding 50% and 90% of the energy and for the
+// second-moment sigma (docs/STABILITY.md, "Scale", has the numbers: at most 4.1% apart, cod13's
+// r50 at 720p).
+TEST_F(StabilityTest, Level0HeightMakesTheBloomResolutionIndependent) {
+  for (BloomFilter filter : {BloomFilter::cod13, BloomFilter::dual, BloomFilter::gauss9}) {
+    BloomConfig config;
+    config.filter = filter;
+    config.level0_height = 540;
+    double r50[3], r90[3], sigma[3];
+    int i = 0;
+    for (VkExtent2D e : {VkExtent2D{1280, 720}, VkExtent2D{1920, 1080}, VkExtent2D{3840, 2160}}) {
+      const double cx = e.width / 2 + 0.3, cy = e.height / 2 + 0.3;
+      const CpuImage in = analysis::subpixel_point(e.width, e.height, cx, cy, 1000.0f);
+      const auto added = analysis::added_light(run_bloom_once(config, in, kF16), in);
+      const auto st = analysis::light_stats(added, e.width, e.height);
+      r50[i] = analysis::radius_holding(added, e.width, e.height, cx, cy, 0.5) / e.width;
+      r90[i] = analysis::radius_holding(added, e.width, e.height, cx, cy, 0.9) / e.width;
+      sigma[i] = std::sqrt(st.xx + st.yy) / e.width;
+      ++i;
+    }
+    for (int k : {0, 2}) {
+      EXPECT_NEAR(r50[k] / r50[1], 1.0, 0.05) << filter_name(filter) << " r50, size " << k;
+      EXPECT_NEAR(r90[k] / r90[1], 1.0, 0.05) << filter_name(filter) << " r90, size " << k;
+      EXPECT_NEAR(sigma[k] / sigma[1], 1.0, 0.05) << filter_name(filter) << " sigma, size " << k;
+    }
+  }
+}
+
 // ---- range: NaN, Inf, negatives, huge values --------------------------------------------------
 
 // One bad pixel: the output is finite everywhere (the bad pixel included), and no pixel beyond the

@@ -21,6 +21,7 @@ struct BloomOptions {
   std::string png;
   std::string device;
   std::string filter = "cod13";
+  std::string guard = "karis_smooth";
   bool fp32 = false;
   float exposure = 1.0f;
   BloomConfig config;
@@ -40,8 +41,15 @@ const char* filter_name(BloomFilter f) {
   }
 }
 
+FireflyGuard guard_from_name(const std::string& name) {
+  if (name == "off") return FireflyGuard::off;
+  if (name == "karis") return FireflyGuard::karis;
+  return FireflyGuard::karis_smooth;  // IsMember() has already rejected anything else
+}
+
 void run_bloom(BloomOptions& o) {
   o.config.filter = filter_from_name(o.filter);
+  o.config.firefly_guard = guard_from_name(o.guard);
   o.config.precision = o.fp32 ? Precision::fp32 : Precision::fp16;
   o.config.validate();  // bad flags fail before any file or device is touched
   check_exposure(o.exposure);
@@ -100,6 +108,11 @@ Command add_bloom_command(CLI::App& app) {
   sub->add_option("--iterations", o->config.iterations, "Pyramid levels (1 to 8; fewer at small sizes)");
   sub->add_option("--radius", o->config.radius, "Scale of the upsample footprint (0.25 to 4)");
   sub->add_option("--filter", o->filter, "Filter between levels")->check(CLI::IsMember({"cod13", "dual", "gauss9"}));
+  sub->add_option("--firefly-guard", o->guard, "Firefly guard on the first downsample (docs/BLOOM.md)")
+      ->check(CLI::IsMember({"off", "karis", "karis_smooth"}));
+  sub->add_option("--max-brightness", o->config.max_brightness, "Per-channel clamp of level 0 (1e-3 to 8000)");
+  sub->add_option("--level0-height", o->config.level0_height,
+                  "Rows of pyramid level 0 (0 = half the input; 8 to 16384 makes the glow resolution independent)");
   sub->add_flag("--fp32", o->fp32, "Keep the pyramid in RGBA32F instead of RGBA16F");
   sub->add_option("--png", o->png, "Also write a tonemapped (ACES fitted) 8-bit sRGB PNG here");
   sub->add_option("--exposure", o->exposure, "Linear exposure applied before the PNG tonemap (> 0)");

@@ -90,13 +90,37 @@ void validate(const CpuImage& input, const BloomConfig& config) {
 // Mip chain (docs/BLOOM.md "Mip chain"). An own copy on purpose: the reference must not share
 // code with the driver it checks (bloom_mip_chain in host/bloom.cpp).
 
-std::vector<LevelSize> level_sizes(uint32_t width, uint32_t height, uint32_t iterations) {
-  std::vector<LevelSize> chain;
+// level0_height > 0: "halve (floor) while half the height is still above the target; then one
+// step to the target height H0 = min(level0_height, input height), width round(W * H0 / H) kept
+// within [max(1, w/2), w] of the image before it". Returns those pre-levels; *level0 gets level 0.
+std::vector<LevelSize> pre_level_sizes(uint32_t width, uint32_t height, uint32_t level0_height, LevelSize* level0) {
+  std::vector<LevelSize> pre;
+  if (level0_height == 0) {
+    *level0 = {std::max(1u, width / 2), std::max(1u, height / 2)};
+    return pre;
+  }
+  const uint32_t target = std::min(level0_height, height);
   uint32_t w = width, h = height;
-  for (uint32_t k = 0; k < iterations; ++k) {
-    // Level k is max(1, w(k-1)/2) x max(1, h(k-1)/2), integer floor division.
+  while (h / 2 > target) {
     w = std::max(1u, w / 2);
-    h = std::max(1u, h / 2);
+    h /= 2;
+    pre.push_back({w, h});
+  }
+  const double aspect_width = std::round(double(width) * target / double(height));
+  const double lo = std::max(1u, w / 2), hi = w;
+  *level0 = {static_cast<uint32_t>(std::clamp(aspect_width, lo, hi)), target};
+  return pre;
+}
+
+std::vector<LevelSize> level_sizes(uint32_t width, uint32_t height, uint32_t iterations, uint32_t level0_height) {
+  std::vector<LevelSize> chain;
+  LevelSize level0;
+  pre_level_sizes(width, height, level0_height, &level0);
+  uint32_t w = 0, h = 0;
+  for (uint32_t k = 0; k < iterations; ++k) {
+    // Level 0 as above; level k is max(1, w(k-1)/2) x max(1, h(k-1)/2), integer floor division.
+    w = k == 0 ? level0.width : std::max(1u, w / 2);
+    h = k == 0 ? level0.height : std::max(1u, h / 2);
     // N is reduced so that every level is at least 2 on each side, but level 0 always exists
     // (a 3x5 input gets one 1x2 level). Sizes never grow, so the first small level ends the chain.
     const bool big_enough = w >= 2 && h >= 2;
@@ -393,7 +417,11 @@ void prefilter(const BloomConfig& config, const double in_rgb[3], double out_rgb
 // vertically, stored, and that blurred level is what the next downsample reads.
 std::vector<DoubleImage> downsampled_levels(const CpuImage& input, const BloomConfig& config, bool round_half) {
   validate(input, config);
-  const std::vector<LevelSize> chain = level_sizes(input.width, input.height, config.iterations);
+  const std::vector<LevelSize> chain = level_sizes(input.width, input.height, config.iterations, config.level0_height);
+  LevelSize level0_size;
+  const std::vector<LevelSize> pre = pre_level_sizes(input.width, input.height, config.level0_height, &level0_size);
+  if (level0_size.width != chain[0].width || level0_size.height != chain[0].height)
+    throw std::logic_error("bloom reference: level 0 size mismatch");
   const double radius = config.radius;
 
   std::vector<DoubleImage> levels;
@@ -401,16 +429,21 @@ std::vector<DoubleImage> downsampled_levels(const CpuImage& input, const BloomCo
   {
     // Level 0 reads the prefiltered full-resolution image P, which is not stored on the GPU
     // (the prefilter is fused into the first downsample), so it is never rounded.
+    // The first step goes to the first pre-level (level0_height) or to level 0.
     const DoubleImage p = prefiltered_image(input, config);
-    if (config.firefly_guard == FireflyGuard::karis_smooth) {
-      levels.push_back(downsample(binomial_smoothed(p), chain[0], config.filter, true));
-    } else {
-      levels.push_back(downsample(p, chain[0], config.filter, config.firefly_guard == FireflyGuard::karis));
+    const LevelSize first = pre.empty() ? chain[0] : pre[0];
+    DoubleImage step = config.firefly_guard == FireflyGuard::karis_smooth
+                           ? downsample(binomial_smoothed(p), first, config.filter, true)
+                           : downsample(p, first, config.filter, config.firefly_guard == FireflyGuard::karis);
+    // Its result is clamped per channel to max_brightness before it is stored.
+    for (size_t i = 0; i < step.rgba.size(); i += 4)
+      for (size_t k = 0; k < 3; ++k) step.rgba[i + k] = std::min(step.rgba[i + k], double(config.max_brightness));
+    // Pre-levels: plain downsamples (no guard, no gauss9 blur), each stored.
+    for (size_t k = 0; k < pre.size(); ++k) {
+      if (round_half) store_half(step);
+      step = downsample(step, k + 1 < pre.size() ? pre[k + 1] : chain[0], config.filter, false);
     }
-    // Level 0 is clamped per channel to max_brightness before it is stored.
-    DoubleImage& level0 = levels.back();
-    for (size_t i = 0; i < level0.rgba.size(); i += 4)
-      for (size_t k = 0; k < 3; ++k) level0.rgba[i + k] = std::min(level0.rgba[i + k], double(config.max_brightness));
+    levels.push_back(std::move(step));
   }
   for (size_t k = 0; k < chain.size(); ++k) {
     if (k > 0) levels.push_back(downsample(levels[k - 1], chain[k], config.filter, false));

@@ -43,6 +43,11 @@ struct BloomConfig {
                                             //!< levels finite. Source texels are first clamped to
                                             //!< 65504 (what +Inf and 1e9 become).
   Precision precision = Precision::fp16;    //!< intermediate storage [shape]
+  /// 0: level 0 is half the input (issue 2's chain; the glow is a fixed size in pixels). Else level
+  /// 0 is this many rows (at most the input's height) with the input's aspect, reached through 2:1
+  /// steps and one step of ratio 1 to 2, so the glow is the same fraction of the image at every
+  /// resolution down to this height (docs/STABILITY.md "Scale"). 0 or 8 to 16384. [shape]
+  uint32_t level0_height = 0;
 
   /// Throws Error(invalid_argument) naming the first field that is out of range or NaN.
   void validate() const;
@@ -50,7 +55,11 @@ struct BloomConfig {
 
 /// The mip chain a bloom of `input` size with `iterations` uses (docs/BLOOM.md, "Mip chain").
 /// Returns at most `iterations` levels; fewer when a level would be under 2 pixels on a side.
-std::vector<LevelSize> bloom_mip_chain(VkExtent2D input, uint32_t iterations);
+std::vector<LevelSize> bloom_mip_chain(VkExtent2D input, uint32_t iterations, uint32_t level0_height = 0);
+
+/// The images the first downsample steps through before level 0 (2:1 each; not part of the
+/// bloom): empty unless level0_height asks for a level 0 under half the input (docs/BLOOM.md).
+std::vector<LevelSize> bloom_pre_levels(VkExtent2D input, uint32_t level0_height);
 
 /// One bloom effect. Make it once; call record() every frame.
 ///

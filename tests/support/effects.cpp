@@ -29,26 +29,33 @@ CpuImage run_bloom_once(const BloomConfig& config, const CpuImage& input, VkForm
 // A change at the input reaches level N-1 through every downsample and comes back to the output
 // through every upsample, so the footprint is the sum of all of these; +1 px for fp rounding of p.
 uint32_t bloom_footprint_px(VkExtent2D extent, const BloomConfig& config) {
-  const auto chain = bloom_mip_chain(extent, config.iterations);
+  // level0_height's pre-levels only add their downsample reach (no blur, no upsample).
+  const auto pre = bloom_pre_levels(extent, config.level0_height);
+  const auto chain = bloom_mip_chain(extent, config.iterations, config.level0_height);
   double worst = 0.0;
   for (int axis = 0; axis < 2; ++axis) {
     const double full = axis == 0 ? extent.width : extent.height;
     double prev_size = full, prev_texel = 1.0, reach = 0.0;
     // karis_smooth filters the source with an 11-tap binomial before the first downsample.
     if (config.firefly_guard == FireflyGuard::karis_smooth) reach += GLINT_BLOOM_SMOOTH_RADIUS;
-    for (const LevelSize& l : chain) {
+    auto down_reach = [&](const LevelSize& l) {
       const double size = axis == 0 ? l.width : l.height;
-      const double texel = full / size;
       const double ratio = prev_size / size;
       double down = 3.0;
       if (config.filter == BloomFilter::dual) down = 2.0;
       if (config.filter == BloomFilter::gauss9) down = ratio / 2.0 + 0.5;
       reach += down * prev_texel;
+      prev_size = size;
+      prev_texel = full / size;
+    };
+    for (const LevelSize& l : pre) down_reach(l);
+    for (const LevelSize& l : chain) {
+      const double size = axis == 0 ? l.width : l.height;
+      const double texel = full / size;
+      down_reach(l);
       if (config.filter == BloomFilter::gauss9) reach += (4.0 * config.radius + 1.0) * texel;
       const double up = config.filter == BloomFilter::gauss9 ? 1.0 : config.radius + 1.0;
       reach += up * texel;
-      prev_size = size;
-      prev_texel = texel;
     }
     worst = std::max(worst, reach);
   }
