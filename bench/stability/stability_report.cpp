@@ -45,13 +45,15 @@ struct FireflySeries {
   std::vector<double> energy, centroid_error;
 };
 
-// A 1e4 point moving right by a quarter pixel per frame over 64 frames (16 px).
-FireflySeries firefly(const Context& ctx, const BloomConfig& config, float value, uint32_t w, uint32_t h) {
+// A point moving right (or, with `diagonal`, right and down) by a quarter pixel per frame over 64
+// frames (16 px).
+FireflySeries firefly(const Context& ctx, const BloomConfig& config, float value, uint32_t w, uint32_t h,
+                      bool diagonal = false) {
   Frame frame(ctx, {w, h});
   Bloom bloom(ctx, config);
   FireflySeries s;
   for (int f = 0; f < 64; ++f) {
-    const double x = 100.0 + 0.25 * f, y = h / 2.0;
+    const double x = 100.0 + 0.25 * f, y = h / 2.0 - (diagonal ? 32.0 - 0.25 * f : 0.0);
     const CpuImage in = analysis::subpixel_point(w, h, x, y, value);
     const CpuImage out = frame.run(ctx, bloom, in);
     const auto st = analysis::light_stats(analysis::added_light(out, in), w, h);
@@ -163,19 +165,26 @@ int main_impl(int argc, char** argv) {
       }
     }
   }
+  std::printf("\n| filter (defaults) | diagonal path: energy spread | max step |\n|---|---|---|\n");
+  for (BloomFilter f : {BloomFilter::cod13, BloomFilter::dual, BloomFilter::gauss9}) {
+    BloomConfig c;
+    c.filter = f;
+    const auto ev = analysis::relative_variation(firefly(ctx, c, 1e4f, 256, 128, true).energy);
+    std::printf("| %s | %.4f | %.4f |\n", filter_name(f), ev.spread, ev.max_step);
+  }
   draw_chart(chart, out_dir + "/firefly_energy.png");
   filmstrip(ctx, out_dir + "/firefly_frames.png");
   std::printf(
-      "\n| filter | iterations | size | r50 / width | r90 / width | sigma / width |\n|---|---|---|---|---|---|\n");
+      "\n| filter | iterations | level0_height | size | r50 / width | r90 / width | sigma / width |\n|---|---|---|---|---|---|---|\n");
   for (BloomFilter f : {BloomFilter::cod13, BloomFilter::dual, BloomFilter::gauss9}) {
     struct Row {
       VkExtent2D e;
       uint32_t it;
       float radius;
+      uint32_t level0_height;
     };
-    for (Row row :
-         {Row{{960, 540}, 4, 1.f}, Row{{1920, 1080}, 5, 1.f}, Row{{3840, 2160}, 6, 1.f}, Row{{1280, 720}, 5, 1.f},
-          Row{{1280, 720}, 5, 0.5f}, Row{{1280, 720}, 5, 0.7f}, Row{{1280, 720}, 4, 1.5f}, Row{{1280, 720}, 4, 2.f}}) {
+    for (Row row : {Row{{1280, 720}, 5, 1.f, 0}, Row{{1920, 1080}, 5, 1.f, 0}, Row{{3840, 2160}, 5, 1.f, 0},
+                    Row{{1280, 720}, 5, 1.f, 540}, Row{{1920, 1080}, 5, 1.f, 540}, Row{{3840, 2160}, 5, 1.f, 540}}) {
       {
         const VkExtent2D e = row.e;
         const uint32_t it = row.it;
@@ -183,15 +192,16 @@ int main_impl(int argc, char** argv) {
         c.filter = f;
         c.iterations = it;
         c.radius = row.radius;
+        c.level0_height = row.level0_height;
         Frame frame(ctx, e);
         Bloom bloom(ctx, c);
-        const double cx = e.width / 2, cy = e.height / 2;
+        const double cx = e.width / 2 + 0.3, cy = e.height / 2 + 0.3;
         const CpuImage in = analysis::subpixel_point(e.width, e.height, cx, cy, 1000.0f);
         const auto added = analysis::added_light(frame.run(ctx, bloom, in), in);
         const auto st = analysis::light_stats(added, e.width, e.height);
         const double r50 = analysis::radius_holding(added, e.width, e.height, cx, cy, 0.5);
         const double r90 = analysis::radius_holding(added, e.width, e.height, cx, cy, 0.9);
-        std::printf("| %s | %u r%.2f | %ux%u | %.4f | %.4f | %.4f |\n", filter_name(f), it, row.radius, e.width,
+        std::printf("| %s | %u | %u | %ux%u | %.5f | %.5f | %.5f |\n", filter_name(f), it, row.level0_height, e.width,
                     e.height, r50 / e.width, r90 / e.width, std::sqrt(st.xx + st.yy) / e.width);
       }
     }

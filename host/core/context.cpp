@@ -113,9 +113,12 @@ VkInstance make_instance(bool validation, ContextState* state, VkDebugUtilsMesse
     extensions.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
   }
   // Synchronization validation on; best practices off (it warns about choices, not errors).
-  VkValidationFeatureEnableEXT enables[] = {VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT};
+  // GLINT_GPU_AV=1 adds GPU-assisted validation (instrumented shaders check descriptor indexing
+  // and buffer bounds on the device); slow, so one CI step runs part of the suite with it.
+  VkValidationFeatureEnableEXT enables[] = {VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT,
+                                            VK_VALIDATION_FEATURE_ENABLE_GPU_ASSISTED_EXT};
   VkValidationFeaturesEXT features{VK_STRUCTURE_TYPE_VALIDATION_FEATURES_EXT};
-  features.enabledValidationFeatureCount = 1;
+  features.enabledValidationFeatureCount = detail::env_flag("GLINT_GPU_AV") ? 2 : 1;
   features.pEnabledValidationFeatures = enables;
 
   VkDebugUtilsMessengerCreateInfoEXT messenger_info{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
