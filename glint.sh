@@ -95,6 +95,18 @@ asan_test() {
   ASAN_OPTIONS="detect_leaks=0:abort_on_error=1" UBSAN_OPTIONS="$ubsan" \
     ctest --test-dir "$dir" --output-on-failure --no-tests=error -LE cpu -j"$(nproc)" "$@"
   ASAN_OPTIONS="detect_leaks=0:abort_on_error=1" UBSAN_OPTIONS="$ubsan" tests/cli_test.sh "$dir/host/glint"
+  gpu_assisted_tests "$dir" "ASAN_OPTIONS=detect_leaks=0:abort_on_error=1" "UBSAN_OPTIONS=$ubsan"
+}
+
+# GPU-assisted validation (instrumented shaders check buffer and descriptor accesses on the
+# device) on the tests that compare every kernel with its reference (13 tests, 26 s in Release on
+# 2 cores): the whole GPU suite under it would add minutes that CI's ten do not have (issue 6:
+# "if it runs in time").
+GPU_AV_TESTS="MatchesReference|MatchesItsReference|MatchesTheReference|MatchesTheFloat64|BatchKernelMatchesTheCppTwin|StatisticsAndResultsMatch"
+gpu_assisted_tests() {
+  local dir="$1"; shift
+  log "GPU-assisted validation: the reference comparisons"
+  env "$@" GLINT_GPU_AV=1 ctest --test-dir "$dir" --output-on-failure --no-tests=error -R "$GPU_AV_TESTS" -j"$(nproc)"
 }
 
 # run_fuzz SECONDS: builds fuzz/ with clang and runs each target on a scratch copy of its corpus.
@@ -173,6 +185,7 @@ case "$cmd" in
       ctest --test-dir "$BUILD_DIR" --output-on-failure --no-tests=error -j"$(nproc)" "$@"
       log "CLI smoke test"
       tests/cli_test.sh "$BUILD_DIR/host/glint"
+      gpu_assisted_tests "$BUILD_DIR"
       consumer_check
     else
       # Everything runs once, in the ASan+UBSan build (build-asan): the suite with validation, the
