@@ -4,6 +4,7 @@
 // joins the range, size and determinism tables there; docs/STABILITY.md has the measurements and
 // bench/stability/stability_report.cpp draws its pictures with the same analysis code.
 #include <glint/bloom.h>
+#include <glint/blur.h>
 #include <glint/lod.h>
 
 #include <cmath>
@@ -14,6 +15,7 @@
 #include "analysis/light_stats.h"
 #include "core/barriers.h"
 #include "core/transfer.h"
+#include "reference/blur_reference.h"
 #include "support/effects.h"
 #include "support/gpu_test.h"
 
@@ -188,7 +190,8 @@ TEST_F(StabilityTest, ABadPixelStaysInsideItsFootprint) {
   };
   const Bad bads[] = {{"NaN", {nan, nan, nan}, false},     {"+Inf", {inf, inf, inf}, true},
                       {"-Inf", {-inf, -inf, -inf}, false}, {"negative", {-5, -1e9f, -0.0f}, false},
-                      {"1e9", {1e9f, 1e9f, 1e9f}, true},   {"mixed", {nan, inf, -inf}, true}};
+                      {"1e9", {1e9f, 1e9f, 1e9f}, true},   {"mixed", {nan, inf, -inf}, true},
+                      {"FLT_MAX", {3.4e38f, 3.4e38f, -3.4e38f}, true}};
   for (const ImageEffect& effect : image_effects()) {
     const uint32_t footprint = effect.footprint_px({w, h});
     ASSERT_LT(bx + footprint, w - 64) << effect.name << ": image too small for the footprint " << footprint;
@@ -283,6 +286,53 @@ TEST_F(StabilityTest, EveryEffectIsBitIdenticalAcrossRuns) {
       const CpuImage a = effect.run(input, format);
       const CpuImage b = effect.run(input, format);
       EXPECT_EQ(0, std::memcmp(a.rgba.data(), b.rgba.data(), a.rgba.size() * 4)) << effect.name;
+    }
+  }
+}
+
+// ---- BlurPyramid: three levels, not an image-to-image effect ------------------------------------
+
+std::array<CpuImage, 3> run_blur_pyramid(BlurPyramid& pyramid, const CpuImage& input, VkFormat format) {
+  auto in = make_image(input, format);
+  context().run_once([&](VkCommandBuffer cmd) { pyramid.record(cmd, in.state); });
+  pyramid.forget_caller_resources();  // `in` dies here
+  return {detail::download(context(), pyramid.level(1)), detail::download(context(), pyramid.level(2)),
+          detail::download(context(), pyramid.level(3))};
+}
+
+// The pyramid's levels cannot take the image-effect table (they are smaller than the input), so
+// its rows are here: prime and maximal thin sizes against the float64 reference, every kind of bad
+// value (finite levels equal to the reference's sanitize), and bit-identical reruns.
+TEST_F(StabilityTest, BlurPyramidHandlesSizesBadValuesAndIsDeterministic) {
+  BlurPyramidConfig config;
+  config.precision = Precision::fp32;
+  BlurPyramid pyramid(context(), config);
+  const std::array<double, 3> sigmas = {config.sigma_texels[0], config.sigma_texels[1], config.sigma_texels[2]};
+  const uint32_t max_dim = context().info().max_image_dimension_2d;
+  for (VkExtent2D e : {VkExtent2D{4097, 3}, VkExtent2D{3, 4097}, VkExtent2D{max_dim, 2}, VkExtent2D{2, max_dim}}) {
+    const CpuImage input = random_hdr(e.width, e.height, e.width + 3 * e.height);
+    const auto levels = run_blur_pyramid(pyramid, input, kF32);
+    const auto ref = reference::blur_pyramid(input, sigmas, false, reference::kBlurMaxValueFp32);
+    for (int k = 0; k < 3; ++k) {
+      ASSERT_TRUE(all_finite(levels[k])) << e.width << "x" << e.height << " level " << k + 1;
+      EXPECT_LT(reference::rgba_relative_l2(levels[k], ref[k]), 2e-3) << e.width << "x" << e.height << " level " << k + 1;
+    }
+  }
+  CpuImage bad = random_hdr(120, 90, 8, 0.03f, 400.0f);
+  const float inf = INFINITY, nan = std::nanf("");
+  const float values[][4] = {{nan, inf, -inf, 1}, {1e9f, -5, -1e9f, nan}, {inf, inf, inf, inf}, {-0.0f, 3e38f, 1, 1}};
+  for (int i = 0; i < 4; ++i)
+    for (int c = 0; c < 4; ++c) bad.at(10 + 30 * i, 45)[c] = values[i][c];
+  for (VkFormat format : {kF16, kF32}) {
+    for (Precision precision : {Precision::fp16, Precision::fp32}) {
+      config.precision = precision;
+      pyramid.set_config(config);
+      const auto a = run_blur_pyramid(pyramid, bad, format);
+      const auto b = run_blur_pyramid(pyramid, bad, format);
+      for (int k = 0; k < 3; ++k) {
+        EXPECT_TRUE(all_finite(a[k])) << "level " << k + 1 << " format " << format << " precision " << int(precision);
+        EXPECT_EQ(0, std::memcmp(a[k].rgba.data(), b[k].rgba.data(), a[k].rgba.size() * 4)) << "level " << k + 1;
+      }
     }
   }
 }

@@ -20,7 +20,7 @@ namespace glint::reference {
 
 /// Sanitize clamp for RGBA16F and RGBA32F input (docs/BLUR.md "Notation").
 inline constexpr double kBlurMaxValueFp16 = 65504.0;
-inline constexpr double kBlurMaxValueFp32 = 3.0e38;
+inline constexpr double kBlurMaxValueFp32 = 1.0e37;
 
 /// Converts `input` to doubles without any change (NaN and Inf kept).
 DoubleImage to_double(const CpuImage& input);

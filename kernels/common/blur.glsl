@@ -40,17 +40,19 @@ vec4 area_sample(ivec2 xy) {
   ivec2 hi = lo + ws;
   ivec2 i0 = lo / wd;
   ivec2 i1 = (hi - 1) / wd;
+  // Overlaps are exact integers; each is divided by the footprint before it weighs a texel, so
+  // no partial sum exceeds the largest texel (huge inputs stay finite: docs/BLUR.md "Sanitize").
   vec4 sum = vec4(0.0);
   for (int j = i0.y; j <= i1.y; ++j) {
-    float wy = float(min(hi.y, (j + 1) * wd.y) - max(lo.y, j * wd.y));
+    float wy = float(min(hi.y, (j + 1) * wd.y) - max(lo.y, j * wd.y)) / float(ws.y);
     vec4 row = vec4(0.0);
     for (int i = i0.x; i <= i1.x; ++i) {
-      float wx = float(min(hi.x, (i + 1) * wd.x) - max(lo.x, i * wd.x));
+      float wx = float(min(hi.x, (i + 1) * wd.x) - max(lo.x, i * wd.x)) / float(ws.x);
       row += wx * src_texel(ivec2(i, j));
     }
     sum += wy * row;
   }
-  return sum / float(ws.x * ws.y);
+  return sum;
 }
 
 // Binomial downsample (docs/BLUR.md, "pyramid"): [1 3 3 1] / 8 per axis on an exact 2:1
