@@ -14,6 +14,7 @@
 #include <glint/bloom.h>
 #include <glint/blur.h>
 #include <glint/lod.h>
+#include <glint/occlusion.h>
 #include <unistd.h>
 
 #include <cmath>
@@ -498,18 +499,37 @@ TEST(ApiMemory, ObjectTrackerReportsALeakAtContextDestruction) {
   EXPECT_GT(detail::validation_messages_all_contexts(), before);
 }
 
-// 1000 prepare() calls at alternating sizes rebuild the pyramid 1000 times. Leaked Vulkan objects
-// (images, memory, views, pools) are caught by the object tracker when the context goes; RSS catches
-// host-side growth (descriptor-set maps, vectors). lavapipe's device memory counts in RSS only
-// once written, so RSS alone would not see a leaked, never-used pyramid.
+// 1000 prepare() calls at alternating sizes rebuild each effect's intermediates 1000 times (bloom
+// with and without level0_height's pre-levels, the blur pyramid, the Gaussian blur's pyramid
+// method); the Hi-Z pyramid, whose size is part of its config, is made 1000 times instead (its
+// kernels compile once per context: before they were shared, each make grew lavapipe by ~4 MB).
+// Leaked Vulkan objects (images, memory, views, pools) are caught by the object tracker when the
+// context goes; RSS catches host-side growth (descriptor-set maps, vectors). lavapipe's device
+// memory counts in RSS only once written, so RSS alone would not see a leaked, never-used pyramid.
 TEST(ApiMemory, AThousandResizesDoNotGrowMemory) {
   const uint64_t messages = detail::validation_messages_all_contexts();
   uint64_t warm = 0, end = 0;
   {
     Context ctx = Context::create(validated());
     Bloom bloom(ctx);
+    BloomConfig stepped;
+    stepped.level0_height = 40;
+    stepped.filter = BloomFilter::gauss9;
+    Bloom bloom_stepped(ctx, stepped);
+    BlurPyramid pyramid(ctx);
+    GaussianBlurConfig gauss_config;
+    gauss_config.method = BlurMethod::pyramid;
+    gauss_config.sigma_px = 6.0f;
+    GaussianBlur gauss(ctx, gauss_config);
     for (int i = 0; i < 1000; ++i) {
-      bloom.prepare(i % 2 ? VkExtent2D{256, 128} : VkExtent2D{200, 100});
+      const VkExtent2D e = i % 2 ? VkExtent2D{256, 128} : VkExtent2D{200, 100};
+      bloom.prepare(e);
+      bloom_stepped.prepare(e);
+      pyramid.prepare(e);
+      gauss.prepare(e);
+      HiZConfig hiz;
+      hiz.extent = e;
+      HiZPyramid made(ctx, hiz);
       if (i == 99) warm = rss_bytes();
     }
     end = rss_bytes();

@@ -6,6 +6,8 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <memory>
+#include <string>
 #include <utility>
 
 namespace glint::detail {
@@ -28,92 +30,89 @@ Workgroup2D choose_workgroup_2d(const DeviceInfo& info) {
   return {8, 8};
 }
 
+CompiledPipeline::~CompiledPipeline() {
+  if (pipeline) vkDestroyPipeline(device, pipeline, nullptr);
+  if (layout) vkDestroyPipelineLayout(device, layout, nullptr);
+  if (set_layout) vkDestroyDescriptorSetLayout(device, set_layout, nullptr);
+}
+
+namespace {
+
+std::shared_ptr<CompiledPipeline> compile(ContextState& s, const PipelineDesc& desc, const KernelBinary& bin) {
+  auto c = std::make_shared<CompiledPipeline>();  // destroys whatever was made if a step throws
+  c->device = s.device;
+  std::vector<VkDescriptorSetLayoutBinding> b(desc.bindings.size());
+  for (uint32_t i = 0; i < b.size(); ++i) b[i] = {i, desc.bindings[i], 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
+  VkDescriptorSetLayoutCreateInfo sl{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
+  sl.bindingCount = static_cast<uint32_t>(b.size());
+  sl.pBindings = b.data();
+  vk_check(vkCreateDescriptorSetLayout(s.device, &sl, nullptr, &c->set_layout), "vkCreateDescriptorSetLayout");
+  s.count_object();
+
+  VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, desc.push_constant_bytes};
+  VkPipelineLayoutCreateInfo pl{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+  pl.setLayoutCount = 1;
+  pl.pSetLayouts = &c->set_layout;
+  pl.pushConstantRangeCount = desc.push_constant_bytes ? 1 : 0;
+  pl.pPushConstantRanges = &range;
+  vk_check(vkCreatePipelineLayout(s.device, &pl, nullptr, &c->layout), "vkCreatePipelineLayout");
+  s.count_object();
+
+  VkShaderModuleCreateInfo sm{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
+  sm.codeSize = bin.size_bytes;
+  sm.pCode = bin.code;
+  VkShaderModule module = VK_NULL_HANDLE;
+  vk_check(vkCreateShaderModule(s.device, &sm, nullptr, &module), "vkCreateShaderModule");
+
+  std::vector<uint32_t> values = {desc.workgroup.x, desc.workgroup.y};
+  values.insert(values.end(), desc.specialization.begin(), desc.specialization.end());
+  std::vector<VkSpecializationMapEntry> entries(values.size());
+  for (uint32_t i = 0; i < values.size(); ++i) entries[i] = {i, i * 4u, 4u};
+  VkSpecializationInfo spec{static_cast<uint32_t>(entries.size()), entries.data(), values.size() * 4, values.data()};
+
+  VkComputePipelineCreateInfo cp{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
+  cp.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
+  cp.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+  cp.stage.module = module;
+  cp.stage.pName = "main";
+  cp.stage.pSpecializationInfo = &spec;
+  cp.layout = c->layout;
+  const VkResult r = vkCreateComputePipelines(s.device, VK_NULL_HANDLE, 1, &cp, nullptr, &c->pipeline);
+  vkDestroyShaderModule(s.device, module, nullptr);
+  vk_check(r, "vkCreateComputePipelines");
+  s.count_object();
+  return c;
+}
+
+}  // namespace
+
 ComputePipeline::ComputePipeline(const Context& context, const PipelineDesc& desc) {
-  device_ = context.device();
   id_ = desc.kernel_id;
   push_bytes_ = desc.push_constant_bytes;
   workgroup_ = desc.workgroup;
   bindings_ = desc.bindings;
-  auto& s = context.state();
   const KernelBinary* bin = find_kernel(desc.kernel_id.c_str());
   if (!bin)
     throw Error(ErrorCode::vulkan_failure, concat("kernel '", desc.kernel_id, "' is not embedded in this build"));
-
-  VkShaderModule module = VK_NULL_HANDLE;
-  try {
-    std::vector<VkDescriptorSetLayoutBinding> b(desc.bindings.size());
-    for (uint32_t i = 0; i < b.size(); ++i) {
-      b[i] = {i, desc.bindings[i], 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
-    }
-    VkDescriptorSetLayoutCreateInfo sl{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
-    sl.bindingCount = static_cast<uint32_t>(b.size());
-    sl.pBindings = b.data();
-    vk_check(vkCreateDescriptorSetLayout(device_, &sl, nullptr, &set_layout_), "vkCreateDescriptorSetLayout");
-    s.count_object();
-
-    VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, desc.push_constant_bytes};
-    VkPipelineLayoutCreateInfo pl{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
-    pl.setLayoutCount = 1;
-    pl.pSetLayouts = &set_layout_;
-    pl.pushConstantRangeCount = desc.push_constant_bytes ? 1 : 0;
-    pl.pPushConstantRanges = &range;
-    vk_check(vkCreatePipelineLayout(device_, &pl, nullptr, &layout_), "vkCreatePipelineLayout");
-    s.count_object();
-
-    VkShaderModuleCreateInfo sm{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
-    sm.codeSize = bin->size_bytes;
-    sm.pCode = bin->code;
-    vk_check(vkCreateShaderModule(device_, &sm, nullptr, &module), "vkCreateShaderModule");
-
-    std::vector<uint32_t> values = {desc.workgroup.x, desc.workgroup.y};
-    values.insert(values.end(), desc.specialization.begin(), desc.specialization.end());
-    std::vector<VkSpecializationMapEntry> entries(values.size());
-    for (uint32_t i = 0; i < values.size(); ++i) entries[i] = {i, i * 4u, 4u};
-    VkSpecializationInfo spec{static_cast<uint32_t>(entries.size()), entries.data(), values.size() * 4, values.data()};
-
-    VkComputePipelineCreateInfo cp{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
-    cp.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
-    cp.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
-    cp.stage.module = module;
-    cp.stage.pName = "main";
-    cp.stage.pSpecializationInfo = &spec;
-    cp.layout = layout_;
-    vk_check(vkCreateComputePipelines(device_, VK_NULL_HANDLE, 1, &cp, nullptr, &pipeline_),
-             "vkCreateComputePipelines");
-    s.count_object();
-    vkDestroyShaderModule(device_, module, nullptr);
-  } catch (...) {
-    if (module) vkDestroyShaderModule(device_, module, nullptr);
-    reset();
-    throw;
-  }
+  // Everything that makes the compiled objects differ is in the key.
+  std::string key = concat("pipeline|", desc.kernel_id, "|", desc.workgroup.x, "x", desc.workgroup.y, "|",
+                           desc.push_constant_bytes, "|");
+  for (uint32_t v : desc.specialization) key += concat(v, ",");
+  key += "|";
+  for (VkDescriptorType t : desc.bindings) key += concat(static_cast<int>(t), ",");
+  auto& s = context.state();
+  compiled_ = &s.cached<CompiledPipeline>(key, [&] { return compile(s, desc, *bin); });
 }
 
 ComputePipeline& ComputePipeline::operator=(ComputePipeline&& o) noexcept {
   if (this != &o) {
-    reset();
-    device_ = std::exchange(o.device_, VK_NULL_HANDLE);
+    compiled_ = std::exchange(o.compiled_, nullptr);
     id_ = std::move(o.id_);
-    set_layout_ = std::exchange(o.set_layout_, VK_NULL_HANDLE);
-    layout_ = std::exchange(o.layout_, VK_NULL_HANDLE);
-    pipeline_ = std::exchange(o.pipeline_, VK_NULL_HANDLE);
     push_bytes_ = o.push_bytes_;
     workgroup_ = o.workgroup_;
     bindings_ = std::move(o.bindings_);
   }
   return *this;
-}
-
-void ComputePipeline::reset() {
-  if (device_) {
-    if (pipeline_) vkDestroyPipeline(device_, pipeline_, nullptr);
-    if (layout_) vkDestroyPipelineLayout(device_, layout_, nullptr);
-    if (set_layout_) vkDestroyDescriptorSetLayout(device_, set_layout_, nullptr);
-  }
-  device_ = VK_NULL_HANDLE;
-  pipeline_ = VK_NULL_HANDLE;
-  layout_ = VK_NULL_HANDLE;
-  set_layout_ = VK_NULL_HANDLE;
 }
 
 void ComputePipeline::bind_and_push(VkCommandBuffer cmd, VkDescriptorSet set, const void* push, uint32_t bytes) const {
@@ -122,9 +121,9 @@ void ComputePipeline::bind_and_push(VkCommandBuffer cmd, VkDescriptorSet set, co
                 concat("kernel ", id_, ": push constants are ", bytes, " bytes, pipeline expects ", push_bytes_));
   }
   count_recorded_command();
-  vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_);
-  vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, layout_, 0, 1, &set, 0, nullptr);
-  if (bytes) vkCmdPushConstants(cmd, layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, bytes, push);
+  vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, compiled_->pipeline);
+  vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, compiled_->layout, 0, 1, &set, 0, nullptr);
+  if (bytes) vkCmdPushConstants(cmd, compiled_->layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, bytes, push);
 }
 
 void ComputePipeline::dispatch_raw(VkCommandBuffer cmd, VkDescriptorSet set, const void* push, uint32_t bytes,

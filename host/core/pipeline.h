@@ -25,6 +25,23 @@ struct PipelineDesc {
   std::vector<uint32_t> specialization;  //!< constant_id 2, 3, ...
 };
 
+/// The Vulkan objects of one compiled kernel variant. Owned by the context (ContextState::cached),
+/// shared by every ComputePipeline of the same PipelineDesc, destroyed with the context.
+struct CompiledPipeline {
+  VkDevice device = VK_NULL_HANDLE;
+  VkDescriptorSetLayout set_layout = VK_NULL_HANDLE;
+  VkPipelineLayout layout = VK_NULL_HANDLE;
+  VkPipeline pipeline = VK_NULL_HANDLE;
+  CompiledPipeline() = default;
+  CompiledPipeline(const CompiledPipeline&) = delete;
+  CompiledPipeline& operator=(const CompiledPipeline&) = delete;
+  ~CompiledPipeline();
+};
+
+/// A kernel variant ready to dispatch. The compiled objects are made once per context and
+/// PipelineDesc and live as long as the context: an effect made again (or a second effect of the
+/// same shape) compiles nothing. lavapipe kept ~2 MB per compile that destroying the pipeline did
+/// not give back, so re-making effects grew the process without bound (tests/api_errors_test.cpp).
 class ComputePipeline {
  public:
   ComputePipeline() = default;
@@ -33,10 +50,10 @@ class ComputePipeline {
   ComputePipeline& operator=(ComputePipeline&& o) noexcept;
   ComputePipeline(const ComputePipeline&) = delete;
   ComputePipeline& operator=(const ComputePipeline&) = delete;
-  ~ComputePipeline() { reset(); }
-  void reset();
+  ~ComputePipeline() = default;
+  void reset() { compiled_ = nullptr; }
 
-  VkDescriptorSetLayout set_layout() const { return set_layout_; }
+  VkDescriptorSetLayout set_layout() const { return compiled_ ? compiled_->set_layout : VK_NULL_HANDLE; }
   const std::vector<VkDescriptorType>& bindings() const { return bindings_; }
 
   /// Binds the pipeline and `set`, pushes `push` and dispatches enough groups to cover
@@ -60,11 +77,8 @@ class ComputePipeline {
   void bind_and_push(VkCommandBuffer cmd, VkDescriptorSet set, const void* push, uint32_t bytes) const;
   void dispatch_raw(VkCommandBuffer cmd, VkDescriptorSet set, const void* push, uint32_t bytes,
                     uint32_t width, uint32_t height) const;
-  VkDevice device_ = VK_NULL_HANDLE;
+  const CompiledPipeline* compiled_ = nullptr;  // owned by the context
   std::string id_;
-  VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
-  VkPipelineLayout layout_ = VK_NULL_HANDLE;
-  VkPipeline pipeline_ = VK_NULL_HANDLE;
   uint32_t push_bytes_ = 0;
   Workgroup2D workgroup_;
   std::vector<VkDescriptorType> bindings_;
