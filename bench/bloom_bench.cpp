@@ -37,6 +37,8 @@ void BM_Bloom(benchmark::State& state) {
   const auto height = static_cast<uint32_t>(state.range(1));
   const auto filter = static_cast<BloomFilter>(state.range(2));
   const auto precision = static_cast<Precision>(state.range(3));
+  const auto guard = static_cast<FireflyGuard>(state.range(4));
+  const auto level0_height = static_cast<uint32_t>(state.range(5));
   const Context& ctx = context();
   const VkFormat format = VK_FORMAT_R16G16B16A16_SFLOAT;
 
@@ -47,6 +49,8 @@ void BM_Bloom(benchmark::State& state) {
   BloomConfig config;
   config.filter = filter;
   config.precision = precision;
+  config.firefly_guard = guard;
+  config.level0_height = level0_height;
   Bloom bloom(ctx, config);
   bloom.prepare({width, height});
   Profiler profiler(ctx, kFramesPerIteration + 1);
@@ -88,18 +92,23 @@ void BM_Bloom(benchmark::State& state) {
   state.counters["median_us"] = median_of(frame_ms) * 1e3;
   state.counters["rel_l2_vs_f64"] = error;
   state.counters["levels"] = bloom.levels();
-  state.SetLabel(std::string(filter_name(filter)) + (precision == Precision::fp16 ? "/fp16" : "/fp32") + " on " +
+  static const char* kGuards[] = {"off", "karis", "karis_smooth"};
+  state.SetLabel(std::string(filter_name(filter)) + (precision == Precision::fp16 ? "/fp16/" : "/fp32/") +
+                 kGuards[state.range(4)] + (level0_height ? "/l0h" + std::to_string(level0_height) : "") + " on " +
                  ctx.info().name);
 }
 
 void bloom_args(benchmark::internal::Benchmark* b) {
+  // Defaults (karis_smooth, level0_height 0) per filter and cod13 with fp32 levels; then cod13 with
+  // the per-box guard and none (what the smooth guard costs), and with level0_height 540.
   for (auto size : {std::pair{640, 480}, std::pair{1920, 1080}, std::pair{3840, 2160}}) {
-    for (int filter = 0; filter < 3; ++filter) {
-      b->Args({size.first, size.second, filter, 0});
-    }
-    b->Args({size.first, size.second, 0, 1});  // cod13 with fp32 intermediates
+    for (int filter = 0; filter < 3; ++filter) b->Args({size.first, size.second, filter, 0, 2, 0});
+    b->Args({size.first, size.second, 0, 1, 2, 0});
+    b->Args({size.first, size.second, 0, 0, 1, 0});
+    b->Args({size.first, size.second, 0, 0, 0, 0});
+    if (size.second >= 1080) b->Args({size.first, size.second, 0, 0, 2, 540});
   }
-  b->ArgNames({"w", "h", "filter", "fp32"});
+  b->ArgNames({"w", "h", "filter", "fp32", "guard", "l0h"});
   b->UseManualTime();
   b->Unit(benchmark::kMicrosecond);
 }

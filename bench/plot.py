@@ -39,6 +39,9 @@ import matplotlib.pyplot as plt  # noqa: E402
 FILTERS = {0: "cod13", 1: "dual", 2: "gauss9"}
 
 
+GUARDS = ["off", "karis", "karis_smooth"]
+
+
 def points(path, size):
     """(label, median_us, rel_l2) for every BM_Bloom median at `size` in a benchmark JSON file."""
     w, h = size.split("x")
@@ -50,6 +53,11 @@ def points(path, size):
         if not m or (m.group(1), m.group(2)) != (w, h) or b.get("rel_l2_vs_f64", -1) < 0:
             continue
         label = FILTERS[int(m.group(3))] + ("/fp32" if m.group(4) == "1" else "/fp16")
+        g = re.search(r"guard:(\d)/l0h:(\d+)", b["name"])  # absent in files from before the guard
+        if g and g.group(1) != "2":
+            label += "/" + GUARDS[int(g.group(1))]
+        if g and g.group(2) != "0":
+            label += "/l0h" + g.group(2)
         out.append((label, b["median_us"], b["rel_l2_vs_f64"]))
     return out
 
