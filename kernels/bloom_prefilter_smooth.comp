@@ -31,6 +31,7 @@ const int kRadius = GLINT_BLOOM_SMOOTH_RADIUS;
 const uint kRawW = kWindowW + 2u * uint(kRadius);
 const uint kRawH = kWindowH + 2u * uint(kRadius);
 const uint kGroupSize = gl_WorkGroupSize.x * gl_WorkGroupSize.y;
+const uint kLoadsPerInvocation = (kRawW * kRawH + kGroupSize - 1u) / kGroupSize;
 const float kBinomial[11] = float[](1.0 / 1024.0, 10.0 / 1024.0, 45.0 / 1024.0, 120.0 / 1024.0,
                                     210.0 / 1024.0, 252.0 / 1024.0, 210.0 / 1024.0, 120.0 / 1024.0,
                                     45.0 / 1024.0, 10.0 / 1024.0, 1.0 / 1024.0);
@@ -51,6 +52,58 @@ vec3 source_texel(ivec2 ij) {
 
 #include "bloom.glsl"
 
+// The exact 2:1 case (both sides even, the common one), as kernels/common/bloom_down_tiled.glsl
+// does it: every bilinear tap of cod13 and dual sits on a corner of four texels, so it is the mean
+// of that 2x2 box; the box means at every corner of the window are formed once, into s_rows (free
+// after the vertical pass), and each invocation reads its 13 (cod13) or 5 (dual) boxes, instead of
+// 13 bilinear taps with their index arithmetic. Texels outside the image read their clamped
+// neighbour, as downsample() does. The window starts at 2 * group origin - 2, as the tiled one.
+const uint kBoxW = 2u * gl_WorkGroupSize.x + 3u;
+const uint kBoxH = 2u * gl_WorkGroupSize.y + 3u;
+
+vec3 window_texel(int i, int j) {
+  ivec2 t = clamp(g_window + ivec2(i, j), ivec2(0), g_src_size - 1) - g_window;
+  return s_window[uint(t.y) * kWindowW + uint(t.x)].rgb;
+}
+
+// Every invocation of the workgroup must call this (it has a barrier).
+vec3 downsample_2to1_from_window() {
+  for (uint i = gl_LocalInvocationIndex; i < kBoxW * kBoxH; i += kGroupSize) {
+    int x = int(i % kBoxW), y = int(i / kBoxW);
+    s_rows[i] = vec4(0.25 * (window_texel(x, y) + window_texel(x + 1, y) + window_texel(x, y + 1) +
+                             window_texel(x + 1, y + 1)), 0.0);
+  }
+  barrier();
+  ivec2 c = ivec2(gl_LocalInvocationID.xy) * 2 + 2;  // output (x, y) sits on window corner 2x + 2
+#define BOX(dx, dy) s_rows[uint(c.y + (dy)) * kBoxW + uint(c.x + (dx))].rgb
+  vec3 sum = vec3(0.0);
+  float wsum = 0.0;
+  if (FILTER == GLINT_BLOOM_GAUSS9) {
+    for (int j = 0; j < 2; ++j)
+      for (int i = 0; i < 2; ++i) add_box(sum, wsum, window_texel(c.x + i, c.y + j), 0.25, true);
+    return sum / wsum;
+  }
+  if (FILTER == GLINT_BLOOM_DUAL) {
+    add_box(sum, wsum, BOX(0, 0), 0.5, true);
+    add_box(sum, wsum, BOX(-1, -1), 0.125, true);
+    add_box(sum, wsum, BOX(1, -1), 0.125, true);
+    add_box(sum, wsum, BOX(-1, 1), 0.125, true);
+    add_box(sum, wsum, BOX(1, 1), 0.125, true);
+    return sum / wsum;
+  }
+  vec3 inner = (BOX(-1, -1) + BOX(1, -1) + BOX(-1, 1) + BOX(1, 1)) * 0.25;
+  vec3 g00 = BOX(-2, -2), g10 = BOX(0, -2), g20 = BOX(2, -2);
+  vec3 g01 = BOX(-2, 0), g11 = BOX(0, 0), g21 = BOX(2, 0);
+  vec3 g02 = BOX(-2, 2), g12 = BOX(0, 2), g22 = BOX(2, 2);
+#undef BOX
+  add_box(sum, wsum, inner, 0.5, true);
+  add_box(sum, wsum, (g00 + g10 + g01 + g11) * 0.25, 0.125, true);
+  add_box(sum, wsum, (g10 + g20 + g11 + g21) * 0.25, 0.125, true);
+  add_box(sum, wsum, (g01 + g11 + g02 + g12) * 0.25, 0.125, true);
+  add_box(sum, wsum, (g11 + g21 + g12 + g22) * 0.25, 0.125, true);
+  return sum / wsum;
+}
+
 vec3 bright_texel(ivec2 ij) {
   ij = clamp(ij, ivec2(0), g_src_size - 1);
   return soft_threshold(sanitize(texelFetch(scene, ij, 0).rgb), p.threshold, p.knee);
@@ -64,8 +117,16 @@ void main() {
   g_window = ivec2(floor(map_position(group_origin, dst_size, g_src_size))) - 2;
   ivec2 raw_origin = g_window - kRadius;
 
-  for (uint i = gl_LocalInvocationIndex; i < kRawW * kRawH; i += kGroupSize)
-    s_window[i] = vec4(bright_texel(raw_origin + ivec2(i % kRawW, i / kRawW)), 0.0);
+  // Every fetch is issued before the first shared store, so their latencies overlap.
+  vec3 fetched[kLoadsPerInvocation];
+  [[unroll]] for (uint n = 0u; n < kLoadsPerInvocation; ++n) {
+    uint i = min(gl_LocalInvocationIndex + n * kGroupSize, kRawW * kRawH - 1u);
+    fetched[n] = bright_texel(raw_origin + ivec2(i % kRawW, i / kRawW));
+  }
+  [[unroll]] for (uint n = 0u; n < kLoadsPerInvocation; ++n) {
+    uint i = gl_LocalInvocationIndex + n * kGroupSize;
+    if (i < kRawW * kRawH) s_window[i] = vec4(fetched[n], 0.0);
+  }
   barrier();
   // P(t) = sum_m C(10, m) / 1024 * B(clamp(t + m - 5)) per axis. Entries of texels outside the
   // image are computed too but never read (source_texel gets clamped indices). Each invocation
@@ -100,7 +161,13 @@ void main() {
   }
   barrier();
 
+  vec3 c;
+  if (g_src_size == 2 * dst_size) {
+    c = downsample_2to1_from_window();  // uniform branch; has a barrier
+  } else {
+    if (any(greaterThanEqual(xy, dst_size))) return;
+    c = downsample(xy, dst_size, true);
+  }
   if (any(greaterThanEqual(xy, dst_size))) return;
-  vec3 c = downsample(xy, dst_size, true);
   imageStore(level0, xy, vec4(min(c, vec3(p.max_brightness)), 1.0));
 }
