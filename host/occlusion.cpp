@@ -390,8 +390,11 @@ LightCuller::LightCuller(const Context& context, const LightCullConfig& config) 
   VkPhysicalDeviceProperties props;
   vkGetPhysicalDeviceProperties(context.physical_device(), &props);
   m.max_groups_x = props.limits.maxComputeWorkGroupCount[0];
-  m.scan_threads = std::min({GLINT_CULL_SCAN_MAX_THREADS, props.limits.maxComputeWorkGroupInvocations,
-                             props.limits.maxComputeWorkGroupSize[0]});
+  // CPU devices (lavapipe) run a workgroup's invocations a few at a time and pay for every barrier
+  // per invocation: 64 there, where longer serial runs of masks per invocation cost little.
+  const uint32_t scan_cap = context.info().type == VK_PHYSICAL_DEVICE_TYPE_CPU ? 64u : GLINT_CULL_SCAN_MAX_THREADS;
+  m.scan_threads =
+      std::min({scan_cap, props.limits.maxComputeWorkGroupInvocations, props.limits.maxComputeWorkGroupSize[0]});
   const auto S = VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE;
   const auto B = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
   detail::PipelineDesc d;
