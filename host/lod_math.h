@@ -4,7 +4,9 @@
 #pragma once
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 
 #include "lod.h"
 
@@ -17,6 +19,7 @@ inline float floor(float x) { return std::floor(x); }
 inline float min(float a, float b) { return std::min(a, b); }
 inline float max(float a, float b) { return std::max(a, b); }
 inline float clamp(float x, float lo, float hi) { return std::min(std::max(x, lo), hi); }
+inline uint32_t floatBitsToUint(float x) { return std::bit_cast<uint32_t>(x); }
 
 #define GLINT_LOD_FN inline
 #include "lod_impl.h"

@@ -29,7 +29,8 @@ static_assert(sizeof(GlintCullPush) == 112);
 static_assert(offsetof(GlintCullPush, width) == 64);
 static_assert(offsetof(GlintCullPush, flags) == 88);
 static_assert(offsetof(GlintCullPush, depth_bias) == 96);
-static_assert(sizeof(GlintCullFinalizePush) == 16);
+static_assert(sizeof(GlintCullCompactPush) == 32);
+static_assert(offsetof(GlintCullCompactPush, flags) == 16);
 static_assert(sizeof(LightCullFrame::view_proj) == sizeof(GlintCullPush::view_proj));
 
 namespace {
@@ -38,7 +39,8 @@ constexpr VkPipelineStageFlags2 kCompute = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BI
 constexpr VkAccessFlags2 kSampled = VK_ACCESS_2_SHADER_SAMPLED_READ_BIT;
 constexpr VkAccessFlags2 kStorageRead = VK_ACCESS_2_SHADER_STORAGE_READ_BIT;
 constexpr VkAccessFlags2 kStorageWrite = VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT;
-constexpr uint32_t kCullGroup = 64;      // lights per workgroup
+constexpr uint32_t kCullGroup = GLINT_CULL_GROUP;  // lights per workgroup: one 64-bit visibility mask
+static_assert(kCullGroup == 64, "light_cull.comp keeps a workgroup's visibility in two 32-bit words");
 constexpr uint32_t kMaxGroupsX = 65535;  // guaranteed maxComputeWorkGroupCount[0]
 
 uint32_t floor_log2(uint32_t v) {
@@ -341,24 +343,32 @@ void LightCullConfig::validate() const {
 struct LightCuller::Impl {
   const Context* context = nullptr;
   LightCullConfig config;
-  CompactionPath path = CompactionPath::shared;
   uint32_t max_groups_x = kMaxGroupsX;
-  detail::ComputePipeline cull, finalize;
-  detail::OwnedBuffer counters;
-  Buffer counter_state;
+  uint32_t scan_threads = 1;  // the scan's single workgroup
+  // The three dispatches of a cull (docs/OCCLUSION.md): cull + grid test, scan, scatter.
+  detail::ComputePipeline cull, scan, scatter;
+  // Header counters and one uvec4 per workgroup (occlusion.h), and one vec4 record per light.
+  detail::OwnedBuffer groups, records;
+  Buffer groups_state, records_state;
   bool counters_cleared = false;
   // Descriptor sets per distinct set of caller resources, made on first use and kept.
-  std::map<std::vector<uint64_t>, VkDescriptorSet> sets;
+  struct Sets {
+    VkDescriptorSet cull = VK_NULL_HANDLE, scan = VK_NULL_HANDLE, scatter = VK_NULL_HANDLE;
+  };
+  std::map<std::vector<uint64_t>, Sets> sets;
   std::vector<detail::DescriptorArena> arenas;
   uint32_t sets_left = 0;
   detail::OwnedBuffer dummy_results;  // bound when the caller wants no per-light results
   Buffer dummy_state;
 
+  // Sets come from arenas of 16; each arena's pool is sized for 32 (4 descriptors of each type
+  // per set there), so the scatter's 5 storage buffers fit whatever the mix of sets.
   VkDescriptorSet allocate(const detail::ComputePipeline& p,
                            const std::vector<detail::DescriptorArena::AnyBinding>& b) {
+    constexpr uint32_t kSetsPerArena = 16;
     if (sets_left == 0) {
-      arenas.emplace_back(*context, 16);
-      sets_left = 16;
+      arenas.emplace_back(*context, 2 * kSetsPerArena);
+      sets_left = kSetsPerArena;
     }
     --sets_left;
     return arenas.back().make_mixed_set(p, b);
@@ -376,38 +386,42 @@ LightCuller::LightCuller(const Context& context, const LightCullConfig& config) 
   Impl& m = *impl_;
   m.context = &context;
   m.config = config;
-  // Subgroup ballot in compute, and the group limit, from the device (STYLE rules 3 and 15).
-  VkPhysicalDeviceSubgroupProperties sub{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES};
-  VkPhysicalDeviceProperties2 props{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
-  props.pNext = &sub;
-  vkGetPhysicalDeviceProperties2(context.physical_device(), &props);
-  m.max_groups_x = props.properties.limits.maxComputeWorkGroupCount[0];
-  const bool ballot = (sub.supportedStages & VK_SHADER_STAGE_COMPUTE_BIT) &&
-                      (sub.supportedOperations & VK_SUBGROUP_FEATURE_BALLOT_BIT) &&
-                      (sub.supportedOperations & VK_SUBGROUP_FEATURE_BASIC_BIT);
-  if (config.path == CompactionPath::ballot && !ballot) {
-    throw Error(ErrorCode::no_device, concat("LightCullConfig::path = ballot, but device '", context.info().name,
-                                             "' lacks subgroup ballot in compute shaders; use automatic or shared"));
-  }
-  m.path = config.path == CompactionPath::automatic ? (ballot ? CompactionPath::ballot : CompactionPath::shared)
-                                                    : config.path;
+  // The group limit and the scan's workgroup size from the device (STYLE rule 3).
+  VkPhysicalDeviceProperties props;
+  vkGetPhysicalDeviceProperties(context.physical_device(), &props);
+  m.max_groups_x = props.limits.maxComputeWorkGroupCount[0];
+  // CPU devices (lavapipe) run a workgroup's invocations a few at a time and pay for every barrier
+  // per invocation: 64 there, where longer serial runs of masks per invocation cost little.
+  const uint32_t scan_cap = context.info().type == VK_PHYSICAL_DEVICE_TYPE_CPU ? 64u : GLINT_CULL_SCAN_MAX_THREADS;
+  m.scan_threads =
+      std::min({scan_cap, props.limits.maxComputeWorkGroupInvocations, props.limits.maxComputeWorkGroupSize[0]});
   const auto S = VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE;
   const auto B = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
   detail::PipelineDesc d;
-  d.kernel_id = m.path == CompactionPath::ballot ? "light_cull_ballot" : "light_cull_shared";
+  d.kernel_id = "light_cull_main";
   d.bindings = {S, S, B, B, B, B};
   d.push_constant_bytes = sizeof(GlintCullPush);
   d.workgroup = {kCullGroup, 1};
   m.cull = detail::ComputePipeline(context, d);
-  detail::PipelineDesc f;
-  f.kernel_id = "light_cull_finalize_main";
-  f.bindings = {B, B, B};
-  f.push_constant_bytes = sizeof(GlintCullFinalizePush);
-  f.workgroup = {1, 1};
-  m.finalize = detail::ComputePipeline(context, f);
+  detail::PipelineDesc sc;
+  sc.kernel_id = "light_cull_scan_main";
+  sc.bindings = {B, B, B};
+  sc.push_constant_bytes = sizeof(GlintCullCompactPush);
+  sc.workgroup = {m.scan_threads, 1};
+  m.scan = detail::ComputePipeline(context, sc);
+  detail::PipelineDesc sp;
+  sp.kernel_id = "light_cull_scatter_main";
+  sp.bindings = {B, B, B, B, B};
+  sp.push_constant_bytes = sizeof(GlintCullCompactPush);
+  sp.workgroup = {kCullGroup, 1};
+  m.scatter = detail::ComputePipeline(context, sp);
   const VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
-  m.counters = detail::OwnedBuffer(context, GLINT_CULL_COUNTER_WORDS * 4, usage, false);
-  m.counter_state = view_of(m.counters, usage);
+  const VkDeviceSize group_count = (VkDeviceSize(config.max_lights) + kCullGroup - 1) / kCullGroup;
+  m.groups = detail::OwnedBuffer(context, GLINT_CULL_HEADER_WORDS * 4 + group_count * 16, usage, false);
+  m.groups_state = view_of(m.groups, usage);
+  m.records =
+      detail::OwnedBuffer(context, VkDeviceSize(config.max_lights) * 16, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, false);
+  m.records_state = view_of(m.records, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
   m.dummy_results =
       detail::OwnedBuffer(context, sizeof(GlintFlareLightResult), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, false);
   m.dummy_state = view_of(m.dummy_results, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
@@ -418,7 +432,7 @@ LightCuller& LightCuller::operator=(LightCuller&&) noexcept = default;
 LightCuller::~LightCuller() = default;
 
 const LightCullConfig& LightCuller::config() const { return impl_->config; }
-CompactionPath LightCuller::path() const { return impl_->path; }
+CompactionPath LightCuller::path() const { return CompactionPath::shared; }
 
 void LightCuller::record(VkCommandBuffer cmd, HiZPyramid& hiz, Image& depth, Buffer& lights, uint32_t count,
                          const LightCullFrame& frame, LightCullOutputs& out, Profiler* profiler) {
@@ -472,43 +486,49 @@ void LightCuller::record(VkCommandBuffer cmd, HiZPyramid& hiz, Image& depth, Buf
   Impl::key_add(key, results);
   Impl::key_add(key, out.indirect);
   Impl::key_add(key, out.stats);
-  VkDescriptorSet cull_set, finalize_set;
-  {
-    auto key_f = key;
-    key_f.push_back(1);
-    auto it = m.sets.find(key);
-    if (it == m.sets.end()) {
-      std::vector<detail::DescriptorArena::AnyBinding> b(6);
-      b[0].image = {depth.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
-      b[1].image = {hiz.image().view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
-      b[2].buffer = lights;
-      b[3].buffer = out.instances;
-      b[4].buffer = results;
-      b[5].buffer = m.counter_state;
-      it = m.sets.emplace(key, m.allocate(m.cull, b)).first;
-      std::vector<detail::DescriptorArena::AnyBinding> f(3);
-      f[0].buffer = m.counter_state;
-      f[1].buffer = out.indirect;
-      f[2].buffer = out.stats;
-      m.sets.emplace(key_f, m.allocate(m.finalize, f));
-    }
-    cull_set = it->second;
-    finalize_set = m.sets.at(key_f);
+  auto it = m.sets.find(key);
+  if (it == m.sets.end()) {
+    Impl::Sets s;
+    std::vector<detail::DescriptorArena::AnyBinding> c(6);
+    c[0].image = {depth.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+    c[1].image = {hiz.image().view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+    c[2].buffer = lights;
+    c[3].buffer = m.records_state;
+    c[4].buffer = results;
+    c[5].buffer = m.groups_state;
+    s.cull = m.allocate(m.cull, c);
+    std::vector<detail::DescriptorArena::AnyBinding> n(3);
+    n[0].buffer = m.groups_state;
+    n[1].buffer = out.indirect;
+    n[2].buffer = out.stats;
+    s.scan = m.allocate(m.scan, n);
+    std::vector<detail::DescriptorArena::AnyBinding> p(5);
+    p[0].buffer = lights;
+    p[1].buffer = m.records_state;
+    p[2].buffer = m.groups_state;
+    p[3].buffer = out.instances;
+    p[4].buffer = results;
+    s.scatter = m.allocate(m.scatter, p);
+    it = m.sets.emplace(key, s).first;
   }
+  const Impl::Sets sets = it->second;
 
   detail::Barriers b;
-  if (!m.counters_cleared) {  // once per object: the finalize kernel resets them every frame
-    b.use(m.counter_state, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);  // fill = "transfer"
+  if (!m.counters_cleared) {  // once per object: the scan kernel resets them every frame
+    b.use(m.groups_state, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);  // fill = "transfer"
     b.flush(cmd);
-    vkCmdFillBuffer(cmd, m.counters.buffer(), 0, VK_WHOLE_SIZE, 0);
+    vkCmdFillBuffer(cmd, m.groups.buffer(), 0, GLINT_CULL_HEADER_WORDS * 4, 0);
     m.counters_cleared = true;
   }
+  const uint32_t flags = want_results ? GLINT_CULL_WRITE_RESULTS : 0u;
+  // 1. Cull + grid test: visibility masks and records, the other lights' results, the counters.
   b.use(depth, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, kCompute, kSampled);
   b.use(hiz.image(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, kCompute, kSampled, std::max(1u, hiz.levels()));
   b.use(lights, kCompute, kStorageRead);
-  b.use(out.instances, kCompute, kStorageWrite);
+  b.use(m.records_state, kCompute, kStorageWrite);
   b.use(results, kCompute, kStorageWrite);
-  b.use(m.counter_state, kCompute, kStorageRead | kStorageWrite);
+  b.use(m.groups_state, kCompute, kStorageRead | kStorageWrite);
+  b.use(out.instances, kCompute, kStorageWrite);  // written by the scatter; here after the last frame's reads
   b.flush(cmd);
   if (count > 0) {
     GlintCullPush push{};
@@ -516,24 +536,37 @@ void LightCuller::record(VkCommandBuffer cmd, HiZPyramid& hiz, Image& depth, Buf
     push.width = static_cast<int32_t>(hc.extent.width);
     push.height = static_cast<int32_t>(hc.extent.height);
     push.count = count;
-    push.capacity = m.config.capacity;
     push.grid = m.config.grid;
     push.levels = hiz.levels();
-    push.flags = (hc.reversed_z ? GLINT_CULL_REVERSED_Z : 0u) | (want_results ? GLINT_CULL_WRITE_RESULTS : 0u) |
+    push.flags = (hc.reversed_z ? GLINT_CULL_REVERSED_Z : 0u) | flags |
                  (m.config.pattern == OcclusionPattern::regular ? GLINT_CULL_REGULAR_GRID : 0u);
     push.margin_ndc = m.config.margin_ndc;
     push.depth_bias = m.config.depth_bias;
-    m.cull.dispatch(cmd, cull_set, push, count, 1);
+    m.cull.dispatch(cmd, sets.cull, push, count, 1);
   }
   if (profiler) profiler->mark(cmd, "light cull");
-  // The cull's atomics (a write) finish before the finalize reads and resets the counters.
-  b.use(m.counter_state, kCompute, kStorageRead | kStorageWrite);
+  // 2. Scan: the masks (and the counters' atomics) are complete; first slots, arguments, stats.
+  GlintCullCompactPush cp{};
+  cp.count = count;
+  cp.capacity = m.config.capacity;
+  cp.vertex_count = frame.vertex_count;
+  cp.groups_per_instance = frame.groups_per_instance;
+  cp.flags = flags;
+  b.use(m.groups_state, kCompute, kStorageRead | kStorageWrite);
   b.use(out.indirect, kCompute, kStorageWrite);
   b.use(out.stats, kCompute, kStorageWrite);
   b.flush(cmd);
-  GlintCullFinalizePush fp{count, m.config.capacity, frame.vertex_count, frame.groups_per_instance};
-  m.finalize.dispatch(cmd, finalize_set, fp, 1, 1);
-  if (profiler) profiler->mark(cmd, "cull finalize");
+  m.scan.dispatch(cmd, sets.scan, cp, m.scan_threads, 1);
+  if (profiler) profiler->mark(cmd, "cull scan");
+  // 3. Scatter: instances in light order, the visible lights' results.
+  if (count > 0) {
+    b.use(m.records_state, kCompute, kStorageRead);
+    b.use(m.groups_state, kCompute, kStorageRead);
+    b.use(results, kCompute, kStorageWrite);
+    b.flush(cmd);
+    m.scatter.dispatch(cmd, sets.scatter, cp, count, 1);
+  }
+  if (profiler) profiler->mark(cmd, "cull scatter");
 }
 
 void HiZPyramid::forget_caller_resources() { impl_->sets.clear(); }

@@ -6,8 +6,10 @@
 // its column's pixels in registers), no atomics on the image or on any global buffer.
 // 1. Binning: invocation t takes instance base + t (the count is group_count_x of the indirect
 //    arguments, read here, over groups_per_instance() = 1; indices past the buffer are skipped) and
-//    appends each of its sprites whose conservative rectangle (glint_flare_bounds) meets the tile
-//    to a shared list.
+//    lists each of its sprites whose conservative rectangle (glint_flare_bounds) meets the tile in
+//    a shared list, at a position given by an exclusive prefix sum of the invocations' hit counts
+//    (Hillis & Steele 1986, in shared memory): the list is in (instance, slot) order, the order the
+//    raster path draws in, on every run (issue 6: no atomic decides the order of the sums).
 // 2. Sprites: the list is turned into GlintFlareSprite (glint_flare_sprite, the function flare.vert
 //    evaluates) in chunks of one per invocation, kept in shared memory.
 // 3. Shading: every invocation adds glint_flare_shade (the function flare.frag evaluates) of every
@@ -30,7 +32,7 @@ layout(binding = 3, DST_FORMAT) uniform image2D color;
 layout(push_constant) uniform Push { GlintFlarePush pc; };
 
 const uint kMaxThreads = GLINT_FLARE_GATHER_MAX_THREADS;
-shared uint s_list_count;
+shared uint s_scan[2][kMaxThreads];                     // hit counts, then their prefix sums
 shared uint s_list[kMaxThreads * GLINT_FLARE_SPRITES];  // instance * 16 + slot
 shared vec4 s_rect[kMaxThreads];                        // lo.xy, size.xy of the listed sprites
 shared vec4 s_rgb_lod[kMaxThreads];
@@ -51,21 +53,34 @@ void main() {
   [[unroll]] for (uint r = 0u; r < GLINT_FLARE_GATHER_ROWS; ++r) sum[r] = vec3(0.0);
 
   for (uint base = 0u; base < count; base += threads) {
-    if (t == 0u) s_list_count = 0u;
-    barrier();
     // 1. Binning: every sprite of one instance against the tile.
     uint i = base + t;
+    uint hits = 0u;  // bit `slot`: that sprite meets the tile
     if (i < count) {
       GlintFlareInstance inst = instances[i];
       for (uint slot = 0u; slot < GLINT_FLARE_SPRITES; ++slot) {
         vec4 b = glint_flare_bounds(inst, slot, pc);
-        if (b.x < tile_hi.x && b.z > tile_lo.x && b.y < tile_hi.y && b.w > tile_lo.y) {
-          s_list[atomicAdd(s_list_count, 1u)] = i * 16u + slot;
-        }
+        if (b.x < tile_hi.x && b.z > tile_lo.x && b.y < tile_hi.y && b.w > tile_lo.y) hits |= 1u << slot;
       }
     }
+    // Inclusive scan of the hit counts (the previous batch's last barrier ended its reads).
+    const uint own = uint(bitCount(hits));
+    s_scan[0][t] = own;
     barrier();
-    const uint listed = s_list_count;  // the same in every invocation
+    uint src = 0u;
+    for (uint d = 1u; d < threads; d <<= 1u) {
+      uint v = s_scan[src][t];
+      if (t >= d) v += s_scan[src][t - d];
+      s_scan[src ^ 1u][t] = v;
+      barrier();
+      src ^= 1u;
+    }
+    const uint listed = s_scan[src][threads - 1u];  // the same in every invocation
+    for (uint at = s_scan[src][t] - own; hits != 0u; ++at) {
+      uint slot = uint(findLSB(hits));
+      hits &= hits - 1u;
+      s_list[at] = i * 16u + slot;
+    }
     for (uint e0 = 0u; e0 < listed; e0 += threads) {
       barrier();  // the previous chunk's sprites have been shaded (and every invocation read `listed`)
       // 2. Sprites: one per invocation.

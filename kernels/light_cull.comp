@@ -1,14 +1,12 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_samplerless_texture_functions : require
-#ifdef GLINT_CULL_BALLOT
-#extension GL_KHR_shader_subgroup_basic : require
-#extension GL_KHR_shader_subgroup_ballot : require
-#endif
-// Cull, occlusion grid test and compaction of the lens-flare lights in one dispatch (issue 5; seed
-// 004 "Method 4", grid test on the Hi-Z of "Method 3"). One invocation per light:
-// 1. project (Vulkan conventions); reject disabled lights, w <= 0, depth outside [0, 1] and
-//    |ndc.xy| > margin;
+// Cull and occlusion grid test of the lens-flare lights (issue 5; seed 004 "Method 4", grid test on
+// the Hi-Z of "Method 3"), the first of the three dispatches of the order-preserving compaction
+// (issue 6). One invocation per light, GLINT_CULL_GROUP per workgroup:
+// 1. reject disabled lights and lights with a non-finite float field (GLINT_FLARE_DISABLED), then
+//    project (Vulkan conventions) and reject w <= 0, non-finite clip coordinates, depth outside
+//    [0, 1] and |ndc.xy| > margin (GLINT_FLARE_FRUSTUM);
 // 2. grid test: the light's size_px square is cut into N x N cells, each holding one
 //    multi-jittered sample (Chiu, Shirley & Wang 1994: distinct x and y sub-positions over all
 //    N^2 samples, so an occluder edge sliding across the light flips one sample at a time). A
@@ -18,11 +16,14 @@
 //    footprints cover the light, so the test is conservative (docs/OCCLUSION.md proves it and
 //    derives the error and step bounds). Pixels off screen read the nearest edge pixel.
 //    visible_fraction = visible samples / N^2;
-// 3. compaction: visible lights are appended to the instance buffer, with one atomic per subgroup
-//    (ballot + exclusive bit count, Wihlidal GDC 2016) or, without subgroup ballot, one per
-//    workgroup (shared-memory counter). Slots at or beyond the capacity are never written.
-// Counters are reset by light_cull_finalize.comp, a separate dispatch (no in-shader reset race,
-// SaschaWillems/Vulkan #748).
+// 3. a visible light sets its bit in the workgroup's visibility mask (a shared atomicOr, whose
+//    result does not depend on the order of the calls) and stores its pixel centre, fraction and
+//    depth in the record buffer; the mask goes to the group buffer. light_cull_scan.comp turns the
+//    masks into instance slots by a prefix sum, light_cull_scatter.comp writes the instances, so
+//    instance order is light order on every run (no atomic decides a slot).
+// The frustum, occluded and disabled counts are summed in shared memory and added to the group
+// buffer's header with one atomic each per workgroup (integer sums: order-independent). The scan
+// resets them, in a separate dispatch (no in-shader reset race, SaschaWillems/Vulkan #748).
 layout(local_size_x_id = 0, local_size_y_id = 1) in;
 
 #include "flare_types.h"
@@ -31,18 +32,28 @@ layout(local_size_x_id = 0, local_size_y_id = 1) in;
 layout(binding = 0) uniform texture2D depth_tex;  // level 0
 layout(binding = 1) uniform texture2D hiz_tex;    // mip m = Hi-Z level m + 1
 layout(std430, binding = 2) readonly buffer Lights { GlintFlareLight lights[]; };
-layout(std430, binding = 3) writeonly buffer Instances { GlintFlareInstance instances[]; };
+layout(std430, binding = 3) writeonly buffer Records { vec4 records[]; };  // centre.xy, fraction, ndc z
 layout(std430, binding = 4) writeonly buffer Results { GlintFlareLightResult results[]; };
-layout(std430, binding = 5) buffer Counters { uint counters[]; };
+layout(std430, binding = 5) buffer Groups {
+  uint counters[GLINT_CULL_HEADER_WORDS];
+  uvec4 groups[];  // visibility mask (x, y), first slot (z, the scan's), 0
+};
 layout(push_constant) uniform Push { GlintCullPush pc; };
 
 shared uint group_frustum;
 shared uint group_occluded;
 shared uint group_disabled;
-#ifndef GLINT_CULL_BALLOT
-shared uint group_visible;
-shared uint group_base;
-#endif
+shared uint group_mask[2];
+
+// Not NaN, not +-Inf, tested on the bits: a compiler that assumes floats are finite may fold
+// x == x, or invert a comparison so that NaN passes it (docs/OCCLUSION.md, "Non-finite input").
+bool cull_finite(float x) { return (floatBitsToUint(x) & 0x7f800000u) != 0x7f800000u; }
+
+bool light_finite(GlintFlareLight l) {
+  return cull_finite(l.position_x) && cull_finite(l.position_y) && cull_finite(l.position_z) &&
+         cull_finite(l.intensity) && cull_finite(l.color_r) && cull_finite(l.color_g) && cull_finite(l.color_b) &&
+         cull_finite(l.size_px);
+}
 
 float fetch_level(int k, ivec2 t) {
   return k == 0 ? texelFetch(depth_tex, t, 0).r : texelFetch(hiz_tex, t, k - 1).r;
@@ -108,37 +119,37 @@ float grid_test(vec2 center, float size, float z) {
 }
 
 void main() {
-  const uint lid = gl_LocalInvocationIndex;
+  const uint lid = gl_LocalInvocationIndex;  // < GLINT_CULL_GROUP: the bit of this light in the mask
   if (lid == 0u) {
     group_frustum = 0u;
     group_occluded = 0u;
     group_disabled = 0u;
-#ifndef GLINT_CULL_BALLOT
-    group_visible = 0u;
-#endif
+    group_mask[0] = 0u;
+    group_mask[1] = 0u;
   }
   barrier();
 
-  // Every invocation runs to the end (subgroup operations and barriers below need them all).
+  // Every invocation runs to the barrier below.
   const uint i = gl_GlobalInvocationID.x;
   const bool in_range = i < pc.count;
   uint state = GLINT_FLARE_DISABLED;
   float fraction = 0.0;
   vec2 center = vec2(0.0);
   float ndc_z = 0.0;
-  GlintFlareLight light;
   if (in_range) {
-    light = lights[i];
-    if (light.enabled != 0u) {
+    const GlintFlareLight light = lights[i];
+    if (light.enabled != 0u && light_finite(light)) {
       const vec4 p = vec4(light.position_x, light.position_y, light.position_z, 1.0);
       const float m[16] = pc.view_proj;
       const vec4 clip = vec4(m[0] * p.x + m[4] * p.y + m[8] * p.z + m[12], m[1] * p.x + m[5] * p.y + m[9] * p.z + m[13],
                              m[2] * p.x + m[6] * p.y + m[10] * p.z + m[14], m[3] * p.x + m[7] * p.y + m[11] * p.z + m[15]);
       state = GLINT_FLARE_FRUSTUM;
-      if (clip.w > 0.0) {
+      // Overflowing clip coordinates (positions near the float range) are culled on the bits too.
+      const bool clip_finite = cull_finite(clip.x) && cull_finite(clip.y) && cull_finite(clip.z) && cull_finite(clip.w);
+      if (clip_finite && clip.w > 0.0) {
         const vec3 ndc = clip.xyz / clip.w;
-        // Written so that NaN fails every test.
-        if (abs(ndc.x) <= pc.margin_ndc && abs(ndc.y) <= pc.margin_ndc && ndc.z >= 0.0 && ndc.z <= 1.0) {
+        if (cull_finite(ndc.x) && cull_finite(ndc.y) && cull_finite(ndc.z) && abs(ndc.x) <= pc.margin_ndc &&
+            abs(ndc.y) <= pc.margin_ndc && ndc.z >= 0.0 && ndc.z <= 1.0) {
           center = (ndc.xy * 0.5 + 0.5) * vec2(pc.width, pc.height);
           ndc_z = ndc.z;
           const float size = light.size_px >= 1.0 ? min(light.size_px, GLINT_CULL_MAX_SIZE_PX) : 1.0;
@@ -150,58 +161,24 @@ void main() {
   }
   const bool visible = in_range && state == GLINT_FLARE_VISIBLE;
 
-  // Compaction: a slot for every visible light.
-#ifdef GLINT_CULL_BALLOT
-  const uvec4 ballot = subgroupBallot(visible);
-  const uint subgroup_count = subgroupBallotBitCount(ballot);
-  uint base = 0u;
-  if (subgroupElect() && subgroup_count > 0u) base = atomicAdd(counters[GLINT_CULL_COUNTER_VISIBLE], subgroup_count);
-  base = subgroupBroadcastFirst(base);
-  const uint slot = base + subgroupBallotExclusiveBitCount(ballot);
-#else
-  const uint local_slot = visible ? atomicAdd(group_visible, 1u) : 0u;
-#endif
+  if (visible) {
+    atomicOr(group_mask[lid >> 5u], 1u << (lid & 31u));
+    records[i] = vec4(center, fraction, ndc_z);
+  }
   if (in_range && state == GLINT_FLARE_FRUSTUM) atomicAdd(group_frustum, 1u);
   if (in_range && state == GLINT_FLARE_OCCLUDED) atomicAdd(group_occluded, 1u);
   if (in_range && state == GLINT_FLARE_DISABLED) atomicAdd(group_disabled, 1u);
   barrier();
-#ifndef GLINT_CULL_BALLOT
-  if (lid == 0u && group_visible > 0u) group_base = atomicAdd(counters[GLINT_CULL_COUNTER_VISIBLE], group_visible);
-#endif
   if (lid == 0u) {
+    groups[gl_WorkGroupID.x] = uvec4(group_mask[0], group_mask[1], 0u, 0u);
     if (group_frustum > 0u) atomicAdd(counters[GLINT_CULL_COUNTER_FRUSTUM], group_frustum);
     if (group_occluded > 0u) atomicAdd(counters[GLINT_CULL_COUNTER_OCCLUDED], group_occluded);
     if (group_disabled > 0u) atomicAdd(counters[GLINT_CULL_COUNTER_DISABLED], group_disabled);
   }
-#ifndef GLINT_CULL_BALLOT
-  barrier();
-  const uint slot = group_base + local_slot;
-#endif
-
-  if (!in_range) return;
-  if (visible) {
-    if (slot < pc.capacity) {
-      GlintFlareInstance inst;
-      inst.center_x_px = center.x;
-      inst.center_y_px = center.y;
-      inst.size_px = light.size_px;
-      inst.visible_fraction = fraction;
-      inst.color_r = light.color_r;
-      inst.color_g = light.color_g;
-      inst.color_b = light.color_b;
-      inst.intensity = light.intensity;
-      inst.light_index = i;
-      inst.element = light.element;
-      inst.ndc_depth = ndc_z;
-      inst.reserved = 0u;
-      instances[slot] = inst;
-    } else {
-      state = GLINT_FLARE_OVERFLOW;
-    }
-  }
-  if ((pc.flags & GLINT_CULL_WRITE_RESULTS) != 0u) {
+  // Visible lights get their result from the scatter, which knows whether they found a slot.
+  if (in_range && !visible && (pc.flags & GLINT_CULL_WRITE_RESULTS) != 0u) {
     GlintFlareLightResult r;
-    r.visible_fraction = state == GLINT_FLARE_VISIBLE ? fraction : 0.0;
+    r.visible_fraction = 0.0;
     r.culled = state;
     results[i] = r;
   }

@@ -18,6 +18,7 @@
 #include "lod.h"
 #include "reference/flare_reference.h"
 #include "reference/lod_reference.h"
+#include "support/flare_check.h"
 #include "support/gpu_test.h"
 
 namespace glint::test {
@@ -116,62 +117,6 @@ CpuImage draw(LensFlare& flare, Path path, const CpuImage& background, VkFormat 
   return detail::download(context(), color.state);
 }
 
-// Every level of the atlas as the GPU made it (exact fp16 values as double).
-reference::FlareAtlas read_atlas(const LensFlare& flare) {
-  const FlareAtlasInfo a = flare.atlas();
-  reference::FlareAtlas out;
-  size_t total = 0;
-  for (uint32_t k = 0; k < a.levels; ++k) total += size_t(std::max(1u, a.width >> k)) * std::max(1u, a.height >> k) * 8;
-  detail::OwnedBuffer staging(context(), total, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true);
-  context().run_once([&](VkCommandBuffer cmd) {
-    Image img{a.image,
-              a.view,
-              a.format,
-              {a.width, a.height},
-              0,
-              VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
-              VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-              VK_ACCESS_2_SHADER_SAMPLED_READ_BIT};
-    detail::Barriers b;
-    b.use(img, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT,
-          a.levels);
-    b.flush(cmd);
-    std::vector<VkBufferImageCopy> regions;
-    VkDeviceSize offset = 0;
-    for (uint32_t k = 0; k < a.levels; ++k) {
-      VkBufferImageCopy r{};
-      r.bufferOffset = offset;
-      r.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, k, 0, 1};
-      r.imageExtent = {std::max(1u, a.width >> k), std::max(1u, a.height >> k), 1};
-      offset += VkDeviceSize(r.imageExtent.width) * r.imageExtent.height * 8;
-      regions.push_back(r);
-    }
-    vkCmdCopyImageToBuffer(cmd, a.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, staging.buffer(),
-                           uint32_t(regions.size()), regions.data());
-    // Back to where the LensFlare keeps it; the copy's reads finish first, the host read waits.
-    b.use(img, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
-          VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-          VK_ACCESS_2_SHADER_SAMPLED_READ_BIT, a.levels);
-    b.flush(cmd);
-    detail::record_host_read_barrier(cmd);
-  });
-  staging.invalidate();
-  const auto* half = static_cast<const uint16_t*>(staging.mapped());
-  for (uint32_t k = 0; k < a.levels; ++k) {
-    reference::FlareAtlasLevel l{std::max(1u, a.width >> k), std::max(1u, a.height >> k), {}};
-    l.rgba.resize(size_t(l.width) * l.height * 4);
-    for (double& v : l.rgba) v = detail::half_to_float(*half++);
-    out.push_back(std::move(l));
-  }
-  return out;
-}
-
-reference::SamplerPrecision sampler_precision() {
-  VkPhysicalDeviceProperties p;
-  vkGetPhysicalDeviceProperties(context().physical_device(), &p);
-  return {p.limits.subTexelPrecisionBits, p.limits.mipmapPrecisionBits};
-}
-
 // Random lights over the image and around it: inside, on the edges, partly and fully off screen,
 // sizes 3 to 60 px (tiny ones exercise the coarse atlas levels), HDR colours, fractions, elements.
 std::vector<GlintFlareInstance> random_instances(uint32_t n, uint32_t seed) {
@@ -195,41 +140,6 @@ std::vector<GlintFlareInstance> random_instances(uint32_t n, uint32_t seed) {
     g.ndc_depth = unit(rng);
   }
   return out;
-}
-
-struct Deviation {
-  double worst_ratio = 0;  // max |gpu - ref| / tolerance
-  size_t outside = 0;
-  std::string first;
-};
-
-// Per channel: |gpu - ref| <= bound + (2 count + 1) * u * |ref| + floor, with u the target's
-// store rounding (kHalfStore, kFloatStore). The raster path rounds twice per blend (the fragment
-// output converted to the attachment format, then the sum); the splat sums in fp32 and rounds once.
-// Each rounding is at most u times the running sum, which for non-negative additions is at most
-// the final value.
-Deviation compare(const CpuImage& gpu, const reference::FlareComposite& ref, VkFormat format) {
-  const double u = format == kF16 ? kHalfStore : kFloatStore;
-  Deviation d;
-  for (uint32_t y = 0; y < ref.height; ++y) {
-    for (uint32_t x = 0; x < ref.width; ++x) {
-      const size_t p = size_t(y) * ref.width + x;
-      for (int c = 0; c < 4; ++c) {
-        const double r = ref.rgba[p * 4 + c];
-        const double tol = ref.bound[p * 4 + c] + (2 * ref.count[p] + 1) * u * std::fabs(r) + 1e-7;
-        const double e = std::fabs(double(gpu.at(x, y)[c]) - r);
-        if (!(e <= tol)) {
-          if (d.outside++ == 0) {
-            d.first = "pixel (" + std::to_string(x) + ", " + std::to_string(y) + ") channel " + std::to_string(c) +
-                      ": gpu " + std::to_string(gpu.at(x, y)[c]) + " ref " + std::to_string(r) + " tol " +
-                      std::to_string(tol);
-          }
-        }
-        d.worst_ratio = std::max(d.worst_ratio, e / tol);
-      }
-    }
-  }
-  return d;
 }
 
 // ---- Config ---------------------------------------------------------------------------------------
@@ -358,7 +268,7 @@ TEST_F(FlareTest, BadImagesAndBuffersThrowBeforeRecording) {
 TEST_F(FlareTest, AtlasMatchesTheFloat64ReferenceAtEveryLevel) {
   LensFlare flare(context(), kF16, {kW, kH});
   ASSERT_TRUE(flare.atlas().generated);
-  const reference::FlareAtlas gpu = read_atlas(flare);
+  const reference::FlareAtlas gpu = read_flare_atlas(flare);
   const reference::FlareAtlas ref = reference::flare_atlas();
   ASSERT_EQ(gpu.size(), size_t(GLINT_FLARE_ATLAS_LEVELS));
   const double u = kHalfStore;
@@ -386,7 +296,7 @@ TEST_F(FlareTest, AtlasMatchesTheFloat64ReferenceAtEveryLevel) {
 
 TEST_F(FlareTest, AtlasTilesArePaddedAndNoLevelMixesTwoTiles) {
   LensFlare flare(context(), kF16, {kW, kH});
-  const reference::FlareAtlas gpu = read_atlas(flare);
+  const reference::FlareAtlas gpu = read_flare_atlas(flare);
   for (size_t k = 0; k < gpu.size(); ++k) {
     const uint32_t s = 1u << k;
     std::vector<int> owner(size_t(gpu[k].width) * gpu[k].height, -1);
@@ -481,7 +391,7 @@ TEST_F(FlareTest, AdoptedContextGeneratesTheAtlasInTheFirstRecordOverPoison) {
   context().run_once([&](VkCommandBuffer cmd) { flare.record_setup(cmd); });
   EXPECT_TRUE(flare.atlas().generated);
   LensFlare standalone(context(), kF32, {kW, kH});
-  const reference::FlareAtlas got = read_atlas(flare), want = read_atlas(standalone);
+  const reference::FlareAtlas got = read_flare_atlas(flare), want = read_flare_atlas(standalone);
   for (size_t k = 0; k < got.size(); ++k) {
     for (size_t i = 0; i < got[k].rgba.size(); ++i) {
       ASSERT_TRUE(std::isfinite(got[k].rgba[i])) << "level " << k << " texel " << i / 4 << " never written";
@@ -514,7 +424,7 @@ class FlareDrawTest : public FlareTest, public ::testing::WithParamInterface<std
 TEST_P(FlareDrawTest, MatchesTheReferenceOnRandomLights) {
   const auto [path, format] = GetParam();
   LensFlare flare(context(), format, {kW, kH});
-  const reference::FlareAtlas atlas = read_atlas(flare);
+  const reference::FlareAtlas atlas = read_flare_atlas(flare);
   const CpuImage background = as_stored(random_hdr(kW, kH, 11), format);
   const auto lights = random_instances(24, 7);
   FlareInputs in(lights, uint32_t(lights.size()), flare.groups_per_instance());
@@ -523,12 +433,12 @@ TEST_P(FlareDrawTest, MatchesTheReferenceOnRandomLights) {
   const CpuImage gpu = draw(flare, path, background, format, in, config);
   ASSERT_TRUE(all_finite(gpu));
   const auto ref =
-      reference::flare_composite(background, lights, uint32_t(lights.size()), config, atlas, sampler_precision());
+      reference::flare_composite(background, lights, uint32_t(lights.size()), config, atlas, flare_sampler_precision());
   // The flares really add light here (the comparison is not of the background with itself).
   double added = 0;
   for (size_t i = 0; i < ref.rgba.size(); ++i) added += ref.rgba[i] - background.rgba[i];
   EXPECT_GT(added, 100.0);
-  const Deviation d = compare(gpu, ref, format);
+  const FlareDeviation d = compare_flare(gpu, ref, format);
   EXPECT_EQ(d.outside, 0u) << path_name(path) << ": " << d.first;
   std::printf("flare %s %s vs float64: worst |error| / tolerance %.3f\n", path_name(path),
               format == kF16 ? "rgba16f" : "rgba32f", d.worst_ratio);
@@ -545,20 +455,21 @@ INSTANTIATE_TEST_SUITE_P(Paths, FlareDrawTest,
 // Raster and compute evaluate the same function at the same pixel centres with the same sampler
 // and explicit level; they differ in how the sum is rounded: the raster path rounds to the target
 // after every blend, the splat sums in fp32 and rounds once. Tolerance: (2n + 1) * u * |value| with
-// n the number of sprites on the pixel (as in compare()), plus the reference's coverage bound at pixels whose centre
-// lies within 2e-3 px of a sprite edge, where the vertex and compute stages' fp32 may disagree.
+// n the number of sprites on the pixel (as in compare_flare()), plus the reference's coverage bound
+// at pixels whose centre lies within 2e-3 px of a sprite edge, where the vertex and compute stages'
+// fp32 may disagree.
 TEST_F(FlareTest, RasterAndComputeGiveTheSameImageWithinTolerance) {
   for (VkFormat format : {kF16, kF32}) {
     LensFlare flare(context(), format, {kW, kH});
-    const reference::FlareAtlas atlas = read_atlas(flare);
+    const reference::FlareAtlas atlas = read_flare_atlas(flare);
     const CpuImage background = as_stored(random_hdr(kW, kH, 21), format);
     const auto lights = random_instances(40, 9);
     FlareInputs in(lights, uint32_t(lights.size()), flare.groups_per_instance());
     const FlareConfig config;
     const CpuImage raster = draw(flare, Path::raster, background, format, in, config);
     const CpuImage compute = draw(flare, Path::compute, background, format, in, config);
-    const auto ref =
-        reference::flare_composite(background, lights, uint32_t(lights.size()), config, atlas, sampler_precision());
+    const auto ref = reference::flare_composite(background, lights, uint32_t(lights.size()), config, atlas,
+                                                flare_sampler_precision());
     const double u = format == kF16 ? kHalfStore : kFloatStore;
     size_t outside = 0, differ = 0;
     double worst = 0;
@@ -591,7 +502,7 @@ TEST_F(FlareTest, RasterAndComputeGiveTheSameImageWithinTolerance) {
 // alignment, so the count is read through the rounded-down binding.
 TEST_F(FlareTest, ComputeGathersManyLightsInBatchesAndChunks) {
   LensFlare flare(context(), kF32, {kW, kH});
-  const reference::FlareAtlas atlas = read_atlas(flare);
+  const reference::FlareAtlas atlas = read_flare_atlas(flare);
   const CpuImage background = random_hdr(kW, kH, 61);
   auto lights = random_instances(300, 23);
   for (auto& g : lights) g.size_px = 2.0f + 0.2f * g.size_px;  // small, so the image stays readable
@@ -614,11 +525,11 @@ TEST_F(FlareTest, ComputeGathersManyLightsInBatchesAndChunks) {
   });
   const CpuImage gpu = detail::download(context(), color.state);
   const auto ref =
-      reference::flare_composite(background, lights, uint32_t(lights.size()), config, atlas, sampler_precision());
+      reference::flare_composite(background, lights, uint32_t(lights.size()), config, atlas, flare_sampler_precision());
   uint32_t most = 0;
   for (uint32_t n : ref.count) most = std::max(most, n);
   EXPECT_GT(most, 64u) << "no pixel is covered by more sprites than a chunk of the gather holds";
-  const Deviation d = compare(gpu, ref, kF32);
+  const FlareDeviation d = compare_flare(gpu, ref, kF32);
   EXPECT_EQ(d.outside, 0u) << d.first;
   std::printf("flare compute, 300 lights: %u sprites on the busiest pixel, worst |error| / tolerance %.3f\n", most,
               d.worst_ratio);
@@ -649,17 +560,17 @@ TEST_F(FlareTest, ZeroInstancesAndDisabledLeaveTheImageBitIdentical) {
 
 TEST_F(FlareTest, InstancesBeyondTheIndirectCountAreIgnored) {
   LensFlare flare(context(), kF32, {kW, kH});
-  const reference::FlareAtlas atlas = read_atlas(flare);
+  const reference::FlareAtlas atlas = read_flare_atlas(flare);
   const CpuImage background = random_hdr(kW, kH, 41);
   const auto lights = random_instances(10, 13);
   FlareInputs three(lights, 3, flare.groups_per_instance());
   const FlareConfig config;
-  const auto ref3 = reference::flare_composite(background, lights, 3, config, atlas, sampler_precision());
-  const auto ref10 = reference::flare_composite(background, lights, 10, config, atlas, sampler_precision());
+  const auto ref3 = reference::flare_composite(background, lights, 3, config, atlas, flare_sampler_precision());
+  const auto ref10 = reference::flare_composite(background, lights, 10, config, atlas, flare_sampler_precision());
   for (Path path : {Path::raster, Path::compute}) {
     const CpuImage gpu = draw(flare, path, background, kF32, three, config);
-    EXPECT_EQ(compare(gpu, ref3, kF32).outside, 0u) << path_name(path) << " differs from the first 3 lights";
-    EXPECT_GT(compare(gpu, ref10, kF32).outside, 100u) << path_name(path) << ": the other 7 would have shown";
+    EXPECT_EQ(compare_flare(gpu, ref3, kF32).outside, 0u) << path_name(path) << " differs from the first 3 lights";
+    EXPECT_GT(compare_flare(gpu, ref10, kF32).outside, 100u) << path_name(path) << ": the other 7 would have shown";
   }
 }
 

@@ -67,6 +67,11 @@ LightVisibility cull_light(const GlintFlareLight& light, const CullSettings& s, 
                            const std::vector<DepthImage>& pyramid) {
   LightVisibility r;
   if (light.enabled == 0) return r;
+  // A non-finite float field disables the light (docs/OCCLUSION.md, "Non-finite input").
+  for (float v : {light.position_x, light.position_y, light.position_z, light.intensity, light.color_r, light.color_g,
+                  light.color_b, light.size_px}) {
+    if (!std::isfinite(v)) return r;
+  }
   r.culled = GLINT_FLARE_FRUSTUM;
   const double p[4] = {light.position_x, light.position_y, light.position_z, 1.0};
   double clip[4];

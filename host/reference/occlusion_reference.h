@@ -64,6 +64,7 @@ struct LightVisibility {
 };
 
 /// Evaluates one light. `pyramid` is hiz_pyramid(depth, settings.reversed_z, settings.levels).
+/// enabled == 0 or a non-finite float field (position, intensity, colour, size_px): DISABLED.
 /// `brute_force` and `mixed_cells` are computed only for lights that pass the frustum test.
 LightVisibility cull_light(const GlintFlareLight& light, const CullSettings& settings, const DepthImage& depth,
                            const std::vector<DepthImage>& pyramid);

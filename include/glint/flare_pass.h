@@ -24,7 +24,7 @@ namespace glint {
 /// How the flares are drawn.
 enum class FlareDrawPath : uint32_t {
   raster = 0,   //!< one vkCmdDrawIndirect (needs a graphics queue and COLOR_ATTACHMENT usage)
-  compute = 1,  //!< splat by vkCmdDispatchIndirect + resolve (needs STORAGE usage)
+  compute = 1,  //!< tile gather launched by vkCmdDispatchIndirect (needs STORAGE usage)
 };
 
 /// Creation-time settings of a LensFlarePass. Checked by validate() (and by the parts it makes).

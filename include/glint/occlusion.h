@@ -1,9 +1,9 @@
 // Visibility of lens-flare lights, kept on the GPU (issue 5): a Hi-Z depth pyramid built in one
-// dispatch (HiZPyramid), and one dispatch that projects the lights, culls them against the frustum,
-// tests their occlusion on an N x N grid read from the pyramid, and appends the visible ones to an
-// instance buffer for an indirect draw or dispatch (LightCuller). docs/OCCLUSION.md derives the
-// fold rule, the level choice and the error bound; host/reference/occlusion_reference.h holds the
-// float64 references.
+// dispatch (HiZPyramid), and a cull (LightCuller) that projects the lights, culls them against the
+// frustum, tests their occlusion on an N x N grid read from the pyramid, and compacts the visible
+// ones, in increasing light index (issue 6), into an instance buffer for an indirect draw or
+// dispatch. docs/OCCLUSION.md derives the fold rule, the level choice, the error bound and the
+// compaction; host/reference/occlusion_reference.h holds the float64 references.
 //
 // Conventions (Vulkan): clip = view_proj * (position, 1); ndc = clip.xyz / clip.w;
 // pixel = (ndc.xy * 0.5 + 0.5) * depth size, so ndc.y = -1 is the first row; depth = ndc.z in
@@ -12,7 +12,7 @@
 //
 // A frame:
 //   hiz.record(cmd, depth);                          // after the depth pass
-//   culler.record(cmd, hiz, depth, lights, count, frame, outputs);
+//   culler.record(cmd, hiz, depth, lights, count, frame, outputs);  // instances in light order
 //   ... draw: vkCmdDrawIndirect(outputs.indirect, offset 0) or vkCmdDispatchIndirect(offset 16),
 //       reading outputs.instances; the caller's barrier starts from the state fields record() left.
 #pragma once
@@ -89,11 +89,13 @@ class HiZPyramid {
   std::unique_ptr<Impl> impl_;
 };
 
-/// How LightCuller compacts visible lights.
+/// Kept for source compatibility: since the compaction preserves light order (issue 6: a scan of
+/// per-workgroup visibility masks, no atomic decides a slot, no subgroup operation) every value
+/// runs the same kernels on every device, and LightCuller::path() returns shared.
 enum class CompactionPath : uint32_t {
-  automatic = 0,  //!< subgroup ballot where the device supports it in compute, else shared
-  ballot = 1,     //!< one atomic per subgroup (ballot + exclusive bit count); Error if unsupported
-  shared = 2,     //!< one atomic per workgroup through a shared-memory counter (any device)
+  automatic = 0,  //!< the order-preserving compaction (as every value)
+  ballot = 1,     //!< formerly one atomic per subgroup; now the same as automatic
+  shared = 2,     //!< the order-preserving compaction (what path() reports)
 };
 
 /// Where LightCuller's N x N occlusion samples read the Hi-Z pyramid (docs/OCCLUSION.md).
@@ -115,7 +117,9 @@ struct LightCullConfig {
                                    //!< culled (1 to 8; the seed's 1.2 keeps off-screen ghosts)
   float depth_bias = 0.0f;         //!< NDC depth tolerance: a light up to this much behind a surface
                                    //!< still counts as visible there (0 to 0.1; the seed uses 0.01)
-  uint32_t max_lights = 1u << 20;  //!< most lights per record() (1 to 4194240 = 65535 x 64)
+  uint32_t max_lights = 1u << 20;  //!< most lights per record() (1 to 4194240 = 65535 x 64); the
+                                   //!< culler keeps 16 bytes per light (and 16 per 64) for it
+  /// Ignored (see CompactionPath).
   CompactionPath path = CompactionPath::automatic;
   OcclusionPattern pattern = OcclusionPattern::multi_jittered;  //!< where the N x N samples read
 
@@ -133,7 +137,8 @@ struct LightCullFrame {
 
 /// The buffers one cull writes. The caller owns them; their state fields are updated.
 struct LightCullOutputs {
-  Buffer instances;  //!< GlintFlareInstance[capacity]; STORAGE usage. Order is unspecified.
+  Buffer instances;  //!< GlintFlareInstance[capacity]; STORAGE usage. The visible lights in increasing
+                     //!< light index; when more are visible than capacity, the lowest indices.
   Buffer indirect;   //!< one GlintFlareIndirect (32 bytes): VkDrawIndirectCommand at 0,
                      //!< VkDispatchIndirectCommand at 16; STORAGE | INDIRECT usage
   Buffer stats;      //!< one GlintFlareStats (32 bytes); STORAGE usage. Read it when you want:
@@ -162,8 +167,11 @@ class LightCuller {
 
   /// Records the cull of `count` lights from `lights` (GlintFlareLight[count], STORAGE usage)
   /// against `hiz` (built from `depth` earlier on this command buffer or before) into `outputs`:
-  /// two dispatches (the cull, then a one-invocation kernel that writes the indirect arguments and
-  /// statistics and resets the counters). count == 0 is allowed (zero instances). Afterwards the
+  /// three dispatches (the cull and grid test; a one-workgroup scan that gives every workgroup of
+  /// 64 lights its first instance slot, writes the indirect arguments and statistics and resets the
+  /// counters; the scatter of the visible lights into their slots). The outputs are the same bits
+  /// on every run. A light with enabled == 0 or a non-finite float field is GLINT_FLARE_DISABLED.
+  /// count == 0 is allowed (zero instances; only the scan runs). Afterwards the
   /// outputs were last written by the compute shader stage: a draw needs a barrier to
   /// DRAW_INDIRECT / INDIRECT_COMMAND_READ for `indirect` and to VERTEX_SHADER (or COMPUTE) /
   /// SHADER_STORAGE_READ for `instances`. The first record() clears the internal counters once.
@@ -173,7 +181,7 @@ class LightCuller {
               const LightCullFrame& frame, LightCullOutputs& outputs, Profiler* profiler = nullptr);
 
   const LightCullConfig& config() const;
-  /// The path chosen at creation (never automatic).
+  /// CompactionPath::shared (the one compaction; kept for source compatibility).
   CompactionPath path() const;
 
   struct Impl;

@@ -73,7 +73,8 @@
 // (rows a workgroup height apart), so a 32x8 workgroup gathers a 32x64 tile (1020 tiles at 1080p).
 // Larger tiles bin each instance against fewer tiles; the rows share one binning and one sprite
 // setup per tile.
-// Shared lists are sized for at most GLINT_FLARE_GATHER_MAX_THREADS invocations (18 KiB).
+// Shared lists and the binning scan are sized for at most GLINT_FLARE_GATHER_MAX_THREADS
+// invocations (20 KiB).
 #define GLINT_FLARE_GATHER_ROWS 8u
 #define GLINT_FLARE_GATHER_MAX_THREADS 256u
 

@@ -23,7 +23,8 @@
 #define GLINT_FLARE_VISIBLE 0u    // drawn (visible_fraction > 0)
 #define GLINT_FLARE_FRUSTUM 1u    // w <= 0 (behind the camera) or outside the frustum + margin
 #define GLINT_FLARE_OCCLUDED 2u   // every grid sample occluded (visible_fraction == 0)
-#define GLINT_FLARE_DISABLED 3u   // enabled == 0; counted in total, in no other statistic
+#define GLINT_FLARE_DISABLED 3u   // enabled == 0 or a non-finite float field; counted in total, in no
+                                  // other statistic
 #define GLINT_FLARE_OVERFLOW 4u   // visible, but the instance buffer was full
 
 // One light, as the caller writes it (48 bytes).
@@ -37,14 +38,14 @@ struct GlintFlareLight {
   GLINT_FLOAT color_b;
   GLINT_FLOAT size_px;     // flare size in pixels (the occlusion footprint is a size_px square)
   GLINT_UINT element;      // GLINT_FLARE_ELEMENT_*: the light's main element
-  GLINT_UINT enabled;      // 0: skipped
+  GLINT_UINT enabled;      // 0: skipped (as is a light with a non-finite float field)
   GLINT_UINT reserved0;
   GLINT_UINT reserved1;
 };
 
-// One visible light, as the compaction writes it for the draw (48 bytes). Order within the
-// buffer is not specified (one atomic per subgroup); the draw is additive, so order does not
-// change the image beyond floating-point rounding.
+// One visible light, as the compaction writes it for the draw (48 bytes). Instances are in
+// increasing light_index (issue 6: the compaction preserves order), so the additive draw sums in
+// the same order, and gives the same bits, on every run.
 struct GlintFlareInstance {
   GLINT_FLOAT center_x_px;       // the light's pixel position, (ndc.xy * 0.5 + 0.5) * viewport
   GLINT_FLOAT center_y_px;

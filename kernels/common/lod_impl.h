@@ -1,6 +1,6 @@
 // The LOD functions, in the common subset of GLSL and C++ (scalars, sqrt, log2, floor, min, max,
-// clamp). GLSL: included by lod.glsl. C++: included by host/lod_math.h inside a namespace that
-// supplies those names. Every path ends in clamp(.., 0, levels - 1). docs/LOD.md derives it.
+// clamp, floatBitsToUint). GLSL: included by lod.glsl. C++: included by host/lod_math.h inside a
+// namespace that supplies those names. Every path ends in clamp(.., 0, levels - 1). docs/LOD.md derives it.
 #ifndef GLINT_LOD_IMPL_H
 #define GLINT_LOD_IMPL_H
 
@@ -29,7 +29,10 @@ GLINT_LOD_FN float glint_lod_rho_y(GlintLodQuery q) {
   return sqrt(mu * mu + mv * mv);
 }
 
-GLINT_LOD_FN bool glint_lod_finite(float x) { return x == x && x - x == 0.0; }  // not NaN, not +-Inf
+// Not NaN, not +-Inf, tested on the bits: the exponent field is all ones only for those. Written as
+// a float test (x == x && x - x == 0), a compiler that assumes floats are finite folds it to true
+// (lavapipe did in a flare shader). floatBitsToUint is GLSL's; host/lod_math.h supplies it for C++.
+GLINT_LOD_FN bool glint_lod_finite(float x) { return (floatBitsToUint(x) & 0x7f800000u) != 0x7f800000u; }
 
 // Valid tile and atlas: finite numbers, a tile of at least 1x1 inside the atlas, levels >= 1.
 GLINT_LOD_FN bool glint_lod_valid(GlintLodQuery q, GlintLodAtlas a) {

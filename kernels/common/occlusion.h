@@ -1,6 +1,8 @@
-// Push constants and counter layout of the visibility stage of the lens flares (issue 5): the Hi-Z
-// build (hiz_build.comp), the cull + occlusion grid test + compaction (light_cull.comp) and the
-// kernel that turns its counters into indirect arguments and statistics (light_cull_finalize.comp).
+// Push constants and buffer layouts of the visibility stage of the lens flares (issue 5): the Hi-Z
+// build (hiz_build.comp), the cull + occlusion grid test (light_cull.comp), and the order-preserving
+// compaction (issue 6): a single-workgroup scan of the cull's per-workgroup visibility masks that
+// also writes the indirect arguments and statistics (light_cull_scan.comp), then the scatter of the
+// visible lights into the instance buffer in light-index order (light_cull_scatter.comp).
 // Declared once for GLSL and C++ (STYLE rule 2); host/occlusion.cpp static_asserts the layouts.
 // docs/OCCLUSION.md explains the algorithms.
 #ifndef GLINT_OCCLUSION_H
@@ -25,12 +27,19 @@ struct GlintHiZPush {
   GLINT_UINT reserved;
 };
 
-// Words of the cull's counter buffer (all zero between frames: the finalize kernel resets them).
-#define GLINT_CULL_COUNTER_VISIBLE 0u
+// Lights per workgroup of light_cull.comp: one workgroup's visibility is one 64-bit mask.
+#define GLINT_CULL_GROUP 64u
+// The cull's group buffer: GLINT_CULL_HEADER_WORDS counter words (all zero between frames: the scan
+// kernel resets them), then one uvec4 per workgroup of GLINT_CULL_GROUP lights: the visibility mask
+// of its lights 0..31 (x) and 32..63 (y), written by the cull, and the instance slot of its first
+// visible light (z), written by the scan; w is 0. Counters are integer sums, so the order of their
+// atomics does not matter; no atomic decides where an instance goes.
 #define GLINT_CULL_COUNTER_FRUSTUM 1u
 #define GLINT_CULL_COUNTER_OCCLUDED 2u
 #define GLINT_CULL_COUNTER_DISABLED 3u
-#define GLINT_CULL_COUNTER_WORDS 4u
+#define GLINT_CULL_HEADER_WORDS 4u
+// Most invocations of the scan's single workgroup (its shared arrays are sized for it).
+#define GLINT_CULL_SCAN_MAX_THREADS 1024u
 
 // GlintCullPush::flags
 #define GLINT_CULL_REVERSED_Z 1u     // depth 1 is near; farthest = min
@@ -48,7 +57,7 @@ struct GlintCullPush {
   GLINT_INT width;            // viewport = depth image size in pixels
   GLINT_INT height;
   GLINT_UINT count;        // lights in the list
-  GLINT_UINT capacity;     // GlintFlareInstance slots in the instance buffer
+  GLINT_UINT reserved0;    // was the capacity: the scatter writes the instances now
   GLINT_UINT grid;         // N: N x N cells per footprint (1 to 16)
   GLINT_UINT levels;       // Hi-Z levels built above level 0 (0 to 14)
   GLINT_UINT flags;        // GLINT_CULL_*
@@ -57,11 +66,14 @@ struct GlintCullPush {
   GLINT_UINT reserved[3];
 };
 
-struct GlintCullFinalizePush {
-  GLINT_UINT count;
-  GLINT_UINT capacity;
-  GLINT_UINT vertex_count;
-  GLINT_UINT groups_per_instance;
+// Push constants of light_cull_scan.comp and light_cull_scatter.comp.
+struct GlintCullCompactPush {
+  GLINT_UINT count;                // lights in the list
+  GLINT_UINT capacity;             // GlintFlareInstance slots in the instance buffer
+  GLINT_UINT vertex_count;         // scan: GlintFlareIndirect::vertex_count
+  GLINT_UINT groups_per_instance;  // scan: GlintFlareIndirect::group_count_x = instances x this
+  GLINT_UINT flags;                // scatter: GLINT_CULL_WRITE_RESULTS
+  GLINT_UINT reserved[3];
 };
 
 #endif
