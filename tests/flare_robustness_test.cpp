@@ -9,7 +9,8 @@
 //   cull, flare_reference.h for the image): lights on the near and far planes, at clip w = 0 and at
 //   tiny w, far outside the screen, thousands on one pixel, more visible than the instance buffer
 //   holds, and NaN / Inf in every float field (culled as disabled, docs/OCCLUSION.md);
-// - the Hi-Z pyramid at 1x1, 1xN, Nx1, 4097x3 and the device's largest side as a thin image;
+// - the Hi-Z pyramid and the whole pass at 1x1, 1xN, Nx1, 4097x3 and the device's largest side as
+//   a thin image;
 // - the LOD kernel's finiteness test on the GPU: Inf derivatives must give level 0 (a test folded
 //   by a compiler that assumes finite floats would give the top level).
 // Validation with synchronization validation is on for every test (support/gpu_test.h).
@@ -691,6 +692,41 @@ TEST_F(FlareRobustnessTest, EdgeCaseLightsAreCulledAsDocumentedAndDrawFiniteImag
           " image/reference worst ratio %.3f\n",
           what.c_str(), n, run.stats.visible, run.indirect.instance_count, run.stats.occluded, run.stats.frustum_culled,
           run.stats.disabled, ambiguous, worst);
+    }
+  }
+}
+
+// ---- Flare sizes -----------------------------------------------------------------------------------
+
+// The whole pass (Hi-Z, cull, draw) at 1x1, 1xN, Nx1, 4097x3 and the device's largest side as a
+// thin image, both draw paths: lights at ndc positions across the image (identity view-projection,
+// nothing occluded, one off screen), the image finite and within docs/FLARE.md's tolerance of the
+// float64 composite of what was drawn.
+TEST_F(FlareRobustnessTest, FlarePassHandlesDegenerateAndThinSizes) {
+  const uint32_t max_side = std::min(16384u, context().info().max_image_dimension_2d);
+  const VkExtent2D sizes[] = {{1, 1}, {1, 61}, {61, 1}, {4097, 3}, {max_side, 2}, {2, max_side}};
+  std::array<float, 16> identity{};
+  identity[0] = identity[5] = identity[10] = identity[15] = 1.0f;
+  const FlareConfig look = FlareConfig::preset(FlarePreset::cinematic);
+  const std::vector<GlintFlareLight> lights = {ndc_light(0.0f, 0.0f, 0.5f, 6.0f), ndc_light(-0.9f, 0.7f, 0.5f, 3.0f),
+                                               ndc_light(0.95f, -0.95f, 0.5f, 12.0f),
+                                               ndc_light(3.0f, 0.0f, 0.5f, 4.0f)};  // off screen
+  for (VkExtent2D e : sizes) {
+    const reference::DepthImage depth{e.width, e.height, std::vector<float>(size_t(e.width) * e.height, 1.0f)};
+    const CpuImage background = as_half(random_hdr(e.width, e.height, e.width + 7 * e.height));
+    for (FlareDrawPath path : {FlareDrawPath::raster, FlareDrawPath::compute}) {
+      const std::string what = std::to_string(e.width) + "x" + std::to_string(e.height) + " " + path_name(path);
+      LensFlarePass pass(context(), pass_config(e, path, 8, uint32_t(lights.size())));
+      const PassRun run = run_pass(pass, background, depth, lights, identity, look, 1)[0];
+      EXPECT_EQ(run.stats.total, lights.size()) << what;
+      EXPECT_EQ(run.stats.frustum_culled, 1u) << what;
+      EXPECT_EQ(run.stats.visible, 3u) << what;
+      ASSERT_TRUE(all_finite(run.image)) << what;
+      const auto ref = reference::flare_composite(background, run.instances, uint32_t(run.instances.size()), look,
+                                                  read_flare_atlas(pass.flare()), flare_sampler_precision());
+      const FlareDeviation d = compare_flare(run.image, ref, kF16);
+      EXPECT_EQ(d.outside, 0u) << what << ": worst ratio " << d.worst_ratio << ", first " << d.first;
+      EXPECT_FALSE(bit_equal(run.image, background)) << what << ": the visible lights drew nothing";
     }
   }
 }
