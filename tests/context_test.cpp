@@ -6,6 +6,10 @@
 #include <cstring>
 
 #include "core/context_state.h"
+#include "core/pipeline.h"
+#include "core/resources.h"
+#include "core/transfer.h"
+#include "demo_scene.h"
 #include "reference/bloom_reference.h"
 #include "support/gpu_test.h"
 
@@ -166,6 +170,38 @@ TEST_F(ContextTest, AdoptRejectsNullHandlesAndBadQueueFamily) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("queue_family_index"), std::string::npos);
   }
+}
+
+// Compiled kernels are shared per context: a second pipeline of the same description compiles
+// nothing, and a context-cached helper whose make() builds a pipeline (the demo starfield) does
+// not wait on itself (it did when both used one lock: the demo hung).
+TEST_F(ContextTest, PipelinesAreSharedAndACachedHelperCanMakeOne) {
+  detail::PipelineDesc d;
+  d.kernel_id = "image_copy_rgba16f";
+  d.bindings = {VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE};
+  d.push_constant_bytes = 48;
+  d.workgroup = {8, 8};
+  detail::ComputePipeline first(context(), d);
+  const uint64_t objects = context().objects_created();
+  detail::ComputePipeline second(context(), d);
+  EXPECT_EQ(context().objects_created(), objects);
+  EXPECT_EQ(first.set_layout(), second.set_layout());
+  d.workgroup = {4, 4};
+  detail::ComputePipeline other(context(), d);
+  EXPECT_GT(context().objects_created(), objects);
+  EXPECT_NE(other.set_layout(), first.set_layout());
+
+  detail::OwnedImage target(context(), {32, 16}, VK_FORMAT_R16G16B16A16_SFLOAT, detail::kToolImageUsage);
+  demo::StarfieldParams params;
+  params.stars = 50;
+  context().run_once([&](VkCommandBuffer cmd) { demo::record_starfield(context(), cmd, target.state, params); });
+  const CpuImage img = detail::download(context(), target.state);
+  float peak = 0.0f;
+  for (float v : img.rgba) {
+    ASSERT_TRUE(std::isfinite(v));
+    peak = std::max(peak, v);
+  }
+  EXPECT_GT(peak, 0.0f);
 }
 
 }  // namespace

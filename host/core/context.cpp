@@ -269,7 +269,8 @@ Context& Context::operator=(Context&&) noexcept = default;
 Context::~Context() {
   if (!state_) return;
   auto& s = *state_;
-  s.cache.clear();  // helper objects first: they hold handles of the device
+  s.cache.clear();      // helper objects first: they hold handles of the device
+  s.pipelines.clear();  // then the compiled kernels, before the device goes
   if (s.adopted) return;
   if (s.device) {
     vkDeviceWaitIdle(s.device);

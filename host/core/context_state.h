@@ -53,6 +53,11 @@ struct ContextState {
   }
   std::mutex cache_mutex;
   std::map<std::string, std::shared_ptr<void>> cache;
+
+  /// Compiled kernels, shared by every ComputePipeline of the context (core/pipeline.cpp). Apart
+  /// from `cache` because a cached helper's make() may itself make a ComputePipeline.
+  std::mutex pipeline_mutex;
+  std::map<std::string, std::shared_ptr<void>> pipelines;
 };
 
 /// Validation messages seen by every context of the process, including those that arrive while a

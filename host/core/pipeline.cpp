@@ -101,7 +101,10 @@ ComputePipeline::ComputePipeline(const Context& context, const PipelineDesc& des
   key += "|";
   for (VkDescriptorType t : desc.bindings) key += concat(static_cast<int>(t), ",");
   auto& s = context.state();
-  compiled_ = &s.cached<CompiledPipeline>(key, [&] { return compile(s, desc, *bin); });
+  std::lock_guard<std::mutex> lock(s.pipeline_mutex);
+  auto& slot = s.pipelines[key];
+  if (!slot) slot = compile(s, desc, *bin);
+  compiled_ = static_cast<const CompiledPipeline*>(slot.get());
 }
 
 ComputePipeline& ComputePipeline::operator=(ComputePipeline&& o) noexcept {

@@ -25,7 +25,7 @@ struct PipelineDesc {
   std::vector<uint32_t> specialization;  //!< constant_id 2, 3, ...
 };
 
-/// The Vulkan objects of one compiled kernel variant. Owned by the context (ContextState::cached),
+/// The Vulkan objects of one compiled kernel variant. Owned by the context (ContextState::pipelines),
 /// shared by every ComputePipeline of the same PipelineDesc, destroyed with the context.
 struct CompiledPipeline {
   VkDevice device = VK_NULL_HANDLE;
