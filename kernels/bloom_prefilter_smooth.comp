@@ -55,11 +55,15 @@ vec3 source_texel(ivec2 ij) {
 // The exact 2:1 case (both sides even, the common one), as kernels/common/bloom_down_tiled.glsl
 // does it: every bilinear tap of cod13 and dual sits on a corner of four texels, so it is the mean
 // of that 2x2 box; the box means at every corner of the window are formed once, into s_rows (free
-// after the vertical pass), and each invocation reads its 13 (cod13) or 5 (dual) boxes, instead of
-// 13 bilinear taps with their index arithmetic. Texels outside the image read their clamped
+// after the vertical pass), and each invocation reads its 13 (cod13) or 5 (dual) boxes
+// (bloom_boxes.glsl, shared with the tiled downsample), instead of 13 bilinear taps with their
+// index arithmetic. Texels outside the image read their clamped
 // neighbour, as downsample() does. The window starts at 2 * group origin - 2, as the tiled one.
 const uint kBoxW = 2u * gl_WorkGroupSize.x + 3u;
 const uint kBoxH = 2u * gl_WorkGroupSize.y + 3u;
+
+#define BOX_MEAN(i) s_rows[i].rgb
+#include "bloom_boxes.glsl"
 
 vec3 window_texel(int i, int j) {
   ivec2 t = clamp(g_window + ivec2(i, j), ivec2(0), g_src_size - 1) - g_window;
@@ -75,33 +79,14 @@ vec3 downsample_2to1_from_window() {
   }
   barrier();
   ivec2 c = ivec2(gl_LocalInvocationID.xy) * 2 + 2;  // output (x, y) sits on window corner 2x + 2
-#define BOX(dx, dy) s_rows[uint(c.y + (dy)) * kBoxW + uint(c.x + (dx))].rgb
-  vec3 sum = vec3(0.0);
-  float wsum = 0.0;
   if (FILTER == GLINT_BLOOM_GAUSS9) {
+    vec3 sum = vec3(0.0);
+    float wsum = 0.0;
     for (int j = 0; j < 2; ++j)
       for (int i = 0; i < 2; ++i) add_box(sum, wsum, window_texel(c.x + i, c.y + j), 0.25, true);
     return sum / wsum;
   }
-  if (FILTER == GLINT_BLOOM_DUAL) {
-    add_box(sum, wsum, BOX(0, 0), 0.5, true);
-    add_box(sum, wsum, BOX(-1, -1), 0.125, true);
-    add_box(sum, wsum, BOX(1, -1), 0.125, true);
-    add_box(sum, wsum, BOX(-1, 1), 0.125, true);
-    add_box(sum, wsum, BOX(1, 1), 0.125, true);
-    return sum / wsum;
-  }
-  vec3 inner = (BOX(-1, -1) + BOX(1, -1) + BOX(-1, 1) + BOX(1, 1)) * 0.25;
-  vec3 g00 = BOX(-2, -2), g10 = BOX(0, -2), g20 = BOX(2, -2);
-  vec3 g01 = BOX(-2, 0), g11 = BOX(0, 0), g21 = BOX(2, 0);
-  vec3 g02 = BOX(-2, 2), g12 = BOX(0, 2), g22 = BOX(2, 2);
-#undef BOX
-  add_box(sum, wsum, inner, 0.5, true);
-  add_box(sum, wsum, (g00 + g10 + g01 + g11) * 0.25, 0.125, true);
-  add_box(sum, wsum, (g10 + g20 + g11 + g21) * 0.25, 0.125, true);
-  add_box(sum, wsum, (g01 + g11 + g02 + g12) * 0.25, 0.125, true);
-  add_box(sum, wsum, (g11 + g21 + g12 + g22) * 0.25, 0.125, true);
-  return sum / wsum;
+  return downsample_from_boxes(c, kBoxW, true);
 }
 
 vec3 bright_texel(ivec2 ij) {

@@ -16,6 +16,9 @@ const uint LOADS_PER_INVOCATION = (TILE_W * TILE_H + GROUP_SIZE - 1u) / GROUP_SI
 shared vec4 s_texel[TILE_W * TILE_H];
 shared vec4 s_box[BOX_W * BOX_H];
 
+#define BOX_MEAN(i) s_box[i].rgb
+#include "bloom_boxes.glsl"
+
 // Every invocation of the workgroup must call this (it has barriers), inside the image or not.
 vec3 downsample_2to1(bool karis) {
   ivec2 origin = ivec2(gl_GlobalInvocationID.xy - gl_LocalInvocationID.xy) * 2 - 2;  // (see bloom_up_tiled)
@@ -38,34 +41,15 @@ vec3 downsample_2to1(bool karis) {
   // Output (x, y) is centred on the corner between source texels 2x and 2x+1, which is corner
   // 2*lx + 2 of the window.
   ivec2 c = ivec2(gl_LocalInvocationID.xy) * 2 + 2;
-#define BOX(dx, dy) s_box[uint(c.y + (dy)) * BOX_W + uint(c.x + (dx))].rgb
-  vec3 sum = vec3(0.0);
-  float wsum = 0.0;
   if (FILTER == GLINT_BLOOM_GAUSS9) {
-    if (!karis) return BOX(0, 0);
+    if (!karis) return s_box[uint(c.y) * BOX_W + uint(c.x)].rgb;
+    vec3 sum = vec3(0.0);
+    float wsum = 0.0;
     for (int j = 0; j < 2; ++j)
       for (int i = 0; i < 2; ++i) add_box(sum, wsum, s_texel[uint(c.y + j) * TILE_W + uint(c.x + i)].rgb, 0.25, true);
     return sum / wsum;
   }
-  if (FILTER == GLINT_BLOOM_DUAL) {
-    add_box(sum, wsum, BOX(0, 0), 0.5, karis);
-    add_box(sum, wsum, BOX(-1, -1), 0.125, karis);
-    add_box(sum, wsum, BOX(1, -1), 0.125, karis);
-    add_box(sum, wsum, BOX(-1, 1), 0.125, karis);
-    add_box(sum, wsum, BOX(1, 1), 0.125, karis);
-    return sum / wsum;
-  }
-  vec3 inner = (BOX(-1, -1) + BOX(1, -1) + BOX(-1, 1) + BOX(1, 1)) * 0.25;
-  vec3 g00 = BOX(-2, -2), g10 = BOX(0, -2), g20 = BOX(2, -2);
-  vec3 g01 = BOX(-2, 0), g11 = BOX(0, 0), g21 = BOX(2, 0);
-  vec3 g02 = BOX(-2, 2), g12 = BOX(0, 2), g22 = BOX(2, 2);
-#undef BOX
-  add_box(sum, wsum, inner, 0.5, karis);
-  add_box(sum, wsum, (g00 + g10 + g01 + g11) * 0.25, 0.125, karis);
-  add_box(sum, wsum, (g10 + g20 + g11 + g21) * 0.25, 0.125, karis);
-  add_box(sum, wsum, (g01 + g11 + g02 + g12) * 0.25, 0.125, karis);
-  add_box(sum, wsum, (g11 + g21 + g12 + g22) * 0.25, 0.125, karis);
-  return sum / wsum;
+  return downsample_from_boxes(c, BOX_W, karis);
 }
 
 // The downsample of the invocation's texel: the shared-memory 2:1 path when it applies (a
