@@ -23,15 +23,6 @@ namespace {
 
 constexpr int kFramesPerIteration = 16;
 
-const char* filter_name(BloomFilter f) {
-  switch (f) {
-    case BloomFilter::cod13: return "cod13";
-    case BloomFilter::dual: return "dual";
-    case BloomFilter::gauss9: return "gauss9";
-  }
-  return "?";
-}
-
 void BM_Bloom(benchmark::State& state) {
   const auto width = static_cast<uint32_t>(state.range(0));
   const auto height = static_cast<uint32_t>(state.range(1));
@@ -92,9 +83,8 @@ void BM_Bloom(benchmark::State& state) {
   state.counters["median_us"] = median_of(frame_ms) * 1e3;
   state.counters["rel_l2_vs_f64"] = error;
   state.counters["levels"] = bloom.levels();
-  static const char* kGuards[] = {"off", "karis", "karis_smooth"};
-  state.SetLabel(std::string(filter_name(filter)) + (precision == Precision::fp16 ? "/fp16/" : "/fp32/") +
-                 kGuards[state.range(4)] + (level0_height ? "/l0h" + std::to_string(level0_height) : "") + " on " +
+  state.SetLabel(std::string(bloom_filter_name(filter)) + (precision == Precision::fp16 ? "/fp16/" : "/fp32/") +
+                 firefly_guard_name(guard) + (level0_height ? "/l0h" + std::to_string(level0_height) : "") + " on " +
                  ctx.info().name);
 }
 

@@ -56,6 +56,24 @@ void BloomConfig::validate() const {
                 concat("BloomConfig::precision = ", p, " is not a Precision: accepted fp16, fp32"));
 }
 
+const char* bloom_filter_name(BloomFilter filter) {
+  switch (filter) {
+    case BloomFilter::cod13: return "cod13";
+    case BloomFilter::dual: return "dual";
+    case BloomFilter::gauss9: return "gauss9";
+  }
+  return "?";
+}
+
+const char* firefly_guard_name(FireflyGuard guard) {
+  switch (guard) {
+    case FireflyGuard::off: return "off";
+    case FireflyGuard::karis: return "karis";
+    case FireflyGuard::karis_smooth: return "karis_smooth";
+  }
+  return "?";
+}
+
 namespace {
 
 // docs/BLOOM.md "Mip chain": with level0_height > 0, halve while the half is still taller than the

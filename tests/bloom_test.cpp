@@ -51,18 +51,6 @@ CpuImage as_stored(const CpuImage& img, VkFormat format) {
   return out;
 }
 
-const char* filter_name(BloomFilter f) {
-  switch (f) {
-    case BloomFilter::cod13:
-      return "cod13";
-    case BloomFilter::dual:
-      return "dual";
-    case BloomFilter::gauss9:
-      return "gauss9";
-  }
-  return "?";
-}
-
 constexpr BloomFilter kFilters[] = {BloomFilter::cod13, BloomFilter::dual, BloomFilter::gauss9};
 
 // Light the bloom added: out - in, summed over RGB, per pixel.
@@ -157,7 +145,7 @@ TEST_F(BloomTest, MatchesReferenceForEveryFilterAndPrecision) {
         const auto ref = reference::bloom(as_stored(input, format), config);
         const double err = reference::relative_l2(gpu, ref);
         const double tol = (precision == Precision::fp32 && format == kF32) ? 1e-3 : 5e-3;
-        EXPECT_LT(err, tol) << filter_name(filter) << (precision == Precision::fp16 ? " fp16" : " fp32")
+        EXPECT_LT(err, tol) << bloom_filter_name(filter) << (precision == Precision::fp16 ? " fp16" : " fp32")
                             << (format == kF16 ? " RGBA16F io" : " RGBA32F io");
         // Alpha passes through untouched.
         const CpuImage stored = as_stored(input, format);
@@ -199,7 +187,7 @@ TEST_F(BloomTest, MatchesReferenceForEveryGuardAndLevel0Height) {
           norm += want * want;
         }
         EXPECT_GT(norm, 0.0);
-        EXPECT_LT(std::sqrt(diff / norm), 1e-3) << filter_name(filter) << " guard " << static_cast<int>(guard) << " "
+        EXPECT_LT(std::sqrt(diff / norm), 1e-3) << bloom_filter_name(filter) << " guard " << firefly_guard_name(guard) << " "
                                                 << c.w << "x" << c.h << " level0_height " << c.level0_height;
       }
     }
@@ -290,7 +278,7 @@ TEST_F(BloomTest, DimPixelsFarFromBrightOnesAreUnchanged) {
     // Footprint of the taps of docs/BLOOM.md (the karis_smooth prefilter, every downsample and
     // upsample), derived in support/effects.cpp (over 400 px for gauss9 here).
     const uint32_t reach = 10 + bloom_footprint_px({input.width, input.height}, config);
-    ASSERT_LT(reach, input.height) << filter_name(filter);
+    ASSERT_LT(reach, input.height) << bloom_filter_name(filter);
     size_t changed_far = 0, changed_near = 0;
     for (uint32_t y = 0; y < input.height; ++y)
       for (uint32_t x = 0; x < input.width; ++x) {
@@ -298,8 +286,8 @@ TEST_F(BloomTest, DimPixelsFarFromBrightOnesAreUnchanged) {
         const bool far = x > reach || y > reach;
         (far ? changed_far : changed_near) += differs;
       }
-    EXPECT_EQ(changed_far, 0u) << filter_name(filter);
-    EXPECT_GT(changed_near, 100u) << filter_name(filter) << ": the bright pixel must bloom";
+    EXPECT_EQ(changed_far, 0u) << bloom_filter_name(filter);
+    EXPECT_GT(changed_near, 100u) << bloom_filter_name(filter) << ": the bright pixel must bloom";
   }
 }
 
@@ -350,7 +338,7 @@ TEST_F(BloomTest, PointSourceGlowIsRadiallySymmetric) {
     const CpuImage gpu = run_bloom(config, input);
     const Moments m = moments(added_light(gpu, input), n, n, 128, 128);
     EXPECT_GT(m.energy, 0.0);
-    EXPECT_NEAR(m.xx / m.yy, 1.0, 0.02) << filter_name(filter) << " xx=" << m.xx << " yy=" << m.yy;
+    EXPECT_NEAR(m.xx / m.yy, 1.0, 0.02) << bloom_filter_name(filter) << " xx=" << m.xx << " yy=" << m.yy;
   }
 }
 
@@ -374,7 +362,7 @@ TEST_F(BloomTest, LargerRadiusGivesWiderGlow) {
       config.filter = filter;
       config.radius = radius;
       const Moments m = moments(added_light(run_bloom(config, input), input), 129, 129, 64, 64);
-      EXPECT_GT(m.xx + m.yy, last * 1.02) << filter_name(filter) << " radius " << radius;
+      EXPECT_GT(m.xx + m.yy, last * 1.02) << bloom_filter_name(filter) << " radius " << radius;
       last = m.xx + m.yy;
     }
   }
@@ -394,8 +382,8 @@ TEST_F(BloomTest, UniformImageStaysUniformAtOddSizes) {
         hi = std::max(hi, gpu.rgba[i]);
       }
       // Bloom adds intensity * prefilter(3) = 0.3 * 2 = 0.6; fp16 levels round to ~1e-3.
-      EXPECT_LE(hi - lo, 2e-3f) << filter_name(filter) << " " << s.width << "x" << s.height;
-      EXPECT_NEAR(lo, 3.6f, 5e-3f) << filter_name(filter) << " " << s.width << "x" << s.height;
+      EXPECT_LE(hi - lo, 2e-3f) << bloom_filter_name(filter) << " " << s.width << "x" << s.height;
+      EXPECT_NEAR(lo, 3.6f, 5e-3f) << bloom_filter_name(filter) << " " << s.width << "x" << s.height;
     }
   }
 }

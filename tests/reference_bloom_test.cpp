@@ -23,19 +23,6 @@ namespace {
 
 constexpr BloomFilter kFilters[] = {BloomFilter::cod13, BloomFilter::dual, BloomFilter::gauss9};
 constexpr FireflyGuard kGuards[] = {FireflyGuard::off, FireflyGuard::karis, FireflyGuard::karis_smooth};
-int guard_id(FireflyGuard g) { return static_cast<int>(g); }
-
-std::string name_of(BloomFilter f) {
-  switch (f) {
-    case BloomFilter::cod13:
-      return "cod13";
-    case BloomFilter::dual:
-      return "dual";
-    case BloomFilter::gauss9:
-      return "gauss9";
-  }
-  return "?";
-}
 
 // A config whose prefilter is the identity for any texel with luma >= 1e-4 (threshold 0, knee 0:
 // factor = max(l, 0) / max(l, 1e-4) = 1), so downsample and blur can be checked in isolation.
@@ -284,8 +271,8 @@ TEST(BloomReferenceLevels, MaxBrightnessClampsLevel0PerChannel) {
     const auto levels = downsampled_levels(flat, config);
     for (const DoubleImage& level : levels)
       for (size_t i = 0; i < level.rgba.size(); i += 4) {
-        EXPECT_NEAR(level.rgba[i], 1000.0, 1e-9) << guard_id(guard);
-        EXPECT_NEAR(level.rgba[i + 1], 500.0, 1e-9) << guard_id(guard);
+        EXPECT_NEAR(level.rgba[i], 1000.0, 1e-9) << firefly_guard_name(guard);
+        EXPECT_NEAR(level.rgba[i + 1], 500.0, 1e-9) << firefly_guard_name(guard);
       }
     CpuImage point(16, 16, 0.0f);
     set_rgb(point, 8, 8, 4000, 4000, 4000);
@@ -516,8 +503,8 @@ TEST(BloomReferenceLevels, KarisSmoothIsKarisOfTheBinomialFilteredSource) {
       differs = std::max(differs, std::abs(smooth.rgba[i] - raw.rgba[i]));
       norm = std::max(norm, std::abs(box.rgba[i]));
     }
-    EXPECT_LT(err, 1e-6 * norm) << name_of(filter);      // float rounding of the fed-back image
-    EXPECT_GT(differs, 1e-2 * norm) << name_of(filter);  // and the prefilter does change level 0
+    EXPECT_LT(err, 1e-6 * norm) << bloom_filter_name(filter);      // float rounding of the fed-back image
+    EXPECT_GT(differs, 1e-2 * norm) << bloom_filter_name(filter);  // and the prefilter does change level 0
   }
 }
 
@@ -607,7 +594,7 @@ TEST(BloomReferenceUpsample, ImpulseResponsesAtHandComputedTexels) {
     const auto diff = upsample_impulse_response(p.filter, 1.0);
     for (size_t k = 0; k < 3; ++k)
       EXPECT_NEAR(diff[(size_t(p.y) * 6 + p.x) * 4 + k], p.expected * colour[k], 1e-12)
-          << name_of(p.filter) << " (" << p.x << ", " << p.y << ")";
+          << bloom_filter_name(p.filter) << " (" << p.x << ", " << p.y << ")";
   }
 }
 
@@ -652,7 +639,7 @@ TEST(BloomReferenceBloom, UniformImageStaysUniform) {
             for (size_t k = 0; k < 3; ++k) {
               const double want = double(c[k]) + double(config.intensity) * pf[k];
               ASSERT_NEAR(out.at(x, y)[k], want, 1e-12 * want)
-                  << name_of(filter) << " " << s.w << "x" << s.h << " guard " << guard_id(guard) << " at " << x << "," << y;
+                  << bloom_filter_name(filter) << " " << s.w << "x" << s.h << " guard " << firefly_guard_name(guard) << " at " << x << "," << y;
               // fp16 storage rounds each stored value the same way everywhere: still uniform.
               ASSERT_EQ(half.at(x, y)[k], half.at(0, 0)[k]);
               ASSERT_NEAR(half.at(x, y)[k], want, 2e-3 * want);
@@ -689,7 +676,7 @@ TEST(BloomReferenceBloom, HalfModeRoundsEveryStoredImage) {
     for (size_t k = 0; k < 3; ++k) {
       const double q = h(pf[k]);
       const double want = double(c[k]) + double(config.intensity) / 3.0 * h(3 * q);
-      EXPECT_NEAR(out.at(5, 7)[k], want, 1e-12 * want) << name_of(filter) << " channel " << k;
+      EXPECT_NEAR(out.at(5, 7)[k], want, 1e-12 * want) << bloom_filter_name(filter) << " channel " << k;
       accumulate_rounded |= h(3 * q) != 3 * q;
     }
     EXPECT_TRUE(accumulate_rounded) << "pick another seed: the accumulation happened to be exact in fp16";
@@ -742,9 +729,9 @@ TEST(BloomReferenceBloom, BrighterPointAddsMoreEnergy) {
         set_rgb(in, 20, 17, b, b, b);
         const double e = total(added_light(bloom(in, config), in));
         if (b < 0.5f) {
-          EXPECT_EQ(e, 0.0) << name_of(filter) << ": a point below threshold - knee must add nothing";
+          EXPECT_EQ(e, 0.0) << bloom_filter_name(filter) << ": a point below threshold - knee must add nothing";
         } else {
-          EXPECT_GT(e, prev) << name_of(filter) << " guard " << guard_id(guard) << " brightness " << b;
+          EXPECT_GT(e, prev) << bloom_filter_name(filter) << " guard " << firefly_guard_name(guard) << " brightness " << b;
         }
         prev = e;
       }
@@ -763,13 +750,13 @@ TEST(BloomReferenceBloom, FireflyGuardDampensAnIsolatedFirefly) {
     const double off = total(added_light(bloom(in, config), in));
     config.firefly_guard = FireflyGuard::karis;
     const double on = total(added_light(bloom(in, config), in));
-    EXPECT_GT(on, 0.0) << name_of(filter);
-    EXPECT_LT(on, 0.5 * off) << name_of(filter);
+    EXPECT_GT(on, 0.0) << bloom_filter_name(filter);
+    EXPECT_LT(on, 0.5 * off) << bloom_filter_name(filter);
     // The smoothed guard trades suppression for stability (docs/STABILITY.md): it still dampens.
     config.firefly_guard = FireflyGuard::karis_smooth;
     const double smooth = total(added_light(bloom(in, config), in));
-    EXPECT_GT(smooth, on) << name_of(filter);
-    EXPECT_LT(smooth, 0.9 * off) << name_of(filter);
+    EXPECT_GT(smooth, on) << bloom_filter_name(filter);
+    EXPECT_LT(smooth, 0.9 * off) << bloom_filter_name(filter);
   }
 }
 
@@ -803,9 +790,9 @@ TEST(BloomReferenceBloom, OffCentrePointIsStillNearlyIsotropic) {
       config.filter = filter;
       config.iterations = 4;
       const Glow g = glow_of(bloom(in, config), in);
-      EXPECT_NEAR(g.mxx, g.myy, 0.05 * 0.5 * (g.mxx + g.myy)) << name_of(filter) << " at " << p.x << "," << p.y;
-      EXPECT_NEAR(g.cx, p.x, 1.5) << name_of(filter);
-      EXPECT_NEAR(g.cy, p.y, 1.5) << name_of(filter);
+      EXPECT_NEAR(g.mxx, g.myy, 0.05 * 0.5 * (g.mxx + g.myy)) << bloom_filter_name(filter) << " at " << p.x << "," << p.y;
+      EXPECT_NEAR(g.cx, p.x, 1.5) << bloom_filter_name(filter);
+      EXPECT_NEAR(g.cy, p.y, 1.5) << bloom_filter_name(filter);
     }
   }
 }
@@ -823,7 +810,7 @@ TEST(BloomReferenceBloom, LargerRadiusGivesWiderGlow) {
       config.iterations = 4;
       const Glow g = glow_of(bloom(in, config), in);
       const double spread = g.mxx + g.myy;
-      EXPECT_GT(spread, prev * 1.05) << name_of(filter) << " radius " << radius;
+      EXPECT_GT(spread, prev * 1.05) << bloom_filter_name(filter) << " radius " << radius;
       prev = spread;
     }
   }
@@ -868,12 +855,12 @@ TEST(BloomReferenceBloom, DarkPixelsFarFromBrightOnesAreUnchanged) {
           if (x < 128 && y < 128) continue;
           for (size_t k = 0; k < 4; ++k)
             ASSERT_TRUE(same_bits(out.at(x, y)[k], double(in.at(x, y)[k])))
-                << name_of(filter) << " changed far pixel " << x << "," << y;
+                << bloom_filter_name(filter) << " changed far pixel " << x << "," << y;
           ++unchanged_far;
         }
       EXPECT_EQ(unchanged_far, 256u * 256u - 128u * 128u);
       // ...while dark pixels near the spot did receive light, so the check above is not vacuous.
-      EXPECT_GT(out.at(20, 20)[1], double(in.at(20, 20)[1])) << name_of(filter);
+      EXPECT_GT(out.at(20, 20)[1], double(in.at(20, 20)[1])) << bloom_filter_name(filter);
     }
   }
 }
@@ -900,7 +887,7 @@ TEST(BloomReferenceBloom, TinyAndThinImages) {
           added += out.rgba[i] - double(in.rgba[i]);
         }
       }
-      EXPECT_GT(added, 0.0) << name_of(filter) << " " << s.w << "x" << s.h;
+      EXPECT_GT(added, 0.0) << bloom_filter_name(filter) << " " << s.w << "x" << s.h;
     }
   }
 }
@@ -913,7 +900,7 @@ TEST(BloomReferenceBloom, HalfIntermediatesStayCloseToDouble) {
     const DoubleImage exact = bloom(in, config, false);
     const DoubleImage half = bloom(in, config, true);
     const double full = relative_l2(to_float(half), exact);
-    EXPECT_LT(full, 5e-3) << name_of(filter);
+    EXPECT_LT(full, 5e-3) << bloom_filter_name(filter);
     // The scene dominates the output; compare the added light alone as well.
     DoubleImage added_exact = exact;
     DoubleImage added_half = half;
@@ -922,9 +909,9 @@ TEST(BloomReferenceBloom, HalfIntermediatesStayCloseToDouble) {
       added_half.rgba[i] -= double(in.rgba[i]);
     }
     const double bloom_only = relative_l2(to_float(added_half), added_exact);
-    EXPECT_LT(bloom_only, 5e-3) << name_of(filter);
+    EXPECT_LT(bloom_only, 5e-3) << bloom_filter_name(filter);
     // fp16 storage really was applied (a mode that changed nothing would pass the bounds above).
-    EXPECT_GT(bloom_only, 1e-6) << name_of(filter);
+    EXPECT_GT(bloom_only, 1e-6) << bloom_filter_name(filter);
   }
 }
 

@@ -27,10 +27,6 @@ constexpr VkFormat kF32 = VK_FORMAT_R32G32B32A32_SFLOAT;
 
 class StabilityTest : public GpuTest {};
 
-const char* filter_name(BloomFilter f) {
-  return f == BloomFilter::cod13 ? "cod13" : f == BloomFilter::dual ? "dual" : "gauss9";
-}
-
 // ---- fireflies ------------------------------------------------------------------------------
 
 // Total added light of a point of `value` moving right by a quarter pixel per frame over 64
@@ -67,8 +63,8 @@ TEST_F(StabilityTest, MovingFireflyEnergyIsSteadyWhereTheBloomIsLinear) {
     config.iterations = 4;
     const auto energy = firefly_energy(config, 1000.0f);
     const auto v = analysis::relative_variation(energy);
-    EXPECT_LT(v.spread, 0.02) << filter_name(filter);
-    EXPECT_LT(v.max_step, 0.02) << filter_name(filter);
+    EXPECT_LT(v.spread, 0.02) << bloom_filter_name(filter);
+    EXPECT_LT(v.max_step, 0.02) << bloom_filter_name(filter);
   }
 }
 
@@ -82,8 +78,8 @@ TEST_F(StabilityTest, DefaultsKeepTheMovingFireflyEnergySteady) {
     config.filter = filter;
     ASSERT_EQ(config.firefly_guard, FireflyGuard::karis_smooth);
     const auto v = analysis::relative_variation(firefly_energy(config, 1e4f));
-    EXPECT_LT(v.spread, 0.02) << filter_name(filter);
-    EXPECT_LT(v.max_step, 0.02) << filter_name(filter);
+    EXPECT_LT(v.spread, 0.02) << bloom_filter_name(filter);
+    EXPECT_LT(v.max_step, 0.02) << bloom_filter_name(filter);
   }
 }
 
@@ -115,7 +111,7 @@ TEST_F(StabilityTest, MovingFireflyCentroidFollowsThePoint) {
     std::vector<double> error;
     firefly_energy(config, 1000.0f, &error);
     const auto [lo, hi] = std::minmax_element(error.begin(), error.end());
-    EXPECT_LT(*hi - *lo, 0.1) << filter_name(filter) << ": centroid jitter in px";
+    EXPECT_LT(*hi - *lo, 0.1) << bloom_filter_name(filter) << ": centroid jitter in px";
   }
 }
 
@@ -138,7 +134,7 @@ TEST_F(StabilityTest, BloomExtentIsFixedInPixelsForFixedIterations) {
     }
     // Level sizes round differently at the two resolutions (720 -> ... 45, 22; 1080 -> ... 67, 33):
     // measured 1.00 to 1.06 (docs/STABILITY.md); in widths the ratio is 1.5.
-    EXPECT_NEAR(r90[0] / r90[1], 1.0, 0.1) << filter_name(filter) << ": r90 " << r90[0] << " vs " << r90[1] << " px";
+    EXPECT_NEAR(r90[0] / r90[1], 1.0, 0.1) << bloom_filter_name(filter) << ": r90 " << r90[0] << " vs " << r90[1] << " px";
   }
 }
 
@@ -165,9 +161,9 @@ TEST_F(StabilityTest, Level0HeightMakesTheBloomResolutionIndependent) {
       ++i;
     }
     for (int k : {0, 2}) {
-      EXPECT_NEAR(r50[k] / r50[1], 1.0, 0.05) << filter_name(filter) << " r50, size " << k;
-      EXPECT_NEAR(r90[k] / r90[1], 1.0, 0.05) << filter_name(filter) << " r90, size " << k;
-      EXPECT_NEAR(sigma[k] / sigma[1], 1.0, 0.05) << filter_name(filter) << " sigma, size " << k;
+      EXPECT_NEAR(r50[k] / r50[1], 1.0, 0.05) << bloom_filter_name(filter) << " r50, size " << k;
+      EXPECT_NEAR(r90[k] / r90[1], 1.0, 0.05) << bloom_filter_name(filter) << " r90, size " << k;
+      EXPECT_NEAR(sigma[k] / sigma[1], 1.0, 0.05) << bloom_filter_name(filter) << " sigma, size " << k;
     }
   }
 }
@@ -239,7 +235,7 @@ TEST_F(StabilityTest, Fp16LevelsDoNotOverflowAtTheLargestClamp) {
     config.iterations = 8;
     config.precision = Precision::fp16;
     const CpuImage out = run_bloom_once(config, input, kF32);
-    ASSERT_TRUE(all_finite(out)) << filter_name(filter);
+    ASSERT_TRUE(all_finite(out)) << bloom_filter_name(filter);
     // The light added equals the reference's (which clamps the same way and rounds its levels
     // through fp16) to the fp16 tolerance of bloom_test: an overflow would make it Inf.
     const auto ref = reference::bloom(input, config, true);
@@ -253,8 +249,8 @@ TEST_F(StabilityTest, Fp16LevelsDoNotOverflowAtTheLargestClamp) {
       norm += want * want;
       peak = std::max(peak, want);
     }
-    EXPECT_LT(std::sqrt(diff / norm), 5e-3) << filter_name(filter);
-    EXPECT_GT(peak, 0.25 * config.intensity * 7999.0) << filter_name(filter) << ": the clamped light must spill over";
+    EXPECT_LT(std::sqrt(diff / norm), 5e-3) << bloom_filter_name(filter);
+    EXPECT_GT(peak, 0.25 * config.intensity * 7999.0) << bloom_filter_name(filter) << ": the clamped light must spill over";
   }
 }
 

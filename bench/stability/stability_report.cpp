@@ -37,10 +37,6 @@ struct Frame {
   }
 };
 
-const char* filter_name(BloomFilter f) {
-  return f == BloomFilter::cod13 ? "cod13" : f == BloomFilter::dual ? "dual" : "gauss9";
-}
-
 struct FireflySeries {
   std::vector<double> energy, centroid_error;
 };
@@ -122,10 +118,6 @@ void filmstrip(const Context& ctx, const std::string& path) {
   io::write_png_tonemapped(path, strip, 0.5f);
 }
 
-const char* guard_name(FireflyGuard g) {
-  return g == FireflyGuard::karis_smooth ? "karis_smooth" : g == FireflyGuard::karis ? "karis" : "off";
-}
-
 int main_impl(int argc, char** argv) {
   std::string out_dir = "docs/stability";
   for (int i = 1; i < argc; ++i) {
@@ -154,12 +146,12 @@ int main_impl(int argc, char** argv) {
             double m = 0;
             for (double e : s.energy) m += e / s.energy.size();
             for (double e : s.energy) rel.push_back(e / m);
-            chart.emplace_back(std::string(filter_name(f)) + " " + guard_name(guard) + (value > 5000 ? " 1e4" : " 1e3"),
+            chart.emplace_back(std::string(bloom_filter_name(f)) + " " + firefly_guard_name(guard) + (value > 5000 ? " 1e4" : " 1e3"),
                                rel);
           }
           double mean = 0;
           for (double e : s.energy) mean += e / s.energy.size();
-          std::printf("| %s | %s | %g | %g | %.4f | %.4f | %.3f | %.4g |\n", filter_name(f), guard_name(guard), maxb,
+          std::printf("| %s | %s | %g | %g | %.4f | %.4f | %.3f | %.4g |\n", bloom_filter_name(f), firefly_guard_name(guard), maxb,
                       value, ev.spread, ev.max_step, hi - lo, mean);
         }
       }
@@ -170,7 +162,7 @@ int main_impl(int argc, char** argv) {
     BloomConfig c;
     c.filter = f;
     const auto ev = analysis::relative_variation(firefly(ctx, c, 1e4f, 256, 128, true).energy);
-    std::printf("| %s | %.4f | %.4f |\n", filter_name(f), ev.spread, ev.max_step);
+    std::printf("| %s | %.4f | %.4f |\n", bloom_filter_name(f), ev.spread, ev.max_step);
   }
   draw_chart(chart, out_dir + "/firefly_energy.png");
   filmstrip(ctx, out_dir + "/firefly_frames.png");
@@ -201,7 +193,7 @@ int main_impl(int argc, char** argv) {
         const auto st = analysis::light_stats(added, e.width, e.height);
         const double r50 = analysis::radius_holding(added, e.width, e.height, cx, cy, 0.5);
         const double r90 = analysis::radius_holding(added, e.width, e.height, cx, cy, 0.9);
-        std::printf("| %s | %u | %u | %ux%u | %.5f | %.5f | %.5f |\n", filter_name(f), it, row.level0_height, e.width,
+        std::printf("| %s | %u | %u | %ux%u | %.5f | %.5f | %.5f |\n", bloom_filter_name(f), it, row.level0_height, e.width,
                     e.height, r50 / e.width, r90 / e.width, std::sqrt(st.xx + st.yy) / e.width);
       }
     }

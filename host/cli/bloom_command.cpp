@@ -33,14 +33,6 @@ BloomFilter filter_from_name(const std::string& name) {
   return BloomFilter::cod13;  // IsMember() has already rejected anything else
 }
 
-const char* filter_name(BloomFilter f) {
-  switch (f) {
-    case BloomFilter::dual: return "dual";
-    case BloomFilter::gauss9: return "gauss9";
-    default: return "cod13";
-  }
-}
-
 FireflyGuard guard_from_name(const std::string& name) {
   if (name == "off") return FireflyGuard::off;
   if (name == "karis") return FireflyGuard::karis;
@@ -78,7 +70,7 @@ void run_bloom(BloomOptions& o) {
 
   std::printf("device: %s (%s)\n", context.info().name.c_str(), device_type_name(context.info().type));
   std::printf("input: %s, %ux%u\n", o.input.c_str(), input.width, input.height);
-  std::printf("bloom: filter %s, %s intermediates, %u level%s", filter_name(o.config.filter), o.fp32 ? "fp32" : "fp16",
+  std::printf("bloom: filter %s, %s intermediates, %u level%s", bloom_filter_name(o.config.filter), o.fp32 ? "fp32" : "fp16",
               bloom.levels(), bloom.levels() == 1 ? "" : "s");
   if (bloom.clamped()) {
     std::printf(" (clamped: --iterations %u does not fit %ux%u)\n", o.config.iterations, input.width, input.height);

@@ -53,6 +53,11 @@ struct BloomConfig {
   void validate() const;
 };
 
+/// "cod13", "dual" or "gauss9" ("?" for a value outside BloomFilter).
+const char* bloom_filter_name(BloomFilter filter);
+/// "off", "karis" or "karis_smooth" ("?" for a value outside FireflyGuard).
+const char* firefly_guard_name(FireflyGuard guard);
+
 /// The mip chain a bloom of `input` size with `iterations` uses (docs/BLOOM.md, "Mip chain").
 /// Returns at most `iterations` levels; fewer when a level would be under 2 pixels on a side.
 std::vector<LevelSize> bloom_mip_chain(VkExtent2D input, uint32_t iterations, uint32_t level0_height = 0);
