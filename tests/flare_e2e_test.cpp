@@ -17,6 +17,7 @@
 #include "core/barriers.h"
 #include "core/half.h"
 #include "flare_types.h"
+#include "support/flare_scene.h"
 #include "support/gpu_test.h"
 
 namespace glint::test {
@@ -28,40 +29,6 @@ constexpr VkImageUsageFlags kColorUsage = detail::kToolImageUsage | VK_IMAGE_USA
 constexpr VkBufferUsageFlags kLightUsage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
 
 class FlareEndToEndTest : public GpuTest {};
-
-// A perspective camera at the origin looking down -z (Vulkan depth [0, 1], standard Z, ndc.y = -1
-// on the first row), as an engine would hand it over.
-struct Camera {
-  double f = 1.0 / std::tan(0.5), aspect = double(kW) / kH, n = 0.1, fa = 100.0;
-  double a() const { return fa / (n - fa); }
-  double b() const { return n * fa / (n - fa); }
-  std::array<float, 16> view_proj() const {
-    std::array<float, 16> m{};
-    m[0] = float(f / aspect);
-    m[5] = float(-f);
-    m[10] = float(a());
-    m[11] = -1.0f;
-    m[14] = float(b());
-    return m;
-  }
-  double depth_at(double distance) const { return (a() * -distance + b()) / distance; }
-  // The world position seen at pixel (px, py), `distance` in front of the camera.
-  GlintFlareLight light_at(double px, double py, double distance, float size_px) const {
-    const double nx = px / kW * 2 - 1, ny = py / kH * 2 - 1;
-    GlintFlareLight l{};
-    l.position_x = float(nx * distance * aspect / f);
-    l.position_y = float(-ny * distance / f);
-    l.position_z = float(-distance);
-    l.color_r = 2.0f;
-    l.color_g = 1.5f;
-    l.color_b = 1.0f;
-    l.intensity = 3.0f;
-    l.size_px = size_px;
-    l.element = GLINT_FLARE_ELEMENT_GLOW;
-    l.enabled = 1;
-    return l;
-  }
-};
 
 // The occluder: pixels [40, 100) x [30, 90) at distance 5 over the far plane.
 std::vector<float> scene_depth(const Camera& cam) {
@@ -206,7 +173,7 @@ double energy(const CpuImage& img, int cx, int cy, int r) {
 }
 
 TEST_F(FlareEndToEndTest, StatisticsAndResultsMatchTheCpuClassification) {
-  const Camera cam;
+  const Camera cam{kW, kH};
   const auto lights = scene_lights(cam);
   std::vector<GlintFlareLight> list;
   for (const auto& l : lights) list.push_back(l.light);
@@ -241,7 +208,7 @@ TEST_F(FlareEndToEndTest, StatisticsAndResultsMatchTheCpuClassification) {
 // Culled and occluded lights add nothing at all: a frame of only those leaves the image bit for
 // bit, and the whole scene gives the image of its visible lights alone (both paths).
 TEST_F(FlareEndToEndTest, CulledAndOccludedLightsAddNothingAndVisibleOnesAddLight) {
-  const Camera cam;
+  const Camera cam{kW, kH};
   const auto lights = scene_lights(cam);
   const auto depth = scene_depth(cam);
   const CpuImage background = random_hdr(kW, kH, 6);
@@ -274,7 +241,7 @@ TEST_F(FlareEndToEndTest, CulledAndOccludedLightsAddNothingAndVisibleOnesAddLigh
 // docs/FLARE.md: |raster - compute| <= (2n + 1) u max(|raster|, |compute|) + C per channel, n the
 // sprites covering the pixel (at most 9 per drawn light here), C the tiny coverage-ambiguous term.
 TEST_F(FlareEndToEndTest, RasterAndComputeAgreeWithinTheDocumentedTolerance) {
-  const Camera cam;
+  const Camera cam{kW, kH};
   const auto lights = scene_lights(cam);
   std::vector<GlintFlareLight> list;
   for (const auto& l : lights) list.push_back(l.light);
@@ -323,7 +290,7 @@ TEST_F(FlareEndToEndTest, RasterAndComputeAgreeWithinTheDocumentedTolerance) {
 // Thousands of lights on one pixel, more visible than the capacity: the instance count is clamped
 // to the capacity, the rest is counted as overflow (and reported per light), the image is finite.
 TEST_F(FlareEndToEndTest, ThousandsOfLightsOnOnePixelOverflowSafely) {
-  const Camera cam;
+  const Camera cam{kW, kH};
   const uint32_t count = 3000, capacity = 700;
   std::vector<GlintFlareLight> list(count, cam.light_at(150.5, 40.5, 20, 12));
   for (uint32_t i = 0; i < count; i += 7) list[i] = cam.light_at(70, 60, 20, 12);  // occluded
@@ -354,7 +321,7 @@ TEST_F(FlareEndToEndTest, ThousandsOfLightsOnOnePixelOverflowSafely) {
 
 // Zero lights: the image is unchanged bit for bit; recording the frame again creates nothing.
 TEST_F(FlareEndToEndTest, ZeroLightsLeaveTheImageBitForBitAndFramesCreateNothing) {
-  const Camera cam;
+  const Camera cam{kW, kH};
   const CpuImage background = random_hdr(kW, kH, 9);
   for (FlareDrawPath path : {FlareDrawPath::raster, FlareDrawPath::compute}) {
     LensFlarePass pass(context(), pass_config(path));
@@ -412,7 +379,7 @@ TEST_F(FlareEndToEndTest, BadArgumentsThrowBeforeRecording) {
                            VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT);
   detail::OwnedBuffer lights(context(), 8 * sizeof(GlintFlareLight), kLightUsage, false);
   Buffer lv{lights.buffer(), 0, lights.size(), kLightUsage, VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE};
-  const Camera cam;
+  const Camera cam{kW, kH};
   auto vp = cam.view_proj();
   const FlareConfig look;
   context().run_once([&](VkCommandBuffer cmd) {

@@ -36,6 +36,7 @@
 #include "reference/flare_reference.h"
 #include "reference/occlusion_reference.h"
 #include "support/flare_check.h"
+#include "support/flare_scene.h"
 #include "support/gpu_test.h"
 
 namespace glint::test {
@@ -46,31 +47,7 @@ class FlareRobustnessTest : public GpuTest {};
 constexpr int kRuns = 5;
 constexpr VkFormat kF16 = VK_FORMAT_R16G16B16A16_SFLOAT;
 constexpr VkImageUsageFlags kColorUsage = detail::kToolImageUsage | VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT;
-constexpr VkBufferUsageFlags kBufferUsage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT |
-                                            VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
 constexpr std::array<float, 16> kIdentity = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
-
-// A host-visible buffer; poison() fills it with 0xFF bytes (NaN as float, ~0u as uint), so data a
-// run did not write shows.
-struct HostBuffer {
-  detail::OwnedBuffer owned;
-  Buffer view;
-  explicit HostBuffer(VkDeviceSize bytes) : owned(context(), std::max<VkDeviceSize>(bytes, 16), kBufferUsage, true) {
-    view = {owned.buffer(), 0, owned.size(), kBufferUsage, VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE};
-    poison();
-  }
-  void poison() {
-    std::memset(owned.mapped(), 0xFF, owned.size());
-    owned.flush();
-    view.stage = VK_PIPELINE_STAGE_2_HOST_BIT;
-    view.access = VK_ACCESS_2_HOST_WRITE_BIT;
-  }
-  std::vector<uint8_t> bytes(size_t n) const {
-    owned.invalidate();
-    const auto* p = static_cast<const uint8_t*>(owned.mapped());
-    return std::vector<uint8_t>(p, p + n);
-  }
-};
 
 template <typename T>
 std::vector<T> as(const std::vector<uint8_t>& bytes, size_t n) {
@@ -95,14 +72,6 @@ bool finite_instance(const GlintFlareInstance& g) {
     if (!std::isfinite(v)) return false;
   }
   return true;
-}
-
-detail::OwnedImage make_depth(const reference::DepthImage& d, VkFormat format) {
-  detail::OwnedImage img(
-      context(), {d.width, d.height}, format,
-      VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT);
-  detail::upload_r32(context(), img.state, d.depth);
-  return img;
 }
 
 // ---- Scenes ----------------------------------------------------------------------------------------
@@ -430,40 +399,6 @@ TEST_F(FlareRobustnessTest, FlarePassImageIsBitIdenticalAcrossRuns) {
 
 constexpr uint32_t kW = 192, kH = 128;
 
-// A perspective camera at the origin looking down -z (Vulkan depth [0, 1], standard Z, ndc.y = -1
-// on the first row), as in flare_e2e_test.cpp.
-struct Camera {
-  double f = 1.0 / std::tan(0.5), aspect = double(kW) / kH, n = 0.1, fa = 100.0;
-  double a() const { return fa / (n - fa); }
-  double b() const { return n * fa / (n - fa); }
-  std::array<float, 16> view_proj() const {
-    std::array<float, 16> m{};
-    m[0] = float(f / aspect);
-    m[5] = float(-f);
-    m[10] = float(a());
-    m[11] = -1.0f;
-    m[14] = float(b());
-    return m;
-  }
-  double depth_at(double distance) const { return (a() * -distance + b()) / distance; }
-  // The world position seen at pixel (px, py), `distance` in front of the camera.
-  GlintFlareLight light_at(double px, double py, double distance, float size_px, float intensity = 3.0f) const {
-    const double nx = px / kW * 2 - 1, ny = py / kH * 2 - 1;
-    GlintFlareLight l{};
-    l.position_x = float(nx * distance * aspect / f);
-    l.position_y = float(-ny * distance / f);
-    l.position_z = float(-distance);
-    l.color_r = 2.0f;
-    l.color_g = 1.5f;
-    l.color_b = 1.0f;
-    l.intensity = intensity;
-    l.size_px = size_px;
-    l.element = GLINT_FLARE_ELEMENT_GLOW;
-    l.enabled = 1;
-    return l;
-  }
-};
-
 // The occluder: pixels [40, 100) x [30, 90) at distance 5 over the far plane.
 reference::DepthImage edge_depth(const Camera& cam) {
   reference::DepthImage d{kW, kH, std::vector<float>(size_t(kW) * kH, 1.0f)};
@@ -601,7 +536,7 @@ std::vector<EdgeCase> edge_cases(const Camera& cam) {
 // nothing is drawn, else within docs/FLARE.md's tolerance of the float64 composite of the
 // instances the GPU kept.
 TEST_F(FlareRobustnessTest, EdgeCaseLightsAreCulledAsDocumentedAndDrawFiniteImages) {
-  const Camera cam;
+  const Camera cam{kW, kH};
   const reference::DepthImage depth = edge_depth(cam);
   const CpuImage background = as_half(random_hdr(kW, kH, 31));
   const FlareConfig look = FlareConfig::preset(FlarePreset::cinematic);

@@ -16,6 +16,7 @@
 #include "core/barriers.h"
 #include "core/transfer.h"
 #include "reference/occlusion_reference.h"
+#include "support/flare_scene.h"
 #include "support/gpu_test.h"
 
 namespace glint::test {
@@ -23,41 +24,11 @@ namespace {
 
 class OcclusionTest : public GpuTest {};
 
-constexpr VkBufferUsageFlags kBufferUsage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT |
-                                            VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
-
-// A host-visible buffer filled with 0xFF bytes (NaN as float, ~0u as uint): unwritten data shows.
-struct HostBuffer {
-  detail::OwnedBuffer owned;
-  Buffer view;
-  explicit HostBuffer(VkDeviceSize bytes) : owned(context(), std::max<VkDeviceSize>(bytes, 4), kBufferUsage, true) {
-    std::memset(owned.mapped(), 0xFF, owned.size());
-    owned.flush();
-    view.buffer = owned.buffer();
-    view.size = owned.size();
-    view.usage = kBufferUsage;
-    view.stage = VK_PIPELINE_STAGE_2_HOST_BIT;
-    view.access = VK_ACCESS_2_HOST_WRITE_BIT;
-  }
-  template <typename T>
-  const T* as() const {
-    owned.invalidate();
-    return static_cast<const T*>(owned.mapped());
-  }
-};
 
 void to_host(VkCommandBuffer cmd, Buffer& b) {
   detail::Barriers barriers;
   barriers.use(b, VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
   barriers.flush(cmd);
-}
-
-detail::OwnedImage make_depth(const reference::DepthImage& d, VkFormat format) {
-  detail::OwnedImage img(
-      context(), {d.width, d.height}, format,
-      VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT);
-  detail::upload_r32(context(), img.state, d.depth);
-  return img;
 }
 
 reference::DepthImage random_depth(uint32_t w, uint32_t h, uint32_t seed) {
