@@ -159,40 +159,6 @@ void check_image(const Context& context, const Image& img, const char* where, co
     throw Error(ErrorCode::missing_usage, concat(where, ": ", role, " image lacks ", need_name, " usage"));
 }
 
-// A sampler for the linear-sampling variant: bilinear, clamp to edge, one level.
-class LinearSampler {
- public:
-  LinearSampler() = default;
-  explicit LinearSampler(const Context& context) : device_(context.device()) {
-    VkSamplerCreateInfo si{VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO};
-    si.magFilter = si.minFilter = VK_FILTER_LINEAR;
-    si.mipmapMode = VK_SAMPLER_MIPMAP_MODE_NEAREST;
-    si.addressModeU = si.addressModeV = si.addressModeW = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
-    si.maxLod = 0.0f;
-    detail::vk_check(vkCreateSampler(device_, &si, nullptr, &sampler_), "vkCreateSampler");
-    context.state().count_object();
-  }
-  LinearSampler(LinearSampler&& o) noexcept { *this = std::move(o); }
-  LinearSampler& operator=(LinearSampler&& o) noexcept {
-    if (this != &o) {
-      reset();
-      device_ = std::exchange(o.device_, VK_NULL_HANDLE);
-      sampler_ = std::exchange(o.sampler_, VK_NULL_HANDLE);
-    }
-    return *this;
-  }
-  ~LinearSampler() { reset(); }
-  void reset() {
-    if (sampler_) vkDestroySampler(device_, sampler_, nullptr);
-    sampler_ = VK_NULL_HANDLE;
-  }
-  VkSampler get() const { return sampler_; }
-
- private:
-  VkDevice device_ = VK_NULL_HANDLE;
-  VkSampler sampler_ = VK_NULL_HANDLE;
-};
-
 // Which image a step reads or writes: the caller's input or output, or an owned image.
 constexpr int kInput = -1;
 constexpr int kOutput = -2;
@@ -217,7 +183,7 @@ struct StepProgram {
   std::vector<detail::OwnedImage> images;
   std::vector<detail::OwnedBuffer> tap_buffers;
   std::vector<Step> steps;
-  LinearSampler sampler;
+  VkSampler sampler = VK_NULL_HANDLE;  // bilinear, for the linear-sampling variant (owned by the context)
   detail::DescriptorArena internal_sets;
   std::map<std::pair<VkImageView, VkImageView>, std::vector<VkDescriptorSet>> caller_sets;
   std::vector<detail::DescriptorArena> caller_arenas;
@@ -269,7 +235,7 @@ struct StepProgram {
     VkImageView dst = s.dst == kOutput ? out : images[s.dst].state.view;
     std::vector<detail::DescriptorArena::AnyBinding> b(2);
     b[0].image = {src, s.src == kInput ? kReadOnly : kGeneral};
-    b[0].sampler = s.sampler ? sampler.get() : VK_NULL_HANDLE;
+    b[0].sampler = s.sampler ? sampler : VK_NULL_HANDLE;
     b[1].image = {dst, kGeneral};
     if (s.taps) {
       b.emplace_back();
@@ -562,7 +528,7 @@ struct GaussianBlur::Impl {
         taps.push_back(static_cast<float>((t * w1 + (t + 1) * w2) / (w1 + w2)));
         taps.push_back(static_cast<float>(w1 + w2));
       }
-      prog.sampler = LinearSampler(*prog.context);
+      prog.sampler = detail::clamp_sampler(*prog.context, VK_FILTER_LINEAR, VK_SAMPLER_MIPMAP_MODE_NEAREST, 0.0f);
       const detail::OwnedBuffer* buf = prog.add_taps(taps);
       const int scratch = add(size);
       for (int pass = 0; pass < 2; ++pass) {

@@ -179,7 +179,7 @@ struct LensFlare::Impl {
 
   // Atlas: one image with every level, a view of all levels (sampling) and one per level (storage).
   detail::OwnedImage atlas_image;  // state tracks all levels together
-  VkSampler sampler = VK_NULL_HANDLE;
+  VkSampler sampler = VK_NULL_HANDLE;  // owned by the context
   bool atlas_generated = false;
   detail::ComputePipeline atlas_pipeline;
   detail::DescriptorArena atlas_sets_arena;
@@ -208,7 +208,6 @@ struct LensFlare::Impl {
     if (raster_layout) vkDestroyPipelineLayout(device, raster_layout, nullptr);
     if (raster_set_layout) vkDestroyDescriptorSetLayout(device, raster_set_layout, nullptr);
     sets.reset();
-    if (sampler) vkDestroySampler(device, sampler, nullptr);
   }
 
   void make_atlas();
@@ -221,7 +220,6 @@ struct LensFlare::Impl {
 };
 
 void LensFlare::Impl::make_atlas() {
-  auto& s = context->state();
   const uint32_t levels = GLINT_FLARE_ATLAS_LEVELS;
   // RGBA16F: HDR tiles scaled by bright lights: 8 bits would band. TRANSFER_SRC and _DST: tests
   // read every level back and poison it before generation.
@@ -232,15 +230,7 @@ void LensFlare::Impl::make_atlas() {
                          levels);
   // Trilinear, clamp to edge (the atlas border is padding), no anisotropy: the level comes from the
   // shader's explicit atlas-aware LOD (textureLod), identical in both paths.
-  VkSamplerCreateInfo si{VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO};
-  si.magFilter = VK_FILTER_LINEAR;
-  si.minFilter = VK_FILTER_LINEAR;
-  si.mipmapMode = VK_SAMPLER_MIPMAP_MODE_LINEAR;
-  si.addressModeU = si.addressModeV = si.addressModeW = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
-  si.minLod = 0.0f;
-  si.maxLod = float(levels - 1);
-  detail::vk_check(vkCreateSampler(device, &si, nullptr, &sampler), "vkCreateSampler");
-  s.count_object();
+  sampler = detail::clamp_sampler(*context, VK_FILTER_LINEAR, VK_SAMPLER_MIPMAP_MODE_LINEAR, float(levels - 1));
 
   detail::PipelineDesc d;
   d.kernel_id = "flare_atlas_main";

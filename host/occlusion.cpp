@@ -122,7 +122,7 @@ struct HiZPyramid::Impl {
   Buffer counter_state;
   bool counters_cleared = false;
   // Nearest, clamp-to-edge: the kernel gathers 2x2 depth texels per fetch (hiz_build.comp).
-  VkSampler sampler = VK_NULL_HANDLE;
+  VkSampler sampler = VK_NULL_HANDLE;  // owned by the context
   // One pipeline per base level a pass reads (specialization constant 2): [0] reads the depth
   // image, [1] level GLINT_HIZ_TILE_LEVELS (made only when a second pass is planned, above 4096).
   detail::ComputePipeline pipelines[2];
@@ -145,8 +145,6 @@ struct HiZPyramid::Impl {
     sets.clear();
     VkDevice device = context ? context->device() : VK_NULL_HANDLE;
     if (!device) return;
-    if (sampler) vkDestroySampler(device, sampler, nullptr);
-    sampler = VK_NULL_HANDLE;
     pyramid.reset();
   }
 
@@ -229,13 +227,7 @@ HiZPyramid::HiZPyramid(const Context& context, const HiZConfig& config) : impl_(
   const VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
   m.counters = detail::OwnedBuffer(context, 16, usage, false);
   m.counter_state = view_of(m.counters, usage);
-  VkSamplerCreateInfo si{VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO};
-  si.magFilter = si.minFilter = VK_FILTER_NEAREST;
-  si.mipmapMode = VK_SAMPLER_MIPMAP_MODE_NEAREST;
-  si.addressModeU = si.addressModeV = si.addressModeW = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
-  si.maxLod = 0.0f;
-  detail::vk_check(vkCreateSampler(context.device(), &si, nullptr, &m.sampler), "vkCreateSampler (Hi-Z)");
-  context.state().count_object();
+  m.sampler = detail::clamp_sampler(context, VK_FILTER_NEAREST, VK_SAMPLER_MIPMAP_MODE_NEAREST, 0.0f);
   detail::PipelineDesc d;
   d.kernel_id = "hiz_build_main";
   d.bindings.push_back(VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER);

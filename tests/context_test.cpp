@@ -172,7 +172,7 @@ TEST_F(ContextTest, AdoptRejectsNullHandlesAndBadQueueFamily) {
   }
 }
 
-// Compiled kernels are shared per context: a second pipeline of the same description compiles
+// Compiled kernels (and samplers) are shared per context: a second pipeline of the same description compiles
 // nothing, and a context-cached helper whose make() builds a pipeline (the demo starfield) does
 // not wait on itself (it did when both used one lock: the demo hung).
 TEST_F(ContextTest, PipelinesAreSharedAndACachedHelperCanMakeOne) {
@@ -190,6 +190,12 @@ TEST_F(ContextTest, PipelinesAreSharedAndACachedHelperCanMakeOne) {
   detail::ComputePipeline other(context(), d);
   EXPECT_GT(context().objects_created(), objects);
   EXPECT_NE(other.set_layout(), first.set_layout());
+  // Samplers are shared the same way.
+  const VkSampler linear = detail::clamp_sampler(context(), VK_FILTER_LINEAR, VK_SAMPLER_MIPMAP_MODE_NEAREST, 0.0f);
+  const uint64_t with_sampler = context().objects_created();
+  EXPECT_EQ(detail::clamp_sampler(context(), VK_FILTER_LINEAR, VK_SAMPLER_MIPMAP_MODE_NEAREST, 0.0f), linear);
+  EXPECT_EQ(context().objects_created(), with_sampler);
+  EXPECT_NE(detail::clamp_sampler(context(), VK_FILTER_NEAREST, VK_SAMPLER_MIPMAP_MODE_NEAREST, 0.0f), linear);
 
   detail::OwnedImage target(context(), {32, 16}, VK_FORMAT_R16G16B16A16_SFLOAT, detail::kToolImageUsage);
   demo::StarfieldParams params;

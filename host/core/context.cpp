@@ -271,6 +271,8 @@ Context::~Context() {
   auto& s = *state_;
   s.cache.clear();      // helper objects first: they hold handles of the device
   s.pipelines.clear();  // then the compiled kernels, before the device goes
+  for (auto& [key, sampler] : s.samplers) vkDestroySampler(s.device, sampler, nullptr);
+  s.samplers.clear();
   if (s.adopted) return;
   if (s.device) {
     vkDeviceWaitIdle(s.device);

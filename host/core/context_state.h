@@ -6,6 +6,7 @@
 #include <atomic>
 #include <functional>
 #include <map>
+#include <tuple>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -58,6 +59,11 @@ struct ContextState {
   /// from `cache` because a cached helper's make() may itself make a ComputePipeline.
   std::mutex pipeline_mutex;
   std::map<std::string, std::shared_ptr<void>> pipelines;
+
+  /// Clamp-to-edge samplers by (filter, mipmap mode, max lod), shared like the kernels
+  /// (core/resources.h, clamp_sampler()); destroyed with the context.
+  std::mutex sampler_mutex;
+  std::map<std::tuple<int, int, float>, VkSampler> samplers;
 };
 
 /// Validation messages seen by every context of the process, including those that arrive while a

@@ -1,11 +1,29 @@
 #include "core/resources.h"
 
+#include <mutex>
 #include <utility>
 
 #include "core/check.h"
 #include "core/context_state.h"
 
 namespace glint::detail {
+
+VkSampler clamp_sampler(const Context& context, VkFilter filter, VkSamplerMipmapMode mipmap, float max_lod) {
+  auto& s = context.state();
+  std::lock_guard<std::mutex> lock(s.sampler_mutex);
+  VkSampler& sampler = s.samplers[{int(filter), int(mipmap), max_lod}];
+  if (!sampler) {
+    VkSamplerCreateInfo si{VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO};
+    si.magFilter = si.minFilter = filter;
+    si.mipmapMode = mipmap;
+    si.addressModeU = si.addressModeV = si.addressModeW = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
+    si.minLod = 0.0f;
+    si.maxLod = max_lod;
+    vk_check(vkCreateSampler(s.device, &si, nullptr, &sampler), "vkCreateSampler");
+    s.count_object();
+  }
+  return sampler;
+}
 
 uint32_t texel_bytes(VkFormat format) {
   switch (format) {

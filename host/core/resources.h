@@ -71,4 +71,9 @@ class OwnedBuffer {
 /// Bytes per texel of the formats glint handles.
 uint32_t texel_bytes(VkFormat format);
 
+/// A clamp-to-edge sampler with `filter` for minification and magnification, `mipmap` between
+/// levels and levels 0 to `max_lod`. Samplers are immutable: one per context and settings is made
+/// on first use and shared by every effect; the context destroys it.
+VkSampler clamp_sampler(const Context& context, VkFilter filter, VkSamplerMipmapMode mipmap, float max_lod);
+
 }  // namespace glint::detail
