@@ -122,10 +122,6 @@ std::vector<LevelSize> bloom_mip_chain(VkExtent2D input, uint32_t iterations, ui
 
 namespace {
 
-const char* format_variant(VkFormat f) { return f == VK_FORMAT_R32G32B32A32_SFLOAT ? "rgba32f" : "rgba16f"; }
-
-bool is_float_rgba(VkFormat f) { return f == VK_FORMAT_R16G16B16A16_SFLOAT || f == VK_FORMAT_R32G32B32A32_SFLOAT; }
-
 constexpr VkPipelineStageFlags2 kCompute = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
 constexpr VkAccessFlags2 kSampled = VK_ACCESS_2_SHADER_SAMPLED_READ_BIT;
 constexpr VkAccessFlags2 kStorageWrite = VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT;
@@ -200,7 +196,7 @@ struct Bloom::Impl {
   }
 
   void make_pipelines() {
-    const std::string lv = format_variant(level_format());
+    const std::string lv = detail::format_variant(level_format());
     const auto S = VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE;
     const auto W = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
     const char* first = config.firefly_guard == FireflyGuard::karis_smooth ? "bloom_prefilter_smooth_"
@@ -311,7 +307,7 @@ struct Bloom::Impl {
       if (!img.image || !img.view) {
         throw Error(ErrorCode::invalid_argument, concat("Bloom::record: ", role, " image and view must be non-null"));
       }
-      if (!is_float_rgba(img.format)) {
+      if (!detail::is_float_rgba(img.format)) {
         throw Error(ErrorCode::unsupported_format,
                     concat("Bloom::record: ", role, " format is ", detail::format_name(img.format),
                            "; accepted VK_FORMAT_R16G16B16A16_SFLOAT or VK_FORMAT_R32G32B32A32_SFLOAT"));

@@ -90,9 +90,6 @@ using blur_plan::kFusedMaxRadius;       // one constant for the planner and the 
 VkFormat precision_format(Precision p) {
   return p == Precision::fp32 ? VK_FORMAT_R32G32B32A32_SFLOAT : VK_FORMAT_R16G16B16A16_SFLOAT;
 }
-const char* variant(VkFormat f) { return f == VK_FORMAT_R32G32B32A32_SFLOAT ? "rgba32f" : "rgba16f"; }
-bool is_float_rgba(VkFormat f) { return f == VK_FORMAT_R16G16B16A16_SFLOAT || f == VK_FORMAT_R32G32B32A32_SFLOAT; }
-
 // The fused kernel's tile: workgroup (x, y) with `rows` outputs per invocation along y.
 struct FusedShape {
   detail::Workgroup2D workgroup{8, 8};
@@ -149,7 +146,7 @@ void check_image(const Context& context, const Image& img, const char* where, co
                  const char* need_name) {
   if (!img.image || !img.view)
     throw Error(ErrorCode::invalid_argument, concat(where, ": ", role, " image and view must be non-null"));
-  if (!is_float_rgba(img.format)) {
+  if (!detail::is_float_rgba(img.format)) {
     throw Error(ErrorCode::unsupported_format,
                 concat(where, ": ", role, " format is ", detail::format_name(img.format),
                        "; accepted VK_FORMAT_R16G16B16A16_SFLOAT or VK_FORMAT_R32G32B32A32_SFLOAT"));
@@ -203,12 +200,12 @@ struct StepProgram {
 
   const detail::ComputePipeline& pipeline(const std::string& kernel, VkFormat dst_format, detail::Workgroup2D wg,
                                           std::vector<uint32_t> spec, std::vector<VkDescriptorType> bindings) {
-    std::string key = concat(kernel, "_", variant(dst_format), "/", wg.x, "x", wg.y);
+    std::string key = concat(kernel, "_", detail::format_variant(dst_format), "/", wg.x, "x", wg.y);
     for (uint32_t v : spec) key += concat("/", v);
     auto it = pipelines.find(key);
     if (it != pipelines.end()) return it->second;
     detail::PipelineDesc d;
-    d.kernel_id = concat(kernel, "_", variant(dst_format));
+    d.kernel_id = concat(kernel, "_", detail::format_variant(dst_format));
     d.bindings = std::move(bindings);
     d.push_constant_bytes = sizeof(BlurPush);
     d.workgroup = wg;

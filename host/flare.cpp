@@ -91,8 +91,6 @@ constexpr VkPipelineStageFlags2 kCompute = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BI
 constexpr VkPipelineStageFlags2 kIndirect = VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT;
 constexpr VkAccessFlags2 kStorageRW = VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT;
 
-bool is_float_rgba(VkFormat f) { return f == VK_FORMAT_R16G16B16A16_SFLOAT || f == VK_FORMAT_R32G32B32A32_SFLOAT; }
-
 // Descriptor pools for sets whose bindings mix buffers and images (DescriptorArena writes one kind).
 class SetPool {
  public:
@@ -379,7 +377,7 @@ void LensFlare::Impl::make_raster_pipeline() {
 void LensFlare::Impl::make_compute_pipelines() {
   const auto SB = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
   detail::PipelineDesc d;
-  d.kernel_id = format == VK_FORMAT_R32G32B32A32_SFLOAT ? "flare_gather_rgba32f" : "flare_gather_rgba16f";
+  d.kernel_id = std::string("flare_gather_") + detail::format_variant(format);
   d.bindings = {SB, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, SB, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE};
   d.push_constant_bytes = sizeof(GlintFlarePush);
   d.workgroup = workgroup;
@@ -465,7 +463,7 @@ void LensFlare::Impl::check_inputs(const char* fn, const Image& color, VkImageUs
 
 LensFlare::LensFlare(const Context& context, VkFormat color_format, VkExtent2D extent)
     : impl_(std::make_unique<Impl>()) {
-  if (!is_float_rgba(color_format)) {
+  if (!detail::is_float_rgba(color_format)) {
     throw Error(ErrorCode::unsupported_format,
                 concat("LensFlare: color format is ", detail::format_name(color_format),
                        "; accepted VK_FORMAT_R16G16B16A16_SFLOAT or VK_FORMAT_R32G32B32A32_SFLOAT"));

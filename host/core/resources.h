@@ -71,6 +71,17 @@ class OwnedBuffer {
 /// Bytes per texel of the formats glint handles.
 uint32_t texel_bytes(VkFormat format);
 
+/// Whether `format` is one of the colour formats the image effects take: RGBA16F or RGBA32F.
+inline bool is_float_rgba(VkFormat format) {
+  return format == VK_FORMAT_R16G16B16A16_SFLOAT || format == VK_FORMAT_R32G32B32A32_SFLOAT;
+}
+
+/// The kernel-variant suffix of a storage format ("rgba32f" or "rgba16f"; kernels/CMakeLists.txt
+/// compiles each image-writing kernel once per storage format).
+inline const char* format_variant(VkFormat format) {
+  return format == VK_FORMAT_R32G32B32A32_SFLOAT ? "rgba32f" : "rgba16f";
+}
+
 /// A clamp-to-edge sampler with `filter` for minification and magnification, `mipmap` between
 /// levels and levels 0 to `max_lod`. Samplers are immutable: one per context and settings is made
 /// on first use and shared by every effect; the context destroys it.
