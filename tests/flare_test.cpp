@@ -336,14 +336,7 @@ TEST_F(FlareTest, AtlasTilesArePaddedAndNoLevelMixesTwoTiles) {
 TEST_F(FlareTest, ChosenLevelsKeepFootprintsInsideThePadding) {
   GlintLodQuery q{};
   q.tex_w = q.tex_h = 64.0f;
-  GlintLodAtlas a{float(GLINT_FLARE_ATLAS_WIDTH),
-                  float(GLINT_FLARE_ATLAS_HEIGHT),
-                  float(GLINT_FLARE_ATLAS_LEVELS),
-                  0.0f,
-                  1.0f,
-                  float(GLINT_FLARE_ATLAS_PADDING),
-                  GLINT_LOD_PADDING_CAP,
-                  0u};
+  const GlintLodAtlas a = reference::flare_lod_atlas();
   const double cap = reference::lod_padding_cap(q, a);
   EXPECT_EQ(cap + 1, double(GLINT_FLARE_ATLAS_LEVELS));
   FlareConfig config;

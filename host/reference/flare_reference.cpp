@@ -120,6 +120,17 @@ FlareAtlas flare_atlas() {
   return a;
 }
 
+GlintLodAtlas flare_lod_atlas() {
+  return {float(GLINT_FLARE_ATLAS_WIDTH),
+          float(GLINT_FLARE_ATLAS_HEIGHT),
+          float(GLINT_FLARE_ATLAS_LEVELS),
+          0.0f,
+          1.0f,
+          float(GLINT_FLARE_ATLAS_PADDING),
+          GLINT_LOD_PADDING_CAP,
+          0u};
+}
+
 FlareSprite flare_sprite(const GlintFlareInstance& in, uint32_t slot, const FlareConfig& c, uint32_t vw, uint32_t vh) {
   FlareSprite s;
   const double fields[] = {in.center_x_px, in.center_y_px, in.size_px, in.visible_fraction,
@@ -175,15 +186,7 @@ FlareSprite flare_sprite(const GlintFlareInstance& in, uint32_t slot, const Flar
   const auto tile = flare_tile(s.tile);
   GlintLodQuery q{float(1.0 / s.width), 0.0f,           0.0f,           float(1.0 / s.height),
                   float(tile[2]),       float(tile[3]), float(tile[0]), float(tile[1])};
-  GlintLodAtlas a{float(GLINT_FLARE_ATLAS_WIDTH),
-                  float(GLINT_FLARE_ATLAS_HEIGHT),
-                  float(GLINT_FLARE_ATLAS_LEVELS),
-                  0.0f,
-                  1.0f,
-                  float(GLINT_FLARE_ATLAS_PADDING),
-                  GLINT_LOD_PADDING_CAP,
-                  0u};
-  s.lod = lod(q, a);
+  s.lod = lod(q, flare_lod_atlas());
   return s;
 }
 

@@ -14,6 +14,7 @@
 
 #include "core/cpu_image.h"
 #include "flare_types.h"
+#include "lod.h"
 
 namespace glint::reference {
 
@@ -36,6 +37,9 @@ FlareAtlasLevel flare_atlas_level0();
 FlareAtlasLevel flare_atlas_reduce(const FlareAtlasLevel& finer);
 /// Every level (GLINT_FLARE_ATLAS_LEVELS), each reduced from the float64 level above.
 FlareAtlas flare_atlas();
+/// The atlas as the LOD function sees it (docs/FLARE.md): its size, levels, padding and the
+/// padding cap; bias 0, anisotropy 1.
+GlintLodAtlas flare_lod_atlas();
 
 /// One sprite of one instance, as docs/FLARE.md defines it (size 0: nothing drawn).
 struct FlareSprite {
