@@ -178,8 +178,7 @@ struct Bloom::Impl {
     VkDescriptorSet copy = VK_NULL_HANDLE;
   };
   std::map<std::pair<VkImageView, VkImageView>, CallerSets> caller_sets;
-  std::vector<detail::DescriptorArena> caller_arenas;
-  uint32_t caller_sets_left = 0;
+  detail::DescriptorArena caller_arena;  // grows by pools of 24 sets
 
   VkFormat level_format() const {
     return config.precision == Precision::fp32 ? VK_FORMAT_R32G32B32A32_SFLOAT : VK_FORMAT_R16G16B16A16_SFLOAT;
@@ -216,8 +215,7 @@ struct Bloom::Impl {
 
   void release_pyramid() {
     caller_sets.clear();
-    caller_arenas.clear();
-    caller_sets_left = 0;
+    caller_arena.reset();
     down_sets.clear();
     pre_sets.clear();
     blur_h_sets.clear();
@@ -268,12 +266,7 @@ struct Bloom::Impl {
     auto key = std::make_pair(in.view, out.view);
     auto it = caller_sets.find(key);
     if (it != caller_sets.end()) return it->second;
-    if (caller_sets_left < 3) {
-      caller_arenas.emplace_back(*context, 24);
-      caller_sets_left = 24;
-    }
-    caller_sets_left -= 3;
-    auto& arena = caller_arenas.back();
+    auto& arena = caller_arena;
     const bool in_place = in.image == out.image;
     const VkImageLayout in_layout = in_place ? VK_IMAGE_LAYOUT_GENERAL : VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
     const VkImageLayout G = VK_IMAGE_LAYOUT_GENERAL;
@@ -435,6 +428,7 @@ Bloom::Bloom(const Context& context, const BloomConfig& config) : impl_(std::mak
   impl_->context = &context;
   impl_->config = config;
   impl_->workgroup = bloom_workgroup(context.info());
+  impl_->caller_arena = detail::DescriptorArena(context, 24);
   impl_->make_pipelines();
 }
 
@@ -475,8 +469,7 @@ void Bloom::record(VkCommandBuffer cmd, Image& input, Image& output, Profiler* p
 
 void Bloom::forget_caller_resources() {
   impl_->caller_sets.clear();
-  impl_->caller_arenas.clear();
-  impl_->caller_sets_left = 0;
+  impl_->caller_arena.reset();
 }
 
 uint32_t Bloom::levels() const { return static_cast<uint32_t>(impl_->chain.size()); }

@@ -183,11 +183,11 @@ struct StepProgram {
   VkSampler sampler = VK_NULL_HANDLE;  // bilinear, for the linear-sampling variant (owned by the context)
   detail::DescriptorArena internal_sets;
   std::map<std::pair<VkImageView, VkImageView>, std::vector<VkDescriptorSet>> caller_sets;
-  std::vector<detail::DescriptorArena> caller_arenas;
+  detail::DescriptorArena caller_arena;  // made with the internal sets; grows by pools of 8 sets
 
   void forget_caller_sets() {
     caller_sets.clear();
-    caller_arenas.clear();
+    caller_arena.reset();
   }
 
   void clear_size() {
@@ -246,6 +246,8 @@ struct StepProgram {
     uint32_t n = 0;
     for (const Step& s : steps) n += (s.src >= 0 && s.dst >= 0);
     internal_sets = detail::DescriptorArena(*context, std::max(1u, n));
+    caller_sets.clear();  // they name the steps of the size before
+    caller_arena = detail::DescriptorArena(*context, 8);
     for (Step& s : steps) {
       if (s.src >= 0 && s.dst >= 0)
         s.set = internal_sets.make_mixed_set(*s.pipeline, bindings_of(s, VK_NULL_HANDLE, VK_NULL_HANDLE));
@@ -257,14 +259,11 @@ struct StepProgram {
     auto key = std::make_pair(in, out);
     auto it = caller_sets.find(key);
     if (it != caller_sets.end()) return it->second;
-    uint32_t n = 0;
-    for (const Step& s : steps) n += (s.src < 0 || s.dst < 0);
-    caller_arenas.emplace_back(*context, std::max(1u, n));
     std::vector<VkDescriptorSet> sets(steps.size(), VK_NULL_HANDLE);
     for (size_t i = 0; i < steps.size(); ++i) {
       const Step& s = steps[i];
       sets[i] =
-          (s.src < 0 || s.dst < 0) ? caller_arenas.back().make_mixed_set(*s.pipeline, bindings_of(s, in, out)) : s.set;
+          (s.src < 0 || s.dst < 0) ? caller_arena.make_mixed_set(*s.pipeline, bindings_of(s, in, out)) : s.set;
     }
     return caller_sets.emplace(key, std::move(sets)).first->second;
   }

@@ -91,71 +91,10 @@ constexpr VkPipelineStageFlags2 kCompute = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BI
 constexpr VkPipelineStageFlags2 kIndirect = VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT;
 constexpr VkAccessFlags2 kStorageRW = VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT;
 
-// Descriptor pools for sets whose bindings mix buffers and images (DescriptorArena writes one kind).
-class SetPool {
- public:
-  explicit SetPool(const Context& c) : context_(&c) {}
-  SetPool(const SetPool&) = delete;
-  SetPool& operator=(const SetPool&) = delete;
-  ~SetPool() {
-    for (VkDescriptorPool p : pools_) vkDestroyDescriptorPool(context_->device(), p, nullptr);
-  }
-  VkDescriptorSet allocate(VkDescriptorSetLayout layout) {
-    if (left_ == 0) {
-      constexpr uint32_t kSets = 16;
-      VkDescriptorPoolSize sizes[] = {{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kSets * 3},
-                                      {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, kSets},
-                                      {VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, kSets}};
-      VkDescriptorPoolCreateInfo info{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
-      info.maxSets = kSets;
-      info.poolSizeCount = 3;
-      info.pPoolSizes = sizes;
-      VkDescriptorPool pool = VK_NULL_HANDLE;
-      detail::vk_check(vkCreateDescriptorPool(context_->device(), &info, nullptr, &pool), "vkCreateDescriptorPool");
-      context_->state().count_object();
-      pools_.push_back(pool);
-      left_ = kSets;
-    }
-    --left_;
-    VkDescriptorSetAllocateInfo alloc{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
-    alloc.descriptorPool = pools_.back();
-    alloc.descriptorSetCount = 1;
-    alloc.pSetLayouts = &layout;
-    VkDescriptorSet set = VK_NULL_HANDLE;
-    detail::vk_check(vkAllocateDescriptorSets(context_->device(), &alloc, &set), "vkAllocateDescriptorSets");
-    context_->state().count_object();
-    return set;
-  }
-
- private:
-  const Context* context_;
-  std::vector<VkDescriptorPool> pools_;
-  uint32_t left_ = 0;
-};
-
-// One binding of a descriptor write: a buffer range, a storage image or a combined image sampler.
-struct Write {
-  VkDescriptorType type;
-  VkDescriptorBufferInfo buffer;
-  VkDescriptorImageInfo image;
-};
-Write buffer_write(const Buffer& b) { return {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, {b.buffer, b.offset, b.size}, {}}; }
-
-void write_set(VkDevice device, VkDescriptorSet set, const std::vector<Write>& bindings) {
-  std::vector<VkWriteDescriptorSet> writes(bindings.size());
-  for (uint32_t i = 0; i < bindings.size(); ++i) {
-    writes[i] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
-    writes[i].dstSet = set;
-    writes[i].dstBinding = i;
-    writes[i].descriptorCount = 1;
-    writes[i].descriptorType = bindings[i].type;
-    if (bindings[i].type == VK_DESCRIPTOR_TYPE_STORAGE_BUFFER) {
-      writes[i].pBufferInfo = &bindings[i].buffer;
-    } else {
-      writes[i].pImageInfo = &bindings[i].image;
-    }
-  }
-  vkUpdateDescriptorSets(device, static_cast<uint32_t>(writes.size()), writes.data(), 0, nullptr);
+detail::DescriptorArena::AnyBinding buffer_binding(const Buffer& b) {
+  detail::DescriptorArena::AnyBinding a;
+  a.buffer = b;
+  return a;
 }
 
 using BufferKey = std::tuple<VkBuffer, VkDeviceSize, VkDeviceSize>;
@@ -196,7 +135,7 @@ struct LensFlare::Impl {
   Buffer gather_args_state;
   std::map<BufferKey, VkDescriptorSet> gather_args_sets;
 
-  std::unique_ptr<SetPool> sets;
+  detail::DescriptorArena sets;  // the sets naming caller buffers and images; pools of 16
   std::map<BufferKey, VkDescriptorSet> raster_sets;
   std::map<GatherKey, VkDescriptorSet> gather_sets;
 
@@ -204,8 +143,16 @@ struct LensFlare::Impl {
     if (!device) return;
     if (raster_pipeline) vkDestroyPipeline(device, raster_pipeline, nullptr);
     if (raster_layout) vkDestroyPipelineLayout(device, raster_layout, nullptr);
-    if (raster_set_layout) vkDestroyDescriptorSetLayout(device, raster_set_layout, nullptr);
     sets.reset();
+    if (raster_set_layout) vkDestroyDescriptorSetLayout(device, raster_set_layout, nullptr);
+  }
+
+  // The atlas as a combined image sampler binding (every level, trilinear).
+  detail::DescriptorArena::AnyBinding atlas_binding() const {
+    detail::DescriptorArena::AnyBinding a;
+    a.image = {atlas_image.state.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+    a.sampler = sampler;
+    return a;
   }
 
   void make_atlas();
@@ -493,7 +440,7 @@ LensFlare::LensFlare(const Context& context, VkFormat color_format, VkExtent2D e
   const uint32_t tile_h = m.workgroup.y * GLINT_FLARE_GATHER_ROWS;
   m.tiles_x = (extent.width + m.workgroup.x - 1) / m.workgroup.x;
   m.tiles_y = (extent.height + tile_h - 1) / tile_h;
-  m.sets = std::make_unique<SetPool>(context);
+  m.sets = detail::DescriptorArena(context, 16);
   m.make_atlas();
   m.make_raster_pipeline();
   m.make_compute_pipelines();
@@ -541,11 +488,9 @@ void LensFlare::record_raster(VkCommandBuffer cmd, Image& color, Buffer& instanc
   if (auto it = m.raster_sets.find(key_of(instances)); it != m.raster_sets.end()) {
     set = it->second;
   } else {
-    set = m.sets->allocate(m.raster_set_layout);
-    Write img{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
-              {},
-              {m.sampler, m.atlas_image.state.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL}};
-    write_set(m.device, set, {buffer_write(instances), img});
+    set = m.sets.make_mixed_set(m.raster_set_layout,
+                                {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER},
+                                {buffer_binding(instances), m.atlas_binding()});
     m.raster_sets.emplace(key_of(instances), set);
   }
 
@@ -613,12 +558,9 @@ void LensFlare::record_compute(VkCommandBuffer cmd, Image& color, Buffer& instan
   if (auto it = m.gather_sets.find(key); it != m.gather_sets.end()) {
     set = it->second;
   } else {
-    set = m.sets->allocate(m.gather.set_layout());
-    Write img{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
-              {},
-              {m.sampler, m.atlas_image.state.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL}};
-    Write dst{VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, {}, {VK_NULL_HANDLE, color.view, VK_IMAGE_LAYOUT_GENERAL}};
-    write_set(m.device, set, {buffer_write(instances), img, buffer_write(indirect_words), dst});
+    detail::DescriptorArena::AnyBinding dst;
+    dst.image = {color.view, VK_IMAGE_LAYOUT_GENERAL};
+    set = m.sets.make_mixed_set(m.gather, {buffer_binding(instances), m.atlas_binding(), buffer_binding(indirect_words), dst});
     m.gather_sets.emplace(key, set);
   }
 
@@ -626,8 +568,7 @@ void LensFlare::record_compute(VkCommandBuffer cmd, Image& color, Buffer& instan
   if (auto it = m.gather_args_sets.find(key_of(indirect_words)); it != m.gather_args_sets.end()) {
     args_set = it->second;
   } else {
-    args_set = m.sets->allocate(m.gather_args.set_layout());
-    write_set(m.device, args_set, {buffer_write(indirect_words), buffer_write(m.gather_args_state)});
+    args_set = m.sets.make_buffer_set(m.gather_args, {indirect_words, m.gather_args_state});
     m.gather_args_sets.emplace(key_of(indirect_words), args_set);
   }
 
@@ -655,7 +596,7 @@ void LensFlare::forget_caller_resources() {
   impl_->raster_sets.clear();
   impl_->gather_sets.clear();
   impl_->gather_args_sets.clear();
-  impl_->sets = std::make_unique<SetPool>(*impl_->context);
+  impl_->sets.reset();
 }
 
 }  // namespace glint

@@ -63,8 +63,7 @@ float lod_level(const LodQuery& query, const LodAtlasConfig& atlas) {
 struct LodBatch::Impl {
   const Context* context;
   detail::ComputePipeline pipeline;
-  std::vector<detail::DescriptorArena> arenas;
-  uint32_t sets_left = 0;
+  detail::DescriptorArena arena;  // grows by pools of 16 sets
   // Per (queries, levels) buffer range pair, made on first use and kept.
   using Key = std::tuple<VkBuffer, VkDeviceSize, VkDeviceSize, VkBuffer, VkDeviceSize, VkDeviceSize>;
   std::map<Key, VkDescriptorSet> sets;
@@ -72,16 +71,11 @@ struct LodBatch::Impl {
   VkDescriptorSet set_for(const Buffer& q, const Buffer& l) {
     Key key{q.buffer, q.offset, q.size, l.buffer, l.offset, l.size};
     if (auto it = sets.find(key); it != sets.end()) return it->second;
-    if (sets_left == 0) {
-      arenas.emplace_back(*context, 16);
-      sets_left = 16;
-    }
-    --sets_left;
-    return sets[key] = arenas.back().make_buffer_set(pipeline, {q, l});
+    return sets[key] = arena.make_buffer_set(pipeline, {q, l});
   }
 };
 
-LodBatch::LodBatch(const Context& context) : impl_(new Impl{&context, {}, {}, 0, {}}) {
+LodBatch::LodBatch(const Context& context) : impl_(new Impl{&context, {}, {}, {}}) {
   detail::PipelineDesc d;
   d.kernel_id = "lod_batch_main";
   d.bindings = {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER};
@@ -89,6 +83,7 @@ LodBatch::LodBatch(const Context& context) : impl_(new Impl{&context, {}, {}, 0,
   d.workgroup = {64, 1};
   try {
     impl_->pipeline = detail::ComputePipeline(context, d);
+    impl_->arena = detail::DescriptorArena(context, 16);
   } catch (...) {
     delete impl_;
     throw;
@@ -99,8 +94,7 @@ LodBatch::~LodBatch() { delete impl_; }
 
 void LodBatch::forget_caller_resources() {
   impl_->sets.clear();
-  impl_->arenas.clear();
-  impl_->sets_left = 0;
+  impl_->arena.reset();
 }
 
 void LodBatch::record(VkCommandBuffer cmd, Buffer& queries, Buffer& levels, uint32_t count, const LodAtlasConfig& atlas,

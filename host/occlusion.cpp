@@ -190,8 +190,8 @@ struct HiZPyramid::Impl {
     auto it = sets.find(depth.view);
     if (it == sets.end()) {
       Sets s;
-      // 14 storage images per set; the arena's pool holds 4 of each type per set, 2 sets.
-      s.arena = detail::DescriptorArena(*context, 8);
+      // Two sets (one per pass), each with GLINT_HIZ_MAX_LEVELS storage images.
+      s.arena = detail::DescriptorArena(*context, 2, GLINT_HIZ_MAX_LEVELS);
       std::vector<detail::DescriptorArena::AnyBinding> b(GLINT_HIZ_MAX_LEVELS + 2);
       b[0].image = {depth.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
       b[0].sampler = sampler;
@@ -348,22 +348,13 @@ struct LightCuller::Impl {
     VkDescriptorSet cull = VK_NULL_HANDLE, scan = VK_NULL_HANDLE, scatter = VK_NULL_HANDLE;
   };
   std::map<std::vector<uint64_t>, Sets> sets;
-  std::vector<detail::DescriptorArena> arenas;
-  uint32_t sets_left = 0;
+  detail::DescriptorArena arena;  // pools of 16 sets, 8 descriptors of a type each (the scatter binds 5 buffers)
   detail::OwnedBuffer dummy_results;  // bound when the caller wants no per-light results
   Buffer dummy_state;
 
-  // Sets come from arenas of 16; each arena's pool is sized for 32 (4 descriptors of each type
-  // per set there), so the scatter's 5 storage buffers fit whatever the mix of sets.
   VkDescriptorSet allocate(const detail::ComputePipeline& p,
                            const std::vector<detail::DescriptorArena::AnyBinding>& b) {
-    constexpr uint32_t kSetsPerArena = 16;
-    if (sets_left == 0) {
-      arenas.emplace_back(*context, 2 * kSetsPerArena);
-      sets_left = kSetsPerArena;
-    }
-    --sets_left;
-    return arenas.back().make_mixed_set(p, b);
+    return arena.make_mixed_set(p, b);
   }
 
   static void key_add(std::vector<uint64_t>& key, const Buffer& b) {
@@ -378,6 +369,7 @@ LightCuller::LightCuller(const Context& context, const LightCullConfig& config) 
   Impl& m = *impl_;
   m.context = &context;
   m.config = config;
+  m.arena = detail::DescriptorArena(context, 16, 8);
   // The group limit and the scan's workgroup size from the device (STYLE rule 3).
   VkPhysicalDeviceProperties props;
   vkGetPhysicalDeviceProperties(context.physical_device(), &props);
@@ -565,8 +557,7 @@ void HiZPyramid::forget_caller_resources() { impl_->sets.clear(); }
 
 void LightCuller::forget_caller_resources() {
   impl_->sets.clear();
-  impl_->arenas.clear();
-  impl_->sets_left = 0;
+  impl_->arena.reset();
 }
 
 }  // namespace glint

@@ -4,6 +4,7 @@
 #include "core/context_state.h"
 #include "core/kernel_table.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <memory>
@@ -135,98 +136,81 @@ void ComputePipeline::dispatch_raw(VkCommandBuffer cmd, VkDescriptorSet set, con
   vkCmdDispatch(cmd, (width + workgroup_.x - 1) / workgroup_.x, (height + workgroup_.y - 1) / workgroup_.y, 1);
 }
 
-DescriptorArena::DescriptorArena(const Context& context, uint32_t max_sets) : context_(&context) {
-  VkDescriptorPoolSize sizes[] = {
-      {VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, max_sets * 4},
-      {VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, max_sets * 4},
-      {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, max_sets * 4},
-      {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, max_sets * 4},
-  };
-  VkDescriptorPoolCreateInfo info{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
-  info.maxSets = max_sets;
-  info.poolSizeCount = 4;
-  info.pPoolSizes = sizes;
-  vk_check(vkCreateDescriptorPool(context.device(), &info, nullptr, &pool_), "vkCreateDescriptorPool");
-  context.state().count_object();
-}
+DescriptorArena::DescriptorArena(const Context& context, uint32_t sets_per_pool, uint32_t per_type)
+    : context_(&context), sets_per_pool_(std::max(1u, sets_per_pool)), per_type_(std::max(1u, per_type)) {}
 
 DescriptorArena& DescriptorArena::operator=(DescriptorArena&& o) noexcept {
   if (this != &o) {
     reset();
     context_ = std::exchange(o.context_, nullptr);
-    pool_ = std::exchange(o.pool_, VK_NULL_HANDLE);
+    sets_per_pool_ = o.sets_per_pool_;
+    per_type_ = o.per_type_;
+    left_ = std::exchange(o.left_, 0);
+    pools_ = std::move(o.pools_);
+    o.pools_.clear();
   }
   return *this;
 }
 
 void DescriptorArena::reset() {
-  if (context_ && pool_) vkDestroyDescriptorPool(context_->device(), pool_, nullptr);
-  pool_ = VK_NULL_HANDLE;
-}
-
-VkDescriptorSet DescriptorArena::allocate(const ComputePipeline& pipeline) {
-  VkDescriptorSetLayout layout = pipeline.set_layout();
-  VkDescriptorSetAllocateInfo alloc{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
-  alloc.descriptorPool = pool_;
-  alloc.descriptorSetCount = 1;
-  alloc.pSetLayouts = &layout;
-  VkDescriptorSet set = VK_NULL_HANDLE;
-  vk_check(vkAllocateDescriptorSets(context_->device(), &alloc, &set), "vkAllocateDescriptorSets");
-  context_->state().count_object();
-  return set;
+  if (context_)
+    for (VkDescriptorPool p : pools_) vkDestroyDescriptorPool(context_->device(), p, nullptr);
+  pools_.clear();
+  left_ = 0;
 }
 
 VkDescriptorSet DescriptorArena::make_set(const ComputePipeline& pipeline, const std::vector<ImageBinding>& images) {
-  VkDescriptorSet set = allocate(pipeline);
-  const auto& types = pipeline.bindings();
-  if (images.size() != types.size()) {
-    throw Error(ErrorCode::invalid_argument,
-                concat("descriptor set: ", images.size(), " images for ", types.size(), " bindings"));
-  }
-  std::vector<VkDescriptorImageInfo> infos(images.size());
-  std::vector<VkWriteDescriptorSet> writes(images.size());
-  for (uint32_t i = 0; i < images.size(); ++i) {
-    infos[i] = {VK_NULL_HANDLE, images[i].view, images[i].layout};
-    writes[i] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
-    writes[i].dstSet = set;
-    writes[i].dstBinding = i;
-    writes[i].descriptorCount = 1;
-    writes[i].descriptorType = types[i];
-    writes[i].pImageInfo = &infos[i];
-  }
-  vkUpdateDescriptorSets(context_->device(), static_cast<uint32_t>(writes.size()), writes.data(), 0, nullptr);
-  return set;
+  std::vector<AnyBinding> bindings(images.size());
+  for (size_t i = 0; i < images.size(); ++i) bindings[i].image = images[i];
+  return make_mixed_set(pipeline, bindings);
 }
 
 VkDescriptorSet DescriptorArena::make_buffer_set(const ComputePipeline& pipeline, const std::vector<Buffer>& buffers) {
-  const auto& types = pipeline.bindings();
-  if (buffers.size() != types.size()) {
-    throw Error(ErrorCode::invalid_argument,
-                concat("descriptor set: ", buffers.size(), " buffers for ", types.size(), " bindings"));
-  }
-  VkDescriptorSet set = allocate(pipeline);
-  std::vector<VkDescriptorBufferInfo> infos(buffers.size());
-  std::vector<VkWriteDescriptorSet> writes(buffers.size());
-  for (uint32_t i = 0; i < buffers.size(); ++i) {
-    infos[i] = {buffers[i].buffer, buffers[i].offset, buffers[i].size};
-    writes[i] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
-    writes[i].dstSet = set;
-    writes[i].dstBinding = i;
-    writes[i].descriptorCount = 1;
-    writes[i].descriptorType = types[i];
-    writes[i].pBufferInfo = &infos[i];
-  }
-  vkUpdateDescriptorSets(context_->device(), static_cast<uint32_t>(writes.size()), writes.data(), 0, nullptr);
-  return set;
+  std::vector<AnyBinding> bindings(buffers.size());
+  for (size_t i = 0; i < buffers.size(); ++i) bindings[i].buffer = buffers[i];
+  return make_mixed_set(pipeline, bindings);
 }
 
-VkDescriptorSet DescriptorArena::make_mixed_set(const ComputePipeline& pipeline,
+VkDescriptorSet DescriptorArena::make_mixed_set(VkDescriptorSetLayout layout, const std::vector<VkDescriptorType>& types,
                                                 const std::vector<AnyBinding>& bindings) {
-  const auto& types = pipeline.bindings();
   if (bindings.size() != types.size()) {
-    throw Error(ErrorCode::invalid_argument, concat("descriptor set: ", bindings.size(), " bindings for ", types.size()));
+    throw Error(ErrorCode::invalid_argument,
+                concat("descriptor set: ", bindings.size(), " bindings for ", types.size()));
   }
-  VkDescriptorSet set = allocate(pipeline);
+  for (VkDescriptorType t : types) {
+    if (uint32_t(std::count(types.begin(), types.end(), t)) > per_type_) {
+      throw Error(ErrorCode::invalid_argument,
+                  concat("descriptor set: more descriptors of one type than the arena's ", per_type_, " per set"));
+    }
+  }
+  const VkDevice device = context_->device();
+  if (left_ == 0) {
+    const uint32_t n = sets_per_pool_;
+    VkDescriptorPoolSize sizes[] = {
+        {VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, n * per_type_},
+        {VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, n * per_type_},
+        {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, n * per_type_},
+        {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, n * per_type_},
+    };
+    VkDescriptorPoolCreateInfo info{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+    info.maxSets = n;
+    info.poolSizeCount = 4;
+    info.pPoolSizes = sizes;
+    VkDescriptorPool pool = VK_NULL_HANDLE;
+    vk_check(vkCreateDescriptorPool(device, &info, nullptr, &pool), "vkCreateDescriptorPool");
+    context_->state().count_object();
+    pools_.push_back(pool);
+    left_ = n;
+  }
+  VkDescriptorSetAllocateInfo alloc{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
+  alloc.descriptorPool = pools_.back();
+  alloc.descriptorSetCount = 1;
+  alloc.pSetLayouts = &layout;
+  VkDescriptorSet set = VK_NULL_HANDLE;
+  vk_check(vkAllocateDescriptorSets(device, &alloc, &set), "vkAllocateDescriptorSets");
+  context_->state().count_object();
+  --left_;
+
   std::vector<VkDescriptorImageInfo> images(bindings.size());
   std::vector<VkDescriptorBufferInfo> buffers(bindings.size());
   std::vector<VkWriteDescriptorSet> writes(bindings.size());
@@ -244,7 +228,7 @@ VkDescriptorSet DescriptorArena::make_mixed_set(const ComputePipeline& pipeline,
       writes[i].pImageInfo = &images[i];
     }
   }
-  vkUpdateDescriptorSets(context_->device(), static_cast<uint32_t>(writes.size()), writes.data(), 0, nullptr);
+  vkUpdateDescriptorSets(device, static_cast<uint32_t>(writes.size()), writes.data(), 0, nullptr);
   return set;
 }
 

@@ -84,26 +84,25 @@ class ComputePipeline {
   std::vector<VkDescriptorType> bindings_;
 };
 
-/// A descriptor pool and the sets allocated from it, owned by one effect.
+/// Descriptor pools and the sets allocated from them, owned by one effect. Pools are made on
+/// demand, each for `sets_per_pool` sets of up to `per_type` descriptors of each type, so an arena
+/// never runs out (effects that make sets for each new caller image keep one arena for them).
 class DescriptorArena {
  public:
   DescriptorArena() = default;
-  DescriptorArena(const Context& context, uint32_t max_sets);
+  DescriptorArena(const Context& context, uint32_t sets_per_pool, uint32_t per_type = 4);
   DescriptorArena(DescriptorArena&& o) noexcept { *this = std::move(o); }
   DescriptorArena& operator=(DescriptorArena&& o) noexcept;
   DescriptorArena(const DescriptorArena&) = delete;
   DescriptorArena& operator=(const DescriptorArena&) = delete;
   ~DescriptorArena() { reset(); }
+  /// Frees every set and pool (the arena stays usable).
   void reset();
 
   struct ImageBinding {
     VkImageView view;
     VkImageLayout layout;
   };
-  /// Allocates a set for `pipeline` and writes one image per binding, in binding order.
-  VkDescriptorSet make_set(const ComputePipeline& pipeline, const std::vector<ImageBinding>& images);
-  /// The same for pipelines whose bindings are all storage buffers.
-  VkDescriptorSet make_buffer_set(const ComputePipeline& pipeline, const std::vector<Buffer>& buffers);
   /// One binding of a set that mixes images and buffers: `buffer.buffer` set means a buffer;
   /// `sampler` goes with the image of a combined image sampler binding.
   struct AnyBinding {
@@ -111,14 +110,24 @@ class DescriptorArena {
     Buffer buffer{};
     VkSampler sampler = VK_NULL_HANDLE;
   };
+  /// Allocates a set for `pipeline` and writes one image per binding, in binding order.
+  VkDescriptorSet make_set(const ComputePipeline& pipeline, const std::vector<ImageBinding>& images);
+  /// The same for pipelines whose bindings are all storage buffers.
+  VkDescriptorSet make_buffer_set(const ComputePipeline& pipeline, const std::vector<Buffer>& buffers);
   /// Allocates a set for `pipeline` and writes one image or buffer per binding, in binding order.
-  VkDescriptorSet make_mixed_set(const ComputePipeline& pipeline, const std::vector<AnyBinding>& bindings);
-
+  VkDescriptorSet make_mixed_set(const ComputePipeline& pipeline, const std::vector<AnyBinding>& bindings) {
+    return make_mixed_set(pipeline.set_layout(), pipeline.bindings(), bindings);
+  }
+  /// The same for any set layout (a graphics pipeline's) whose binding i has type types[i].
+  VkDescriptorSet make_mixed_set(VkDescriptorSetLayout layout, const std::vector<VkDescriptorType>& types,
+                                 const std::vector<AnyBinding>& bindings);
 
  private:
-  VkDescriptorSet allocate(const ComputePipeline& pipeline);
   const Context* context_ = nullptr;
-  VkDescriptorPool pool_ = VK_NULL_HANDLE;
+  uint32_t sets_per_pool_ = 0;
+  uint32_t per_type_ = 4;
+  uint32_t left_ = 0;  // sets the last pool can still give
+  std::vector<VkDescriptorPool> pools_;
 };
 
 }  // namespace glint::detail
