@@ -51,25 +51,15 @@ void run_bloom(BloomOptions& o) {
   const CpuImage input = io::read_exr(o.input);
   const VkExtent2D extent{input.width, input.height};
 
-  ContextOptions options;
-  options.device = o.device;
-  const Context context = Context::create(options);
+  const Context context = make_context(o.device);
   Bloom bloom(context, o.config);
   bloom.prepare(extent);  // throws unsupported_size before any image is made for a too-large input
-
-  detail::OwnedImage source(context, extent, VK_FORMAT_R32G32B32A32_SFLOAT, detail::kToolImageUsage);
-  detail::OwnedImage result(context, extent, VK_FORMAT_R16G16B16A16_SFLOAT, detail::kToolImageUsage);
-  detail::upload(context, source.image(), input);
   Profiler profiler(context);
-  context.run_once([&](VkCommandBuffer cmd) {
-    profiler.reset(cmd);
-    profiler.mark(cmd, "start");
-    bloom.record(cmd, source.image(), result.image(), &profiler);
-  });
-  const CpuImage output = detail::download(context, result.image());
-
-  std::printf("device: %s (%s)\n", context.info().name.c_str(), device_type_name(context.info().type));
-  std::printf("input: %s, %ux%u\n", o.input.c_str(), input.width, input.height);
+  const CpuImage output =
+      run_image_effect(context, input, profiler, [&](VkCommandBuffer cmd, Image& in, Image& out, Profiler* p) {
+        bloom.record(cmd, in, out, p);
+      });
+  print_device(context, o.input, input);
   std::printf("bloom: filter %s, %s intermediates, %u level%s", bloom_filter_name(o.config.filter), o.fp32 ? "fp32" : "fp16",
               bloom.levels(), bloom.levels() == 1 ? "" : "s");
   if (bloom.clamped()) {

@@ -37,11 +37,6 @@ std::array<float, 3> parse_sigmas(const std::string& text) {
   return s;
 }
 
-void print_device(const Context& context, const std::string& input, const CpuImage& image) {
-  std::printf("device: %s (%s)\n", context.info().name.c_str(), device_type_name(context.info().type));
-  std::printf("input: %s, %ux%u\n", input.c_str(), image.width, image.height);
-}
-
 void run_blur(const BlurOptions& o) {
   BlurPyramidConfig config;
   if (!o.sigmas.empty()) config.sigma_texels = parse_sigmas(o.sigmas);
@@ -51,20 +46,12 @@ void run_blur(const BlurOptions& o) {
   for (const std::string& n : names) check_output_path(n);
 
   const CpuImage input = io::read_exr(o.input);
-  ContextOptions options;
-  options.device = o.device;
-  const Context context = Context::create(options);
+  const Context context = make_context(o.device);
   BlurPyramid pyramid(context, config);
   pyramid.prepare({input.width, input.height});
-  detail::OwnedImage source(context, {input.width, input.height}, VK_FORMAT_R32G32B32A32_SFLOAT,
-                            detail::kToolImageUsage);
-  detail::upload(context, source.image(), input);
   Profiler profiler(context);
-  context.run_once([&](VkCommandBuffer cmd) {
-    profiler.reset(cmd);
-    profiler.mark(cmd, "start");
-    pyramid.record(cmd, source.image(), &profiler);
-  });
+  run_on_input(context, input, profiler,
+               [&](VkCommandBuffer cmd, Image& source, Profiler* p) { pyramid.record(cmd, source, p); });
   print_device(context, o.input, input);
   print_stages(profiler);
   for (uint32_t k = 1; k <= 3; ++k) {
@@ -102,21 +89,14 @@ void run_gauss(GaussOptions& o) {
 
   const CpuImage input = io::read_exr(o.input);
   const VkExtent2D extent{input.width, input.height};
-  ContextOptions options;
-  options.device = o.device;
-  const Context context = Context::create(options);
+  const Context context = make_context(o.device);
   GaussianBlur blur(context, o.config);
   blur.prepare(extent);
-  detail::OwnedImage source(context, extent, VK_FORMAT_R32G32B32A32_SFLOAT, detail::kToolImageUsage);
-  detail::OwnedImage result(context, extent, VK_FORMAT_R16G16B16A16_SFLOAT, detail::kToolImageUsage);
-  detail::upload(context, source.image(), input);
   Profiler profiler(context);
-  context.run_once([&](VkCommandBuffer cmd) {
-    profiler.reset(cmd);
-    profiler.mark(cmd, "start");
-    blur.record(cmd, source.image(), result.image(), &profiler);
-  });
-  const CpuImage output = detail::download(context, result.image());
+  const CpuImage output =
+      run_image_effect(context, input, profiler, [&](VkCommandBuffer cmd, Image& in, Image& out, Profiler* p) {
+        blur.record(cmd, in, out, p);
+      });
   print_device(context, o.input, input);
   const BlurChoice& c = blur.choice();
   std::printf("method: %s%s (asked: %s)", to_string(c.method), c.linear_sampling ? " with linear sampling" : "",

@@ -7,6 +7,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include "core/cpu_image.h"
+
 #include <functional>
 #include <string>
 
@@ -47,5 +49,20 @@ void add_device_option(CLI::App& sub, std::string& device);
 
 /// Prints each profiler stage and the total in ms, or a note when the device has no timestamps.
 void print_stages(const Profiler& profiler);
+
+/// The context a command runs on: standalone, on --device (empty: the default choice).
+Context make_context(const std::string& device);
+
+/// Prints "device: NAME (TYPE)" and "input: PATH, WxH".
+void print_device(const Context& context, const std::string& input_path, const CpuImage& input);
+
+/// Uploads `input` as RGBA32F and, in one submission, records `effect` after the profiler's
+/// reset and "start" mark. The effect gets the input image and a profiler to mark.
+void run_on_input(const Context& context, const CpuImage& input, Profiler& profiler,
+                  const std::function<void(VkCommandBuffer, Image& source, Profiler*)>& effect);
+
+/// run_on_input() with an RGBA16F output image of the same size, which is read back and returned.
+CpuImage run_image_effect(const Context& context, const CpuImage& input, Profiler& profiler,
+                          const std::function<void(VkCommandBuffer, Image& source, Image& result, Profiler*)>& effect);
 
 }  // namespace glint::cli

@@ -4,6 +4,8 @@
 #include <filesystem>
 
 #include "cli/commands.h"
+#include "core/resources.h"
+#include "core/transfer.h"
 #include "io/exr_io.h"
 
 namespace glint::cli {
@@ -67,6 +69,38 @@ void print_stages(const Profiler& profiler) {
   std::printf("GPU time per stage:\n");
   for (const auto& s : stages) std::printf("  %-28s %9.3f ms\n", s.label.c_str(), s.ms);
   std::printf("  %-28s %9.3f ms\n", "total", profiler.total_ms());
+}
+
+Context make_context(const std::string& device) {
+  ContextOptions options;
+  options.device = device;
+  return Context::create(options);
+}
+
+void print_device(const Context& context, const std::string& input_path, const CpuImage& input) {
+  std::printf("device: %s (%s)\n", context.info().name.c_str(), device_type_name(context.info().type));
+  std::printf("input: %s, %ux%u\n", input_path.c_str(), input.width, input.height);
+}
+
+void run_on_input(const Context& context, const CpuImage& input, Profiler& profiler,
+                  const std::function<void(VkCommandBuffer, Image& source, Profiler*)>& effect) {
+  detail::OwnedImage source(context, {input.width, input.height}, VK_FORMAT_R32G32B32A32_SFLOAT,
+                            detail::kToolImageUsage);
+  detail::upload(context, source.image(), input);
+  context.run_once([&](VkCommandBuffer cmd) {
+    profiler.reset(cmd);
+    profiler.mark(cmd, "start");
+    effect(cmd, source.image(), &profiler);
+  });
+}
+
+CpuImage run_image_effect(const Context& context, const CpuImage& input, Profiler& profiler,
+                          const std::function<void(VkCommandBuffer, Image& source, Image& result, Profiler*)>& effect) {
+  detail::OwnedImage result(context, {input.width, input.height}, VK_FORMAT_R16G16B16A16_SFLOAT,
+                            detail::kToolImageUsage);
+  run_on_input(context, input, profiler,
+               [&](VkCommandBuffer cmd, Image& source, Profiler* p) { effect(cmd, source, result.image(), p); });
+  return detail::download(context, result.image());
 }
 
 }  // namespace glint::cli

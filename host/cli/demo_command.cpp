@@ -72,9 +72,7 @@ void run_demo(const DemoOptions& o) {
   }
   const auto out_path = [&](const char* name) { return (fs::path(o.out_dir) / name).string(); };
 
-  ContextOptions options;
-  options.device = o.device;
-  const Context context = Context::create(options);
+  const Context context = make_context(o.device);
   Bloom bloom(context);  // the default BloomConfig
   bloom.prepare(extent);
   const demo::FlareScene flare_scene = demo::make_flare_scene(extent);

@@ -122,9 +122,7 @@ void run_flare(const FlareOptions& o) {
   float max_size = 1.0f;
   for (const auto& l : lights.lights) max_size = std::max(max_size, l.size_px);
 
-  ContextOptions options;
-  options.device = o.device;
-  const Context context = Context::create(options);
+  const Context context = make_context(o.device);
   const VkExtent2D extent{color_in.width, color_in.height};
   FlarePassConfig pc;
   pc.extent = extent;

@@ -112,9 +112,7 @@ Command add_lod_command(CLI::App& app) {
             std::string header;
             const std::vector<Row> rows = read_queries(o->in, header);
 
-            ContextOptions options;
-            options.device = o->device;
-            Context ctx = Context::create(options);
+            Context ctx = make_context(o->device);
             std::vector<float> levels(rows.size());
             if (!rows.empty()) {
               const VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
