@@ -20,8 +20,14 @@ void main() {
   uint i = gl_GlobalInvocationID.x;
   if (i >= count) return;
   GlintLodQuery q = queries[i];
+#ifdef GLINT_PROBE_EXPLICIT_LOD
+  // The explicit-level variant: (dudx, dvdx) is the atlas UV and dudy the level, so the value read
+  // back shows how the device blends two levels for a given fractional level (mipmapPrecisionBits).
+  levels[i] = textureLod(level_atlas, vec2(q.dudx, q.dvdx), q.dudy).r;
+#else
   vec2 atlas_size = vec2(atlas.atlas_w, atlas.atlas_h);
   vec2 scale = vec2(q.tex_w, q.tex_h) / atlas_size;
   vec2 centre = (vec2(q.off_x, q.off_y) + 0.5 * vec2(q.tex_w, q.tex_h)) / atlas_size;
   levels[i] = textureGrad(level_atlas, centre, vec2(q.dudx, q.dvdx) * scale, vec2(q.dudy, q.dvdy) * scale).r;
+#endif
 }

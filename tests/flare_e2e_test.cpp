@@ -354,13 +354,33 @@ TEST_F(FlareEndToEndTest, ZeroLightsLeaveTheImageBitForBitAndFramesCreateNothing
 }
 
 TEST_F(FlareEndToEndTest, BadArgumentsThrowBeforeRecording) {
+  // The compute path holds at most maxStorageBufferRange / 48 instances (LensFlare::
+  // max_compute_instances()); the config accepts up to 2^24. The device decides which case applies:
+  // lavapipe's 128 MiB range holds fewer than 2^24, the H100's 4 GiB more.
   FlarePassConfig pc = pass_config(FlareDrawPath::compute);
-  pc.cull.capacity = 16777216;  // beyond any device's dispatch limit for the compute path
-  EXPECT_THROW(LensFlarePass(context(), pc), Error);
-  pc.clamp_capacity = true;
-  {
+  VkPhysicalDeviceProperties props;
+  vkGetPhysicalDeviceProperties(context().physical_device(), &props);
+  const uint64_t limit = props.limits.maxStorageBufferRange / sizeof(GlintFlareInstance);
+  constexpr uint32_t kMaxCapacity = 16777216;
+  if (limit < kMaxCapacity) {
+    pc.cull.capacity = uint32_t(limit) + 1;
+    try {
+      LensFlarePass too_many(context(), pc);
+      ADD_FAILURE() << "capacity " << pc.cull.capacity << " above the device's " << limit << " was accepted";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(std::to_string(limit)), std::string::npos) << e.what();
+    }
+    pc.clamp_capacity = true;
     LensFlarePass clamped(context(), pc);
     EXPECT_EQ(clamped.config().cull.capacity, clamped.flare().max_compute_instances());
+    EXPECT_EQ(uint64_t(clamped.config().cull.capacity), limit);
+  } else {
+    pc.cull.capacity = kMaxCapacity;  // within the device's range: accepted as is, clamped or not
+    for (bool clamp : {false, true}) {
+      pc.clamp_capacity = clamp;
+      LensFlarePass pass(context(), pc);
+      EXPECT_EQ(pass.config().cull.capacity, kMaxCapacity);
+    }
   }
   FlarePassConfig bad = pass_config(FlareDrawPath::raster);
   bad.max_size_px = -1.0f;

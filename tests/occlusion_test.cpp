@@ -693,6 +693,13 @@ TEST_F(OcclusionTest, BadConfigAndArgumentsThrow) {
   Buffer no_indirect = indirect.view;
   no_indirect.usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
   LightCullFrame frame;
+  VkPhysicalDeviceProperties props;
+  vkGetPhysicalDeviceProperties(context().physical_device(), &props);
+  LightCullConfig wide_config = cc;
+  wide_config.capacity = props.limits.maxComputeWorkGroupCount[0] / 65535 + 1;
+  LightCuller wide(context(), wide_config);
+  HostBuffer wide_inst(size_t(wide_config.capacity) * sizeof(GlintFlareInstance));
+  LightCullOutputs wide_out{wide_inst.view, indirect.view, stats.view, {}};
   const uint64_t objects = context().objects_created();
   context().run_once([&](VkCommandBuffer cmd) {
     expect_error([&] { hiz.record(cmd, other.state); }, ErrorCode::unsupported_size, "HiZConfig::extent is 64x64");
@@ -715,10 +722,12 @@ TEST_F(OcclusionTest, BadConfigAndArgumentsThrow) {
     bad.stats = {};
     expect_error([&] { culler.record(cmd, hiz, img.state, lights.view, 10, frame, bad); }, ErrorCode::invalid_argument,
                  "stats buffer is null");
+    // capacity x groups_per_instance groups must fit the device's maxComputeWorkGroupCount[0]
+    // (65535 on lavapipe, 2^31 - 1 on the H100): a capacity just above limit / 65535 exceeds it.
     LightCullFrame big = frame;
     big.groups_per_instance = 65535;
-    expect_error([&] { culler.record(cmd, hiz, img.state, lights.view, 10, big, out); }, ErrorCode::invalid_argument,
-                 "maxComputeWorkGroupCount");
+    expect_error([&] { wide.record(cmd, hiz, img.state, lights.view, 10, big, wide_out); },
+                 ErrorCode::invalid_argument, "maxComputeWorkGroupCount");
     LightCullFrame nan = frame;
     nan.view_proj[5] = std::nanf("");
     expect_error([&] { culler.record(cmd, hiz, img.state, lights.view, 10, nan, out); }, ErrorCode::invalid_argument,

@@ -68,9 +68,12 @@ reference::FlareAtlas read_flare_atlas(const LensFlare& flare) {
 }
 
 reference::SamplerPrecision flare_sampler_precision() {
-  VkPhysicalDeviceProperties p;
-  vkGetPhysicalDeviceProperties(context().physical_device(), &p);
-  return {p.limits.subTexelPrecisionBits, p.limits.mipmapPrecisionBits};
+  // The specification's minimums for every conformant device (Vulkan, "Limit Requirements":
+  // subTexelPrecisionBits >= 4, mipmapPrecisionBits >= 4), not the device's claim: a sampler is
+  // tested against its claims nowhere, and the NVIDIA H100 (claiming 8 and 8) filters the coarse
+  // atlas levels up to 3.6 times further from the exact value than 8 sub-texel bits allow, while
+  // staying within the guaranteed 4 bits (docs/FLARE.md "Tolerance").
+  return {4, 4};
 }
 
 FlareDeviation compare_flare(const CpuImage& gpu, const reference::FlareComposite& ref, VkFormat format) {

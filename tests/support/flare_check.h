@@ -17,7 +17,8 @@ namespace glint::test {
 /// atlas where the LensFlare keeps it.
 reference::FlareAtlas read_flare_atlas(const LensFlare& flare);
 
-/// The test device's subTexelPrecisionBits and mipmapPrecisionBits.
+/// The sub-texel and mipmap precision every conformant Vulkan device guarantees (4 and 4 bits),
+/// which the flare tolerances are derived from.
 reference::SamplerPrecision flare_sampler_precision();
 
 struct FlareDeviation {
