@@ -1,5 +1,7 @@
 #include "bench_support.h"
 
+#include "tooling/environment.h"
+
 #include <algorithm>
 #include <cstdio>
 #include <memory>
@@ -9,7 +11,7 @@ namespace glint::bench {
 
 const Context& context() {
   static std::unique_ptr<Context> ctx = [] {
-    auto c = std::make_unique<Context>(Context::create());
+    auto c = std::make_unique<Context>(Context::create(tools::context_options_from_environment()));
     std::fprintf(stderr, "glint_bench: device %s\n", c->info().name.c_str());
     return c;
   }();

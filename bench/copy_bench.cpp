@@ -25,7 +25,7 @@ void BM_CopyFloor(benchmark::State& state) {
   desc.kernel_id = "image_copy_rgba16f";
   desc.bindings = {VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE};
   desc.push_constant_bytes = sizeof(BloomPush);
-  desc.workgroup = detail::choose_workgroup_2d(ctx.info());
+  desc.workgroup = detail::choose_workgroup_2d(ctx);
   detail::ComputePipeline copy(ctx, desc);
   detail::DescriptorArena arena(ctx, 1);
   VkDescriptorSet set = arena.make_set(copy, {{src.state.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL},

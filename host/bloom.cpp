@@ -138,8 +138,9 @@ uint32_t bloom_shared_bytes(detail::Workgroup2D g) {
 }
 
 // The device's preferred workgroup if its shared memory holds the tiles, else 8x8 (12 KiB).
-detail::Workgroup2D bloom_workgroup(const DeviceInfo& info) {
-  detail::Workgroup2D g = detail::choose_workgroup_2d(info);
+detail::Workgroup2D bloom_workgroup(const Context& context) {
+  const DeviceInfo& info = context.info();
+  detail::Workgroup2D g = detail::choose_workgroup_2d(context);
   if (bloom_shared_bytes(g) > info.max_shared_memory_bytes) g = {8, 8};
   if (bloom_shared_bytes(g) > info.max_shared_memory_bytes) {
     throw Error(ErrorCode::no_device, concat("bloom needs ", bloom_shared_bytes(g), " bytes of shared memory; device '",
@@ -427,7 +428,7 @@ Bloom::Bloom(const Context& context, const BloomConfig& config) : impl_(std::mak
   config.validate();
   impl_->context = &context;
   impl_->config = config;
-  impl_->workgroup = bloom_workgroup(context.info());
+  impl_->workgroup = bloom_workgroup(context);
   impl_->caller_arena = detail::DescriptorArena(context, 24);
   impl_->make_pipelines();
 }

@@ -330,12 +330,12 @@ Step fused_step(StepProgram& prog, const DeviceInfo& info, int src, int dst, VkE
 }
 
 // A plain per-texel step (upsample, dual down/up) with 2D workgroups.
-Step simple_step(StepProgram& prog, const DeviceInfo& info, const char* kernel, int src, int dst, VkExtent2D src_size,
+Step simple_step(StepProgram& prog, const char* kernel, int src, int dst, VkExtent2D src_size,
                  VkExtent2D dst_size, VkFormat dst_format, uint32_t flags, float max_value, std::string label,
                  std::vector<VkDescriptorType> bindings = {VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE,
                                                            VK_DESCRIPTOR_TYPE_STORAGE_IMAGE}) {
   Step s;
-  s.pipeline = &prog.pipeline(kernel, dst_format, detail::choose_workgroup_2d(info), {}, std::move(bindings));
+  s.pipeline = &prog.pipeline(kernel, dst_format, detail::choose_workgroup_2d(*prog.context), {}, std::move(bindings));
   s.src = src;
   s.dst = dst;
   s.push = make_push(src_size, dst_size, flags, max_value);
@@ -528,7 +528,7 @@ struct GaussianBlur::Impl {
       const detail::OwnedBuffer* buf = prog.add_taps(taps);
       const int scratch = add(size);
       for (int pass = 0; pass < 2; ++pass) {
-        Step s = simple_step(prog, info, "blur_linear", pass == 0 ? kInput : scratch, pass == 0 ? scratch : kOutput,
+        Step s = simple_step(prog, "blur_linear", pass == 0 ? kInput : scratch, pass == 0 ? scratch : kOutput,
                              size, size, pass == 0 ? lf : out_format, pass == 0 ? 0u : GLINT_BLUR_FLAG_VERTICAL,
                              max_value, pass == 0 ? "gauss linear horizontal" : "gauss linear vertical",
                              {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
@@ -577,7 +577,7 @@ struct GaussianBlur::Impl {
         src = dst;
         prev = e;
       }
-      prog.steps.push_back(simple_step(prog, info, "blur_upsample", src, kOutput, prev, size, out_format, 0u, max_value,
+      prog.steps.push_back(simple_step(prog, "blur_upsample", src, kOutput, prev, size, out_format, 0u, max_value,
                                        "gauss pyramid upsample"));
     } else {  // dual
       std::vector<VkExtent2D> sizes = {size};
@@ -585,7 +585,7 @@ struct GaussianBlur::Impl {
       for (uint32_t j = 1; j <= choice.levels; ++j) {
         const VkExtent2D e = half_extent(sizes.back());
         const int dst = add(e);
-        Step s = simple_step(prog, info, "blur_dual_down", ids.back(), dst, sizes.back(), e, lf,
+        Step s = simple_step(prog, "blur_dual_down", ids.back(), dst, sizes.back(), e, lf,
                              ids.back() == kInput ? sanitize : 0u, max_value, concat("gauss dual down ", j));
         s.push.offset = static_cast<float>(choice.dual_offset);
         prog.steps.push_back(std::move(s));
@@ -595,7 +595,7 @@ struct GaussianBlur::Impl {
       // Up: level j is rewritten from level j+1 (its downsampled content is no longer needed).
       for (uint32_t j = choice.levels; j-- > 0;) {
         const bool last = j == 0;
-        Step s = simple_step(prog, info, "blur_dual_up", ids[j + 1], last ? kOutput : ids[j], sizes[j + 1], sizes[j],
+        Step s = simple_step(prog, "blur_dual_up", ids[j + 1], last ? kOutput : ids[j], sizes[j + 1], sizes[j],
                              last ? out_format : lf, 0u, max_value, concat("gauss dual up ", j));
         s.push.offset = static_cast<float>(choice.dual_offset);
         prog.steps.push_back(std::move(s));

@@ -32,7 +32,7 @@ DemoPipelines& pipelines_for(const Context& context, VkFormat format) {
     d.kernel_id = fp32 ? "demo_starfield_rgba32f" : "demo_starfield_rgba16f";
     d.bindings = {VK_DESCRIPTOR_TYPE_STORAGE_IMAGE};
     d.push_constant_bytes = sizeof(StarfieldPush);
-    d.workgroup = detail::choose_workgroup_2d(context.info());
+    d.workgroup = detail::choose_workgroup_2d(context);
     dp->pipeline = detail::ComputePipeline(context, d);
     dp->arena = detail::DescriptorArena(context, 16);
     return dp;

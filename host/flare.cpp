@@ -181,7 +181,7 @@ void LensFlare::Impl::make_atlas() {
   d.kernel_id = "flare_atlas_main";
   d.bindings = {VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE};
   d.push_constant_bytes = sizeof(GlintFlareAtlasPush);
-  d.workgroup = detail::choose_workgroup_2d(context->info());
+  d.workgroup = detail::choose_workgroup_2d(*context);
   atlas_pipeline = detail::ComputePipeline(*context, d);
   atlas_sets_arena = detail::DescriptorArena(*context, levels);
   const VkImageLayout G = VK_IMAGE_LAYOUT_GENERAL;
@@ -431,7 +431,7 @@ LensFlare::LensFlare(const Context& context, VkFormat color_format, VkExtent2D e
   m.storage_alignment = std::max<VkDeviceSize>(1, props.limits.minStorageBufferOffsetAlignment);
   // The gather's workgroup: 32x8 on GPUs (a 32x64 tile; on the H100 it beat 16x8, whose tiles bin
   // every instance twice as often: docs/FLARE.md), the device's 2D choice (8x8) on CPU devices.
-  m.workgroup = detail::choose_workgroup_2d(context.info());
+  m.workgroup = detail::choose_workgroup_2d(context);
   if (context.info().type != VK_PHYSICAL_DEVICE_TYPE_CPU && context.info().max_workgroup_invocations >= 256 &&
       context.info().subgroup_size >= 32) {
     m.workgroup = {32, 8};

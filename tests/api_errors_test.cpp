@@ -28,6 +28,7 @@
 #include "core/context_state.h"
 #include "core/transfer.h"
 #include "support/gpu_test.h"
+#include "tooling/environment.h"
 
 namespace glint::test {
 namespace {
@@ -481,7 +482,7 @@ uint64_t rss_bytes() {
 ContextOptions validated() {
   ContextOptions o;
   o.validation = true;
-  return o;
+  return tools::context_options_from_environment(o);
 }
 
 // The object tracker of the validation layer reports every object still alive when a device is

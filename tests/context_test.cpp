@@ -12,6 +12,7 @@
 #include "demo_scene.h"
 #include "reference/bloom_reference.h"
 #include "support/gpu_test.h"
+#include "tooling/environment.h"
 
 namespace glint::test {
 namespace {
@@ -41,6 +42,69 @@ TEST_F(ContextTest, UnknownDeviceIsAClearError) {
   }
   options.device = "99";
   EXPECT_THROW(Context::create(options), Error);
+}
+
+// ContextOptions::workgroup_2d replaces every image kernel's workgroup choice; out-of-range values
+// are refused naming the field and the device's limit.
+TEST_F(ContextTest, WorkgroupOverrideIsCheckedAndUsed) {
+  ContextOptions options;
+  options.workgroup_2d = {8, 4};
+  const Context forced = Context::create(options);
+  const detail::Workgroup2D g = detail::choose_workgroup_2d(forced);
+  EXPECT_EQ(g.x, 8u);
+  EXPECT_EQ(g.y, 4u);
+  for (VkExtent2D bad : {VkExtent2D{0, 8}, VkExtent2D{8, 0}, VkExtent2D{4096, 4096}}) {
+    options.workgroup_2d = bad;
+    try {
+      Context::create(options);
+      ADD_FAILURE() << bad.width << "x" << bad.height << ": no error";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.code(), ErrorCode::invalid_argument);
+      EXPECT_NE(std::string(e.what()).find("ContextOptions::workgroup_2d = " + std::to_string(bad.width) + "x" +
+                                           std::to_string(bad.height)),
+                std::string::npos)
+          << e.what();
+      EXPECT_NE(std::string(e.what()).find("maxComputeWorkGroupInvocations"), std::string::npos) << e.what();
+    }
+  }
+  ContextOptions gpu_av_alone;
+  gpu_av_alone.gpu_assisted_validation = true;
+  EXPECT_THROW(Context::create(gpu_av_alone), Error);
+}
+
+// The tools' environment mapping: GLINT_* variables become ContextOptions fields, malformed values
+// are errors naming the variable (the library itself reads none: see the nm check in glint.sh).
+TEST(ContextEnvironment, ToolsMapGlintVariablesToOptions) {
+  struct Restore {
+    ~Restore() {
+      unsetenv("GLINT_WORKGROUP");
+      unsetenv("GLINT_GPU_AV");
+    }
+  } restore;
+  setenv("GLINT_WORKGROUP", "16x4", 1);
+  ContextOptions o = tools::context_options_from_environment();
+  EXPECT_EQ(o.workgroup_2d.width, 16u);
+  EXPECT_EQ(o.workgroup_2d.height, 4u);
+  for (const char* bad : {"16by8", "16x", "0x8", "16x8x2"}) {
+    setenv("GLINT_WORKGROUP", bad, 1);
+    try {
+      tools::context_options_from_environment();
+      ADD_FAILURE() << bad << ": no error";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("GLINT_WORKGROUP"), std::string::npos) << e.what();
+    }
+  }
+  unsetenv("GLINT_WORKGROUP");
+  setenv("GLINT_GPU_AV", "yes", 1);
+  EXPECT_THROW(tools::context_options_from_environment(), Error);
+  setenv("GLINT_GPU_AV", "1", 1);
+  o = tools::context_options_from_environment();
+  EXPECT_TRUE(o.gpu_assisted_validation && o.validation);
+  ContextOptions named;
+  named.device = "by-flag";
+  setenv("GLINT_DEVICE", "by-env", 1);
+  EXPECT_EQ(tools::context_options_from_environment(named).device, "by-flag");
+  unsetenv("GLINT_DEVICE");
 }
 
 // The validation layer reports a deliberately invalid call: without this, "no messages" could

@@ -18,6 +18,7 @@
 #include "core/resources.h"
 #include "core/transfer.h"
 #include "io/png_io.h"
+#include "tooling/environment.h"
 
 namespace glint {
 namespace {
@@ -123,7 +124,7 @@ int main_impl(int argc, char** argv) {
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--out") && i + 1 < argc) out_dir = argv[++i];
   }
-  const Context ctx = Context::create();
+  const Context ctx = Context::create(tools::context_options_from_environment());
   std::printf("device: %s\n\n", ctx.info().name.c_str());
   std::printf(
       "| filter | firefly_guard | max_brightness | value | energy spread | max step | centroid jitter px | mean energy "

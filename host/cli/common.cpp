@@ -7,6 +7,7 @@
 #include "core/resources.h"
 #include "core/transfer.h"
 #include "io/exr_io.h"
+#include "tooling/environment.h"
 
 namespace glint::cli {
 
@@ -73,8 +74,8 @@ void print_stages(const Profiler& profiler) {
 
 Context make_context(const std::string& device) {
   ContextOptions options;
-  options.device = device;
-  return Context::create(options);
+  options.device = device;  // --device wins over GLINT_DEVICE
+  return Context::create(tools::context_options_from_environment(options));
 }
 
 void print_device(const Context& context, const std::string& input_path, const CpuImage& input) {

@@ -73,11 +73,6 @@ VKAPI_ATTR VkBool32 VKAPI_CALL on_validation_message(
   return VK_FALSE;
 }
 
-bool env_flag(const char* name) {
-  const char* v = std::getenv(name);
-  return v && std::strcmp(v, "0") != 0 && *v != '\0';
-}
-
 bool layer_available(const char* name) {
   uint32_t n = 0;
   vkEnumerateInstanceLayerProperties(&n, nullptr);
@@ -94,7 +89,7 @@ std::string lower(std::string s) {
   return s;
 }
 
-VkInstance make_instance(bool validation, ContextState* state, VkDebugUtilsMessengerEXT* messenger) {
+VkInstance make_instance(bool validation, bool gpu_assisted, ContextState* state, VkDebugUtilsMessengerEXT* messenger) {
   VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
   app.pApplicationName = "glint";
   app.pEngineName = "glint";
@@ -106,19 +101,19 @@ VkInstance make_instance(bool validation, ContextState* state, VkDebugUtilsMesse
   if (validation) {
     if (!layer_available(kValidation)) {
       throw Error(ErrorCode::no_device,
-                  "validation requested (GLINT_VALIDATION=1 or ContextOptions::validation) but "
+                  "ContextOptions::validation is set but "
                   "VK_LAYER_KHRONOS_validation is not installed (Debian: vulkan-validationlayers)");
     }
     layers.push_back(kValidation);
     extensions.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
   }
   // Synchronization validation on; best practices off (it warns about choices, not errors).
-  // GLINT_GPU_AV=1 adds GPU-assisted validation (instrumented shaders check descriptor indexing
-  // and buffer bounds on the device); slow, so one CI step runs part of the suite with it.
+  // ContextOptions::gpu_assisted_validation adds GPU-assisted validation (instrumented shaders
+  // check descriptor indexing and buffer bounds on the device); slow.
   VkValidationFeatureEnableEXT enables[] = {VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT,
                                             VK_VALIDATION_FEATURE_ENABLE_GPU_ASSISTED_EXT};
   VkValidationFeaturesEXT features{VK_STRUCTURE_TYPE_VALIDATION_FEATURES_EXT};
-  features.enabledValidationFeatureCount = detail::env_flag("GLINT_GPU_AV") ? 2 : 1;
+  features.enabledValidationFeatureCount = gpu_assisted ? 2 : 1;
   features.pEnabledValidationFeatures = enables;
 
   VkDebugUtilsMessengerCreateInfoEXT messenger_info{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
@@ -169,9 +164,6 @@ int type_rank(VkPhysicalDeviceType t) {
 VkPhysicalDevice choose_device(VkInstance instance, std::string wanted) {
   auto devices = physical_devices(instance);
   if (devices.empty()) throw Error(ErrorCode::no_device, "no Vulkan device found (Debian: mesa-vulkan-drivers gives lavapipe)");
-  if (wanted.empty()) {
-    if (const char* env = std::getenv("GLINT_DEVICE")) wanted = env;
-  }
   std::vector<VkPhysicalDeviceProperties> props(devices.size());
   for (size_t i = 0; i < devices.size(); ++i) vkGetPhysicalDeviceProperties(devices[i], &props[i]);
   if (!wanted.empty()) {
@@ -307,8 +299,11 @@ Context Context::create(const ContextOptions& options) {
     }
   } guard{&s};
 
-  const bool validation = options.validation || detail::env_flag("GLINT_VALIDATION");
-  s.instance = detail::make_instance(validation, &s, &s.messenger);
+  if (options.gpu_assisted_validation && !options.validation) {
+    throw Error(ErrorCode::invalid_argument,
+                "ContextOptions::gpu_assisted_validation needs ContextOptions::validation = true");
+  }
+  s.instance = detail::make_instance(options.validation, options.gpu_assisted_validation, &s, &s.messenger);
   s.physical_device = detail::choose_device(s.instance, options.device);
   s.queue_family = detail::compute_queue_family(s.physical_device);
 
@@ -364,6 +359,17 @@ Context Context::create(const ContextOptions& options) {
   vk_check(vkCreateFence(s.device, &fence, nullptr, &s.fence), "vkCreateFence");
   detail::fill_info(s);
   s.dynamic_rendering = f13.dynamicRendering == VK_TRUE;
+  const VkExtent2D wg = options.workgroup_2d;
+  if (wg.width != 0 || wg.height != 0) {
+    const uint64_t n = uint64_t(wg.width) * wg.height;
+    if (wg.width == 0 || wg.height == 0 || n > s.info.max_workgroup_invocations) {
+      throw Error(ErrorCode::invalid_argument,
+                  concat("ContextOptions::workgroup_2d = ", wg.width, "x", wg.height,
+                         " is out of range: accepted 0x0 (the device's choice) or WxH with W, H >= 1 and W * H <= ",
+                         s.info.max_workgroup_invocations, " (maxComputeWorkGroupInvocations)"));
+    }
+    s.workgroup_2d = wg;
+  }
   guard.done = true;
   return Context(std::move(state));
 }
@@ -442,7 +448,7 @@ void Context::run_once(const std::function<void(VkCommandBuffer)>& record) const
 }
 
 std::vector<DeviceDescription> list_devices() {
-  VkInstance instance = detail::make_instance(false, nullptr, nullptr);
+  VkInstance instance = detail::make_instance(false, false, nullptr, nullptr);
   std::vector<DeviceDescription> out;
   try {
     auto devices = detail::physical_devices(instance);

@@ -27,6 +27,8 @@ struct ContextState {
   // whether the queue family can draw. LensFlare's raster path needs both.
   bool dynamic_rendering = false;
   bool graphics_queue = false;
+  // ContextOptions::workgroup_2d (0x0: each kernel's device-specific choice).
+  VkExtent2D workgroup_2d{0, 0};
   VkPhysicalDeviceMemoryProperties memory{};
 
   // Standalone helpers for run_once().

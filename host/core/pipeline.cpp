@@ -13,14 +13,11 @@
 
 namespace glint::detail {
 
-Workgroup2D choose_workgroup_2d(const DeviceInfo& info) {
-  // GLINT_WORKGROUP=WxH overrides the choice (for tuning benchmarks); ignored if malformed.
-  if (const char* env = std::getenv("GLINT_WORKGROUP")) {
-    unsigned w = 0, h = 0;
-    if (std::sscanf(env, "%ux%u", &w, &h) == 2 && w >= 1 && h >= 1 && w * h <= info.max_workgroup_invocations) {
-      return {w, h};
-    }
-  }
+Workgroup2D choose_workgroup_2d(const Context& context) {
+  const DeviceInfo& info = context.info();
+  // ContextOptions::workgroup_2d overrides the choice (checked when the context was made).
+  const VkExtent2D forced = context.state().workgroup_2d;
+  if (forced.width != 0) return {forced.width, forced.height};
   // CPU devices (lavapipe) run a workgroup per thread with 8-wide SIMD: 8x8 keeps groups small
   // enough to spread over cores. GPUs with 32/64-wide subgroups get 16x8: on an H100 it beat 8x8,
   // 16x16 and 32x8 for the bloom chain (docs/PERF.md), as a compromise between the shared-memory

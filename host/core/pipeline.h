@@ -15,7 +15,7 @@ struct Workgroup2D {
   uint32_t x = 8;
   uint32_t y = 8;
 };
-Workgroup2D choose_workgroup_2d(const DeviceInfo& info);
+Workgroup2D choose_workgroup_2d(const Context& context);
 
 struct PipelineDesc {
   std::string kernel_id;                   //!< e.g. "bloom_down_rgba16f"

@@ -60,13 +60,20 @@ struct DeviceDescription {
 /// Options for a standalone context (one that creates its own instance and device).
 struct ContextOptions {
   /// Which device: a decimal index into list_devices(), or a case-insensitive substring of the
-  /// device name. Empty: the GLINT_DEVICE environment variable if set, else the first discrete
-  /// GPU, else the first integrated GPU, else the first CPU device (lavapipe).
+  /// device name. Empty: the first discrete GPU, else the first integrated GPU, else the first CPU
+  /// device (lavapipe). The library reads no environment variable; the glint command, the tests
+  /// and the benchmarks map GLINT_DEVICE to this field.
   std::string device;
-  /// Enable VK_LAYER_KHRONOS_validation with synchronization validation. Also enabled when the
-  /// environment variable GLINT_VALIDATION=1 is set. Messages are counted (validation_messages())
-  /// and printed to stderr.
+  /// Enable VK_LAYER_KHRONOS_validation with synchronization validation. Messages are counted
+  /// (validation_messages()) and printed to stderr.
   bool validation = false;
+  /// Also enable GPU-assisted validation (instrumented shaders check descriptor and buffer accesses
+  /// on the device; slow). Needs `validation`.
+  bool gpu_assisted_validation = false;
+  /// The 2-D workgroup of every image kernel, for tuning benchmarks: 0x0 (default) lets each
+  /// kernel choose from the device's limits; else W x H with W, H >= 1 and W * H at most
+  /// maxComputeWorkGroupInvocations (checked by create()).
+  VkExtent2D workgroup_2d{0, 0};
 };
 
 /// What an engine hands glint when it adopts the engine's own Vulkan objects. glint never

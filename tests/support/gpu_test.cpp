@@ -1,5 +1,7 @@
 #include "support/gpu_test.h"
 
+#include "tooling/environment.h"
+
 #include <cmath>
 #include <cstdlib>
 #include <memory>
@@ -9,12 +11,10 @@ namespace glint::test {
 
 const Context& context() {
   static std::unique_ptr<Context> ctx = [] {
-    // Validation is always on, except where GLINT_VALIDATION=0 says the layer is absent (the lent
-    // GPU machine, which runs the hardware checks only).
+    // Validation is always on, except where GLINT_VALIDATION=0 says the layer is absent.
     ContextOptions options;
-    const char* env = std::getenv("GLINT_VALIDATION");
-    options.validation = !(env && std::string(env) == "0");
-    return std::make_unique<Context>(Context::create(options));
+    options.validation = true;
+    return std::make_unique<Context>(Context::create(tools::context_options_from_environment(options)));
   }();
   return *ctx;
 }
