@@ -71,7 +71,6 @@ void BM_FlareDraw(benchmark::State& state) {
   detail::OwnedImage color(ctx, {width, height}, format, detail::kToolImageUsage | VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT);
   detail::upload(ctx, color.state, random_hdr(width, height, 7));
   LensFlare flare(ctx, format, {width, height});
-  if (compute) flare.prepare_compute();
   const FlareConfig config = FlareConfig::preset(FlarePreset::cinematic);
 
   const std::vector<GlintFlareInstance> list = bench_lights(lights, width, height, mixed);

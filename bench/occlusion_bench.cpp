@@ -108,15 +108,13 @@ Buffer view(const detail::OwnedBuffer& b, VkBufferUsageFlags usage, bool after_c
   return v;
 }
 
-// Args: lights, grid N, compaction path (0 automatic, 2 shared: both run the order-preserving
-// compaction since issue 6; the argument is kept so earlier result files line up), per-light
-// results (0/1), and whether the Hi-Z build is timed with the cull (0/1).
+// Args: lights, grid N, per-light results (0/1), and whether the Hi-Z build is timed with the
+// cull (0/1).
 void BM_LightCull(benchmark::State& state) {
   const auto n = static_cast<uint32_t>(state.range(0));
   const auto grid = static_cast<uint32_t>(state.range(1));
-  const auto path = static_cast<CompactionPath>(state.range(2));
-  const bool with_results = state.range(3) != 0;
-  const bool with_hiz = state.range(4) != 0;
+  const bool with_results = state.range(2) != 0;
+  const bool with_hiz = state.range(3) != 0;
   const Context& ctx = context();
   const uint32_t w = 1920, h = 1080;
   // Flares of 8 to 128 pixels (the seed's default is 100).
@@ -128,7 +126,6 @@ void BM_LightCull(benchmark::State& state) {
   LightCullConfig cc;
   cc.capacity = std::max(n, 1u);
   cc.grid = grid;
-  cc.path = path;
   cc.max_lights = std::max(n, 1u);
   LightCuller culler(ctx, cc);
   const VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT;
@@ -219,19 +216,18 @@ void BM_LightCull(benchmark::State& state) {
 }
 
 BENCHMARK(BM_LightCull)
-    ->Args({10, 4, 0, 0, 0})
-    ->Args({1000, 4, 0, 0, 0})
-    ->Args({1000000, 4, 0, 0, 0})
-    ->Args({1000000, 4, 2, 0, 0})
-    ->Args({1000000, 4, 0, 1, 0})
-    ->Args({1000000, 1, 0, 0, 0})
-    ->Args({1000000, 8, 0, 0, 0})
-    ->Args({1000000, 16, 0, 0, 0})
-    ->Args({10, 4, 0, 0, 1})
-    ->Args({1000, 1, 0, 0, 0})
-    ->Args({1000, 8, 0, 0, 0})
-    ->Args({1000, 16, 0, 0, 0})
-    ->ArgNames({"n", "grid", "path", "results", "hiz"})
+    ->Args({10, 4, 0, 0})
+    ->Args({1000, 4, 0, 0})
+    ->Args({1000000, 4, 0, 0})
+    ->Args({1000000, 4, 1, 0})
+    ->Args({1000000, 1, 0, 0})
+    ->Args({1000000, 8, 0, 0})
+    ->Args({1000000, 16, 0, 0})
+    ->Args({10, 4, 0, 1})
+    ->Args({1000, 1, 0, 0})
+    ->Args({1000, 8, 0, 0})
+    ->Args({1000, 16, 0, 0})
+    ->ArgNames({"n", "grid", "results", "hiz"})
     ->UseManualTime()
     ->Unit(benchmark::kMicrosecond);
 

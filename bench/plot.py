@@ -135,7 +135,7 @@ def occlusion_points(path, lights):
             continue
         if not has_medians and b.get("run_type") == "aggregate":
             continue
-        m = re.search(r"n:(\d+)/grid:(\d+)/path:0/results:0/hiz:0", b["name"])
+        m = re.search(r"n:(\d+)/grid:(\d+)/(?:path:0/)?results:0/hiz:0", b["name"])
         if not m or int(m.group(1)) != lights:
             continue
         out.append((f"N={m.group(2)}", b["median_us"], b["mean_abs_error_vs_brute_force"]))

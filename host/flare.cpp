@@ -1,6 +1,7 @@
 // Lens-flare driver (issue 5, drawing half): validates, generates the element atlas, owns the
 // raster and compute pipelines, and records either path. docs/FLARE.md explains the choices.
 #include <glint/flare.h>
+#include <glint/occlusion.h>
 
 #include <algorithm>
 #include <cmath>
@@ -34,6 +35,8 @@ static_assert(offsetof(GlintFlarePush, indirect_word) == 84);
 static_assert(sizeof(GlintFlareAtlasPush) == 12);
 static_assert(sizeof(GlintFlareInstance) == 48 && sizeof(GlintFlareIndirect) == 32);
 static_assert(LensFlare::vertices_per_instance() == GLINT_FLARE_SPRITES * GLINT_FLARE_VERTICES_PER_SPRITE);
+// A LightCullFrame left at its defaults feeds the flare draw.
+static_assert(LightCullFrame{}.vertex_count == LensFlare::vertices_per_instance());
 // Tiles and the atlas must be aligned to the coarsest level so no mip texel straddles two tiles.
 static_assert(GLINT_FLARE_ATLAS_WIDTH % (1u << (GLINT_FLARE_ATLAS_LEVELS - 1)) == 0);
 static_assert(GLINT_FLARE_ATLAS_HEIGHT % (1u << (GLINT_FLARE_ATLAS_LEVELS - 1)) == 0);
@@ -454,7 +457,6 @@ LensFlare::~LensFlare() = default;
 uint32_t LensFlare::groups_per_instance() const { return 1; }
 uint32_t LensFlare::max_compute_instances() const { return impl_->max_compute_instances; }
 void LensFlare::record_setup(VkCommandBuffer cmd) { impl_->record_setup(cmd); }
-void LensFlare::prepare_compute() {}  // the gather owns no buffers
 VkFormat LensFlare::color_format() const { return impl_->format; }
 VkExtent2D LensFlare::extent() const { return impl_->extent; }
 

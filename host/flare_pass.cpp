@@ -100,7 +100,6 @@ struct LensFlarePass::Impl {
         hiz(ctx, hiz_config(c)),
         culler(ctx, cull_config(c, flare)) {
     config.cull = culler.config();
-    if (c.draw == FlareDrawPath::compute) flare.prepare_compute();
     instances = OwnedView(ctx, VkDeviceSize(config.cull.capacity) * sizeof(GlintFlareInstance), kStorage);
     indirect = OwnedView(ctx, sizeof(GlintFlareIndirect), kStorage | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT);
     stats = OwnedView(ctx, sizeof(GlintFlareStats), kStorage);

@@ -320,11 +320,6 @@ void LightCullConfig::validate() const {
   check_range("LightCullConfig::margin_ndc", margin_ndc, 1.0, 8.0);
   check_range("LightCullConfig::depth_bias", depth_bias, 0.0, 0.1);
   check_uint("LightCullConfig::max_lights", max_lights, 1, uint64_t(kMaxGroupsX) * kCullGroup);
-  const auto p = static_cast<uint32_t>(path);
-  if (p > 2) {
-    throw Error(ErrorCode::invalid_argument,
-                concat("LightCullConfig::path = ", p, " is not a CompactionPath: accepted automatic, ballot, shared"));
-  }
   const auto q = static_cast<uint32_t>(pattern);
   if (q > 1) {
     throw Error(ErrorCode::invalid_argument, concat("LightCullConfig::pattern = ", q,
@@ -416,7 +411,6 @@ LightCuller& LightCuller::operator=(LightCuller&&) noexcept = default;
 LightCuller::~LightCuller() = default;
 
 const LightCullConfig& LightCuller::config() const { return impl_->config; }
-CompactionPath LightCuller::path() const { return CompactionPath::shared; }
 
 void LightCuller::record(VkCommandBuffer cmd, HiZPyramid& hiz, Image& depth, Buffer& lights, uint32_t count,
                          const LightCullFrame& frame, LightCullOutputs& out, Profiler* profiler) {

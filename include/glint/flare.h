@@ -121,9 +121,6 @@ class LensFlare {
   /// Records the atlas generation if it has not been recorded yet (adopted contexts; a no-op on
   /// standalone ones). record_*() call it themselves; call it earlier to keep the first frame short.
   void record_setup(VkCommandBuffer cmd);
-  /// Does nothing: the compute path no longer has an accumulation buffer. Kept for source
-  /// compatibility.
-  void prepare_compute();
 
   /// Raster path: one vkCmdDrawIndirect of all instances inside vkCmdBeginRendering (dynamic
   /// rendering, load and store, no depth), additive ONE/ONE blending of premultiplied colour.

@@ -62,7 +62,7 @@ class LensFlarePass {
   /// targets alive never need it. Creates nothing; the next record() makes the sets again.
   void forget_caller_resources();
 
-  /// Makes every part (pipelines, atlas, buffers; the compute path's accumulation buffer too), so
+  /// Makes every part (pipelines, atlas, buffers), so
   /// that record() creates nothing. Throws Error for a bad config or one the device cannot run.
   LensFlarePass(const Context& context, const FlarePassConfig& config);
   LensFlarePass(const LensFlarePass&) = delete;

@@ -89,15 +89,6 @@ class HiZPyramid {
   std::unique_ptr<Impl> impl_;
 };
 
-/// Kept for source compatibility: since the compaction preserves light order (issue 6: a scan of
-/// per-workgroup visibility masks, no atomic decides a slot, no subgroup operation) every value
-/// runs the same kernels on every device, and LightCuller::path() returns shared.
-enum class CompactionPath : uint32_t {
-  automatic = 0,  //!< the order-preserving compaction (as every value)
-  ballot = 1,     //!< formerly one atomic per subgroup; now the same as automatic
-  shared = 2,     //!< the order-preserving compaction (what path() reports)
-};
-
 /// Where LightCuller's N x N occlusion samples read the Hi-Z pyramid (docs/OCCLUSION.md).
 enum class OcclusionPattern : uint32_t {
   /// One sample per cell at multi-jittered positions (distinct x and y over all N^2 samples), each
@@ -119,8 +110,6 @@ struct LightCullConfig {
                                    //!< still counts as visible there (0 to 0.1; the seed uses 0.01)
   uint32_t max_lights = 1u << 20;  //!< most lights per record() (1 to 4194240 = 65535 x 64); the
                                    //!< culler keeps 16 bytes per light (and 16 per 64) for it
-  /// Ignored (see CompactionPath).
-  CompactionPath path = CompactionPath::automatic;
   OcclusionPattern pattern = OcclusionPattern::multi_jittered;  //!< where the N x N samples read
 
   void validate() const;
@@ -129,7 +118,8 @@ struct LightCullConfig {
 /// Per-frame inputs of LightCuller::record().
 struct LightCullFrame {
   float view_proj[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};  //!< column-major (GLM)
-  uint32_t vertex_count = 4;         //!< written to GlintFlareIndirect::vertex_count (0 to 2^20)
+  uint32_t vertex_count = 54;        //!< written to GlintFlareIndirect::vertex_count (0 to 2^20);
+                                     //!< the default is LensFlare::vertices_per_instance()
   uint32_t groups_per_instance = 1;  //!< GlintFlareIndirect::group_count_x = instances x this
                                      //!< (0 to 65535; capacity x this must fit the device's
                                      //!< maxComputeWorkGroupCount[0])
@@ -181,8 +171,6 @@ class LightCuller {
               const LightCullFrame& frame, LightCullOutputs& outputs, Profiler* profiler = nullptr);
 
   const LightCullConfig& config() const;
-  /// CompactionPath::shared (the one compaction; kept for source compatibility).
-  CompactionPath path() const;
 
   struct Impl;
 

@@ -57,7 +57,7 @@ struct GlintCullPush {
   GLINT_INT width;            // viewport = depth image size in pixels
   GLINT_INT height;
   GLINT_UINT count;        // lights in the list
-  GLINT_UINT reserved0;    // was the capacity: the scatter writes the instances now
+  GLINT_UINT reserved0;    // 0; keeps the struct 16-byte aligned
   GLINT_UINT grid;         // N: N x N cells per footprint (1 to 16)
   GLINT_UINT levels;       // Hi-Z levels built above level 0 (0 to 14)
   GLINT_UINT flags;        // GLINT_CULL_*
