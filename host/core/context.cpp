@@ -423,6 +423,7 @@ void Context::run_once(const std::function<void(VkCommandBuffer)>& record) const
   if (s.adopted) {
     throw Error(ErrorCode::invalid_argument, "run_once() is for standalone contexts; an adopted context never submits");
   }
+  std::lock_guard<std::recursive_mutex> lock(s.submit_mutex);
   VkCommandBufferAllocateInfo alloc{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
   alloc.commandPool = s.command_pool;
   alloc.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;

@@ -31,9 +31,13 @@ struct ContextState {
   VkExtent2D workgroup_2d{0, 0};
   VkPhysicalDeviceMemoryProperties memory{};
 
-  // Standalone helpers for run_once().
+  // Standalone helpers for run_once(). The pool, the fence and the queue need external
+  // synchronization (Vulkan, "Threading Behavior"): run_once() holds submit_mutex from allocating
+  // its command buffer to the fence wait. Recursive, because a recording callback may make an
+  // effect whose constructor submits through run_once() on the same thread.
   VkCommandPool command_pool = VK_NULL_HANDLE;
   VkFence fence = VK_NULL_HANDLE;
+  std::recursive_mutex submit_mutex;
 
   VkDebugUtilsMessengerEXT messenger = VK_NULL_HANDLE;
   mutable std::mutex log_mutex;

@@ -11,6 +11,13 @@
 // - Effects record into the caller's VkCommandBuffer and never submit, wait or read back.
 // - Images are described by glint::Image, which also carries the caller's last use of the image
 //   (layout, stage, access). Effects write the state they leave the image in back into it.
+// - Threads. A Context may be used from several threads at once: its const member functions,
+//   run_once() (submissions are serialized inside), and constructing, preparing and destroying
+//   effects on it (the shared kernel and sampler caches are locked). An effect object is not:
+//   call one effect's members from one thread at a time. Different effects may record into
+//   different command buffers on different threads at the same time, as engines record in
+//   parallel. Command buffers, pools and queues follow Vulkan's external synchronization rules;
+//   glint touches only the command buffer passed to record().
 #pragma once
 
 #include <vulkan/vulkan.h>
@@ -139,6 +146,8 @@ class Context {
 
   /// Standalone contexts only: records commands with `record`, submits them, waits for the
   /// queue and returns. For tools and tests; effects never call it. Throws in adopted mode.
+  /// Safe from any thread: calls are serialized (one submission at a time); `record` may itself
+  /// call run_once() on the same thread.
   void run_once(const std::function<void(VkCommandBuffer)>& record) const;
 
   /// Number of validation-layer messages (errors and warnings) seen since creation, and their
