@@ -465,6 +465,9 @@ void Bloom::prepare(VkExtent2D extent) {
 }
 
 void Bloom::record(VkCommandBuffer cmd, Image& input, Image& output, Profiler* profiler) {
+  detail::check_command_buffer("Bloom::record", cmd);
+  detail::check_image_layout("Bloom::record", "input", input);
+  detail::check_image_layout("Bloom::record", "output", output);
   impl_->record(cmd, input, output, profiler);
 }
 

@@ -237,6 +237,7 @@ struct StepProgram {
     if (s.taps) {
       b.emplace_back();
       b[2].buffer.buffer = s.taps->buffer();
+      b[2].buffer.size = s.taps->size();
     }
     return b;
   }
@@ -414,6 +415,8 @@ void BlurPyramid::prepare(VkExtent2D input_extent) {
 }
 
 void BlurPyramid::record(VkCommandBuffer cmd, Image& input, Profiler* profiler) {
+  detail::check_command_buffer("BlurPyramid::record", cmd);
+  detail::check_image_layout("BlurPyramid::record", "input", input);
   check_image(*impl_->prog.context, input, "BlurPyramid::record", "input", VK_IMAGE_USAGE_SAMPLED_BIT,
               "VK_IMAGE_USAGE_SAMPLED_BIT");
   prepare(input.extent);
@@ -635,6 +638,9 @@ void GaussianBlur::prepare(VkExtent2D extent) {
 }
 
 void GaussianBlur::record(VkCommandBuffer cmd, Image& input, Image& output, Profiler* profiler) {
+  detail::check_command_buffer("GaussianBlur::record", cmd);
+  detail::check_image_layout("GaussianBlur::record", "input", input);
+  detail::check_image_layout("GaussianBlur::record", "output", output);
   const Context& ctx = *impl_->prog.context;
   check_image(ctx, input, "GaussianBlur::record", "input", VK_IMAGE_USAGE_SAMPLED_BIT, "VK_IMAGE_USAGE_SAMPLED_BIT");
   check_image(ctx, output, "GaussianBlur::record", "output", VK_IMAGE_USAGE_STORAGE_BIT, "VK_IMAGE_USAGE_STORAGE_BIT");

@@ -387,28 +387,9 @@ void LensFlare::Impl::check_inputs(const char* fn, const Image& color, VkImageUs
   }
   if ((color.usage & usage) != usage)
     throw Error(ErrorCode::missing_usage, concat(fn, ": color image lacks ", usage_name, " usage"));
-  if (!instances.buffer) throw Error(ErrorCode::invalid_argument, concat(fn, ": instances buffer is null"));
-  if (!(instances.usage & VK_BUFFER_USAGE_STORAGE_BUFFER_BIT)) {
-    throw Error(ErrorCode::missing_usage,
-                concat(fn, ": instances buffer lacks VK_BUFFER_USAGE_STORAGE_BUFFER_BIT usage"));
-  }
-  if (instances.size != VK_WHOLE_SIZE && instances.size < sizeof(GlintFlareInstance)) {
-    throw Error(ErrorCode::invalid_argument, concat(fn, ": instances buffer holds ", instances.size,
-                                                    " bytes; at least one GlintFlareInstance (48 bytes) is needed"));
-  }
-  if (!indirect.buffer) throw Error(ErrorCode::invalid_argument, concat(fn, ": indirect buffer is null"));
-  if (!(indirect.usage & VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT)) {
-    throw Error(ErrorCode::missing_usage,
-                concat(fn, ": indirect buffer lacks VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT usage"));
-  }
-  if (indirect.offset % 4 != 0) {
-    throw Error(ErrorCode::invalid_argument,
-                concat(fn, ": indirect offset = ", indirect.offset, " is not a multiple of 4"));
-  }
-  if (indirect.size != VK_WHOLE_SIZE && indirect.size < sizeof(GlintFlareIndirect)) {
-    throw Error(ErrorCode::invalid_argument,
-                concat(fn, ": indirect buffer holds ", indirect.size, " bytes; a GlintFlareIndirect needs 32"));
-  }
+  detail::check_image_layout(fn, "color", color);
+  detail::check_buffer(fn, "instances", instances, sizeof(GlintFlareInstance), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  detail::check_buffer(fn, "indirect", indirect, sizeof(GlintFlareIndirect), VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT);
 }
 
 LensFlare::LensFlare(const Context& context, VkFormat color_format, VkExtent2D extent)
@@ -456,7 +437,10 @@ LensFlare::~LensFlare() = default;
 
 uint32_t LensFlare::groups_per_instance() const { return 1; }
 uint32_t LensFlare::max_compute_instances() const { return impl_->max_compute_instances; }
-void LensFlare::record_setup(VkCommandBuffer cmd) { impl_->record_setup(cmd); }
+void LensFlare::record_setup(VkCommandBuffer cmd) {
+  detail::check_command_buffer("LensFlare::record_setup", cmd);
+  impl_->record_setup(cmd);
+}
 VkFormat LensFlare::color_format() const { return impl_->format; }
 VkExtent2D LensFlare::extent() const { return impl_->extent; }
 
@@ -475,6 +459,7 @@ FlareAtlasInfo LensFlare::atlas() const {
 
 void LensFlare::record_raster(VkCommandBuffer cmd, Image& color, Buffer& instances, Buffer& indirect,
                               const FlareConfig& config, Profiler* profiler) {
+  detail::check_command_buffer("LensFlare::record_raster", cmd);
   Impl& m = *impl_;
   m.check_inputs("LensFlare::record_raster", color, VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT,
                  "VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT", instances, indirect, config);
@@ -532,6 +517,7 @@ void LensFlare::record_raster(VkCommandBuffer cmd, Image& color, Buffer& instanc
 
 void LensFlare::record_compute(VkCommandBuffer cmd, Image& color, Buffer& instances, Buffer& indirect,
                                const FlareConfig& config, Profiler* profiler) {
+  detail::check_command_buffer("LensFlare::record_compute", cmd);
   Impl& m = *impl_;
   m.check_inputs("LensFlare::record_compute", color, VK_IMAGE_USAGE_STORAGE_BIT, "VK_IMAGE_USAGE_STORAGE_BIT",
                  instances, indirect, config);
@@ -540,7 +526,7 @@ void LensFlare::record_compute(VkCommandBuffer cmd, Image& color, Buffer& instan
                 "LensFlare::record_compute: indirect buffer lacks VK_BUFFER_USAGE_STORAGE_BUFFER_BIT usage (the "
                 "compute path reads the instance count from it)");
   }
-  if (instances.size != VK_WHOLE_SIZE && instances.size / sizeof(GlintFlareInstance) > max_compute_instances()) {
+  if (instances.size / sizeof(GlintFlareInstance) > max_compute_instances()) {
     throw Error(
         ErrorCode::invalid_argument,
         concat("LensFlare::record_compute: the instances buffer holds ", instances.size / sizeof(GlintFlareInstance),

@@ -117,6 +117,7 @@ LensFlarePass::~LensFlarePass() = default;
 
 void LensFlarePass::record(VkCommandBuffer cmd, Image& color, Image& depth, Buffer& lights, uint32_t count,
                            const float view_proj[16], const FlareConfig& look, Profiler* profiler) {
+  detail::check_command_buffer("LensFlarePass::record", cmd);
   Impl& m = *impl_;
   // Everything the parts would reject later is checked first, so a throw records nothing.
   if (view_proj == nullptr) throw Error(ErrorCode::invalid_argument, "LensFlarePass::record: view_proj is null");
@@ -158,12 +159,9 @@ void LensFlarePass::record(VkCommandBuffer cmd, Image& color, Image& depth, Buff
                 concat("LensFlarePass::record: count = ", count,
                        " is out of range: accepted 0 to cull.max_lights = ", m.config.cull.max_lights));
   }
-  if (!lights.buffer || !(lights.usage & VK_BUFFER_USAGE_STORAGE_BUFFER_BIT) ||
-      (lights.size != VK_WHOLE_SIZE && lights.size < VkDeviceSize(count) * sizeof(GlintFlareLight))) {
-    throw Error(ErrorCode::invalid_argument,
-                concat("LensFlarePass::record: lights must be a buffer with STORAGE usage holding count = ", count,
-                       " GlintFlareLight (", VkDeviceSize(count) * sizeof(GlintFlareLight), " bytes)"));
-  }
+  detail::check_buffer("LensFlarePass::record", "lights", lights,
+                       std::max<VkDeviceSize>(1, VkDeviceSize(count) * sizeof(GlintFlareLight)),
+                       VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
   LightCullFrame frame;
   std::copy(view_proj, view_proj + 16, frame.view_proj);
   frame.vertex_count = LensFlare::vertices_per_instance();

@@ -99,27 +99,19 @@ void LodBatch::forget_caller_resources() {
 
 void LodBatch::record(VkCommandBuffer cmd, Buffer& queries, Buffer& levels, uint32_t count, const LodAtlasConfig& atlas,
                       Profiler* profiler) {
+  detail::check_command_buffer("LodBatch::record", cmd);
   atlas.validate();
-  auto check = [&](const Buffer& b, const char* role, VkDeviceSize need) {
-    if (!b.buffer) throw Error(ErrorCode::invalid_argument, concat("LodBatch::record: ", role, " buffer is null"));
-    if (!(b.usage & VK_BUFFER_USAGE_STORAGE_BUFFER_BIT)) {
-      throw Error(ErrorCode::missing_usage,
-                  concat("LodBatch::record: ", role, " buffer lacks VK_BUFFER_USAGE_STORAGE_BUFFER_BIT usage"));
-    }
-    if (b.size != VK_WHOLE_SIZE && b.size < need) {
-      throw Error(ErrorCode::invalid_argument, concat("LodBatch::record: ", role, " buffer holds ", b.size, " bytes; ",
-                                                      count, " queries need ", need, ": accepted at least ", need,
-                                                      " bytes"));
-    }
-  };
-  check(queries, "queries", VkDeviceSize(count) * sizeof(LodQuery));
-  check(levels, "levels", VkDeviceSize(count) * sizeof(float));
-  if (count == 0) return;
   const uint32_t max_count = 65535u * 64u;  // one dispatch row of 64-wide groups
   if (count > max_count) {
     throw Error(ErrorCode::invalid_argument,
                 concat("LodBatch::record: count = ", count, " is out of range: accepted 0 to ", max_count));
   }
+  detail::check_buffer("LodBatch::record", "queries", queries,
+                       std::max<VkDeviceSize>(1, VkDeviceSize(count) * sizeof(LodQuery)),
+                       VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  detail::check_buffer("LodBatch::record", "levels", levels, std::max<VkDeviceSize>(1, VkDeviceSize(count) * sizeof(float)),
+                       VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  if (count == 0) return;
   VkDescriptorSet set = impl_->set_for(queries, levels);
   detail::Barriers b;
   b.use(queries, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_READ_BIT);

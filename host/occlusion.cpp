@@ -70,24 +70,6 @@ void check_uint(const char* name, uint64_t value, uint64_t lo, uint64_t hi) {
   }
 }
 
-void check_buffer(const char* where, const char* role, const Buffer& b, VkDeviceSize need, VkBufferUsageFlags usage) {
-  if (!b.buffer) throw Error(ErrorCode::invalid_argument, concat(where, ": ", role, " buffer is null"));
-  if ((b.usage & usage) != usage) {
-    throw Error(ErrorCode::missing_usage,
-                concat(where, ": ", role, " buffer lacks usage 0x", std::hex, usage & ~b.usage, std::dec,
-                       (usage & VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT ? " (needs STORAGE_BUFFER | INDIRECT_BUFFER)"
-                                                                    : " (needs STORAGE_BUFFER)")));
-  }
-  if (b.size != VK_WHOLE_SIZE && b.size < need) {
-    throw Error(ErrorCode::invalid_argument,
-                concat(where, ": ", role, " buffer holds ", b.size, " bytes; ", need, " needed"));
-  }
-  if (b.offset % 4 != 0) {
-    throw Error(ErrorCode::invalid_argument,
-                concat(where, ": ", role, " buffer offset = ", b.offset, " is not a multiple of 4"));
-  }
-}
-
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------
@@ -264,6 +246,8 @@ uint64_t HiZPyramid::min_bytes_moved() const {
 }
 
 void HiZPyramid::record(VkCommandBuffer cmd, Image& depth, Profiler* profiler) {
+  detail::check_command_buffer("HiZPyramid::record", cmd);
+  detail::check_image_layout("HiZPyramid::record", "depth", depth);
   Impl& m = *impl_;
   const char* where = "HiZPyramid::record";
   if (!depth.image || !depth.view)
@@ -414,6 +398,7 @@ const LightCullConfig& LightCuller::config() const { return impl_->config; }
 
 void LightCuller::record(VkCommandBuffer cmd, HiZPyramid& hiz, Image& depth, Buffer& lights, uint32_t count,
                          const LightCullFrame& frame, LightCullOutputs& out, Profiler* profiler) {
+  detail::check_command_buffer("LightCuller::record", cmd);
   Impl& m = *impl_;
   const char* where = "LightCuller::record";
   const HiZConfig& hc = hiz.config();
@@ -445,15 +430,15 @@ void LightCuller::record(VkCommandBuffer cmd, HiZPyramid& hiz, Image& depth, Buf
     throw Error(ErrorCode::missing_usage, concat(where, ": depth image lacks VK_IMAGE_USAGE_SAMPLED_BIT usage"));
   }
   const VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
-  check_buffer(where, "lights", lights, VkDeviceSize(count) * sizeof(GlintFlareLight), storage);
-  check_buffer(where, "instances", out.instances, VkDeviceSize(m.config.capacity) * sizeof(GlintFlareInstance),
+  detail::check_buffer(where, "lights", lights, VkDeviceSize(count) * sizeof(GlintFlareLight), storage);
+  detail::check_buffer(where, "instances", out.instances, VkDeviceSize(m.config.capacity) * sizeof(GlintFlareInstance),
                storage);
-  check_buffer(where, "indirect", out.indirect, sizeof(GlintFlareIndirect),
+  detail::check_buffer(where, "indirect", out.indirect, sizeof(GlintFlareIndirect),
                storage | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT);
-  check_buffer(where, "stats", out.stats, sizeof(GlintFlareStats), storage);
+  detail::check_buffer(where, "stats", out.stats, sizeof(GlintFlareStats), storage);
   const bool want_results = out.results.buffer != VK_NULL_HANDLE;
   if (want_results) {
-    check_buffer(where, "results", out.results, VkDeviceSize(count) * sizeof(GlintFlareLightResult), storage);
+    detail::check_buffer(where, "results", out.results, VkDeviceSize(count) * sizeof(GlintFlareLightResult), storage);
   }
   Buffer& results = want_results ? out.results : m.dummy_state;
 

@@ -283,6 +283,40 @@ std::vector<ApiCase> api_cases() {
                      fx.gauss.record(cmd, *images[0], *images[0]);
                    }});
 
+  // A null command buffer and image layouts outside the VkImageLayout enumeration.
+  cases.push_back({"Bloom::record null command buffer", ErrorCode::invalid_argument,
+                   {"Bloom::record", "command buffer is null"},
+                   [](Fixture& fx, VkCommandBuffer, std::vector<Image*>& images, auto&) {
+                     fx.bloom.record(VK_NULL_HANDLE, *images[0], *images[1]);
+                   }});
+  cases.push_back({"BlurPyramid::record null command buffer", ErrorCode::invalid_argument,
+                   {"BlurPyramid::record", "command buffer is null"},
+                   [](Fixture& fx, VkCommandBuffer, std::vector<Image*>& images, auto&) {
+                     fx.pyramid.record(VK_NULL_HANDLE, *images[0]);
+                   }});
+  cases.push_back({"GaussianBlur::record null command buffer", ErrorCode::invalid_argument,
+                   {"GaussianBlur::record", "command buffer is null"},
+                   [](Fixture& fx, VkCommandBuffer, std::vector<Image*>& images, auto&) {
+                     fx.gauss.record(VK_NULL_HANDLE, *images[0], *images[1]);
+                   }});
+  cases.push_back({"LodBatch::record null command buffer", ErrorCode::invalid_argument,
+                   {"LodBatch::record", "command buffer is null"},
+                   [](Fixture& fx, VkCommandBuffer, auto&, std::vector<Buffer*>& b) {
+                     fx.lod.record(VK_NULL_HANDLE, *b[0], *b[1], 16, LodAtlasConfig{});
+                   }});
+  cases.push_back({"Bloom::record input layout 12345", ErrorCode::invalid_argument,
+                   {"Bloom::record", "input Image::layout = 12345", "accepts"},
+                   [](Fixture& fx, VkCommandBuffer cmd, std::vector<Image*>& images, auto&) {
+                     images[0]->layout = static_cast<VkImageLayout>(12345);
+                     fx.bloom.record(cmd, *images[0], *images[1]);
+                   }});
+  cases.push_back({"GaussianBlur::record output layout PREINITIALIZED", ErrorCode::invalid_argument,
+                   {"GaussianBlur::record", "output Image::layout = VK_IMAGE_LAYOUT_PREINITIALIZED"},
+                   [](Fixture& fx, VkCommandBuffer cmd, std::vector<Image*>& images, auto&) {
+                     images[1]->layout = VK_IMAGE_LAYOUT_PREINITIALIZED;
+                     fx.gauss.record(cmd, *images[0], *images[1]);
+                   }});
+
   // LodAtlasConfig fields, through validate(), lod_level() and LodBatch::record.
   struct LodField {
     const char* name;
@@ -357,6 +391,28 @@ std::vector<ApiCase> api_cases() {
        ErrorCode::missing_usage,
        {"levels", "VK_BUFFER_USAGE_STORAGE_BUFFER_BIT"},
        [](Buffer&, Buffer& l, uint32_t&) { l.usage = 0; }},
+      {"queries size VK_WHOLE_SIZE",
+       ErrorCode::invalid_argument,
+       {"queries Buffer::size = VK_WHOLE_SIZE", "at least 512"},
+       [](Buffer& q, Buffer&, uint32_t&) { q.size = VK_WHOLE_SIZE; }},
+      {"levels size 0",
+       ErrorCode::invalid_argument,
+       {"levels Buffer::size = 0", "at least 64"},
+       [](Buffer&, Buffer& l, uint32_t&) { l.size = 0; }},
+      {"100000 queries in a 512-byte buffer",
+       ErrorCode::invalid_argument,
+       {"queries buffer holds 512 bytes", "accepted at least 3200000"},
+       [](Buffer& q, Buffer& l, uint32_t& n) {
+         q.size = l.size = 512;
+         n = 100000;
+       }},
+      {"misaligned offset",
+       ErrorCode::invalid_argument,
+       {"levels buffer offset = 2", "multiple of 4"},
+       [](Buffer&, Buffer& l, uint32_t&) {
+         l.offset = 2;
+         l.size = 128;
+       }},
       {"count above the maximum",
        ErrorCode::invalid_argument,
        {"count = 4194241", "accepted 0 to 4194240"},

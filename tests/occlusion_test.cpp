@@ -704,7 +704,7 @@ TEST_F(OcclusionTest, BadConfigAndArgumentsThrow) {
     expect_error([&] { culler.record(cmd, hiz, other.state, lights.view, 10, frame, out); },
                  ErrorCode::invalid_argument, "does not match the Hi-Z pyramid");
     expect_error([&] { culler.record(cmd, hiz, img.state, lights.view, 11, frame, out); }, ErrorCode::invalid_argument,
-                 "lights buffer holds 480 bytes; 528 needed");
+                 "lights buffer holds 480 bytes: accepted at least 528");
     expect_error([&] { culler.record(cmd, hiz, img.state, lights.view, cc.max_lights + 1, frame, out); },
                  ErrorCode::invalid_argument, "count = 1048577");
     LightCullOutputs bad = out;
@@ -714,7 +714,7 @@ TEST_F(OcclusionTest, BadConfigAndArgumentsThrow) {
     bad = out;
     bad.instances = small.view;
     expect_error([&] { culler.record(cmd, hiz, img.state, lights.view, 10, frame, bad); }, ErrorCode::invalid_argument,
-                 "instances buffer holds 8 bytes; 384 needed");
+                 "instances buffer holds 8 bytes: accepted at least 384");
     bad = out;
     bad.stats = {};
     expect_error([&] { culler.record(cmd, hiz, img.state, lights.view, 10, frame, bad); }, ErrorCode::invalid_argument,

@@ -36,4 +36,20 @@ inline void check_range(const char* name, double value, double lo, double hi) {
 
 const char* format_name(VkFormat format);
 
+/// The checks every effect makes on a caller's buffer before recording, in one place so that
+/// effects (and composites such as LensFlarePass) declare what they need instead of repeating
+/// the tests. `where` names the call ("LightCuller::record"), `role` the argument ("instances").
+/// Throws Error for a null buffer, a size of 0 or VK_WHOLE_SIZE (glint cannot query a VkBuffer's
+/// size, so the caller states it), fewer than `need` bytes, a missing usage flag, or an offset
+/// that is not a multiple of `offset_alignment`.
+void check_buffer(const char* where, const char* role, const Buffer& b, VkDeviceSize need, VkBufferUsageFlags usage,
+                  VkDeviceSize offset_alignment = 4);
+
+/// Throws Error(invalid_argument) for a null command buffer.
+void check_command_buffer(const char* where, VkCommandBuffer cmd);
+
+/// Throws Error(invalid_argument) if `image.layout` is not a VkImageLayout an image can be in
+/// (a value outside the enumeration, or PREINITIALIZED for an image glint would read).
+void check_image_layout(const char* where, const char* role, const Image& image);
+
 }  // namespace glint::detail

@@ -200,7 +200,8 @@ struct Image {
 struct Buffer {
   VkBuffer buffer = VK_NULL_HANDLE;
   VkDeviceSize offset = 0;             //!< a multiple of minStorageBufferOffsetAlignment
-  VkDeviceSize size = VK_WHOLE_SIZE;   //!< bytes from offset, or VK_WHOLE_SIZE
+  VkDeviceSize size = 0;               //!< bytes from offset that glint may use; required (glint cannot
+                                       //!< query a VkBuffer's size, so 0 and VK_WHOLE_SIZE are refused)
   VkBufferUsageFlags usage = 0;        //!< the usage the buffer was created with
   VkPipelineStageFlags2 stage = VK_PIPELINE_STAGE_2_NONE;
   VkAccessFlags2 access = VK_ACCESS_2_NONE;
