@@ -26,12 +26,12 @@ namespace glint {
 using detail::check_range;
 using detail::concat;
 
-static_assert(sizeof(GlintFlareGatherArgsPush) == 16);
-static_assert(sizeof(GlintFlarePush) == 88,
+static_assert(sizeof(GlintFlareGatherArgsPush) == 12);
+static_assert(sizeof(GlintFlarePush) == 84,
               "GlintFlarePush layout changed: update kernels/common/flare_params.h users");
 static_assert(offsetof(GlintFlarePush, ghost_pos0) == 52);
-static_assert(offsetof(GlintFlarePush, groups_per_instance) == 72);
-static_assert(offsetof(GlintFlarePush, indirect_word) == 84);
+static_assert(offsetof(GlintFlarePush, tile_w) == 72);
+static_assert(offsetof(GlintFlarePush, indirect_word) == 80);
 static_assert(sizeof(GlintFlareAtlasPush) == 12);
 static_assert(sizeof(GlintFlareInstance) == 48 && sizeof(GlintFlareIndirect) == 32);
 static_assert(LensFlare::vertices_per_instance() == GLINT_FLARE_SPRITES * GLINT_FLARE_VERTICES_PER_SPRITE);
@@ -364,7 +364,6 @@ GlintFlarePush LensFlare::Impl::push(const FlareConfig& c) const {
   p.ghost_pos2 = c.ghost_positions[2];
   p.ghost_pos3 = c.ghost_positions[3];
   p.ghost_pos4 = c.ghost_positions[4];
-  p.groups_per_instance = 1;
   p.tile_w = workgroup.x;
   p.tile_h = workgroup.y * GLINT_FLARE_GATHER_ROWS;
   p.indirect_word = 0;  // set by record_compute
@@ -537,7 +536,7 @@ void LensFlare::record_compute(VkCommandBuffer cmd, Image& color, Buffer& instan
 
   // The indirect arguments are read as words from a storage-buffer binding whose offset is rounded
   // down to minStorageBufferOffsetAlignment; the push constant says where group_count_x is.
-  const VkDeviceSize args_offset = indirect.offset + offsetof(GlintFlareIndirect, group_count_x);
+  const VkDeviceSize args_offset = indirect.offset + offsetof(GlintFlareIndirect, instance_count);
   const VkDeviceSize bound_offset = args_offset - args_offset % m.storage_alignment;
   const Buffer indirect_words{indirect.buffer, bound_offset,   args_offset - bound_offset + sizeof(uint32_t),
                               indirect.usage,  indirect.stage, indirect.access};
@@ -562,7 +561,7 @@ void LensFlare::record_compute(VkCommandBuffer cmd, Image& color, Buffer& instan
 
   GlintFlarePush p = m.push(config);
   p.indirect_word = uint32_t((args_offset - bound_offset) / sizeof(uint32_t));
-  GlintFlareGatherArgsPush ap{p.indirect_word, p.groups_per_instance, m.tiles_x, m.tiles_y};
+  GlintFlareGatherArgsPush ap{p.indirect_word, m.tiles_x, m.tiles_y};
   detail::Barriers b;
   // 1. The launch arguments: every tile when any instance is visible, none otherwise.
   b.use(indirect, kCompute, VK_ACCESS_2_SHADER_STORAGE_READ_BIT);

@@ -100,6 +100,13 @@ struct LensFlarePass::Impl {
         hiz(ctx, hiz_config(c)),
         culler(ctx, cull_config(c, flare)) {
     config.cull = culler.config();
+    // Every limit a frame could hit is checked here, not in record().
+    if (flare.groups_per_instance() > culler.max_groups_per_instance()) {
+      throw Error(ErrorCode::invalid_argument,
+                  concat("FlarePassConfig::cull.capacity = ", config.cull.capacity,
+                         " is out of range on this device: its flare dispatch needs ", flare.groups_per_instance(),
+                         " workgroups per instance and the device allows ", culler.max_groups_per_instance()));
+    }
     instances = OwnedView(ctx, VkDeviceSize(config.cull.capacity) * sizeof(GlintFlareInstance), kStorage);
     indirect = OwnedView(ctx, sizeof(GlintFlareIndirect), kStorage | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT);
     stats = OwnedView(ctx, sizeof(GlintFlareStats), kStorage);

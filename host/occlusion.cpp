@@ -31,6 +31,7 @@ static_assert(offsetof(GlintCullPush, flags) == 88);
 static_assert(offsetof(GlintCullPush, depth_bias) == 96);
 static_assert(sizeof(GlintCullCompactPush) == 32);
 static_assert(offsetof(GlintCullCompactPush, flags) == 16);
+static_assert(offsetof(GlintCullCompactPush, max_group_count_x) == 20);
 static_assert(sizeof(LightCullFrame::view_proj) == sizeof(GlintCullPush::view_proj));
 
 namespace {
@@ -315,6 +316,7 @@ struct LightCuller::Impl {
   const Context* context = nullptr;
   LightCullConfig config;
   uint32_t max_groups_x = kMaxGroupsX;
+  uint32_t max_groups_y = kMaxGroupsX;
   uint32_t scan_threads = 1;  // the scan's single workgroup
   // The three dispatches of a cull (docs/OCCLUSION.md): cull + grid test, scan, scatter.
   detail::ComputePipeline cull, scan, scatter;
@@ -353,6 +355,7 @@ LightCuller::LightCuller(const Context& context, const LightCullConfig& config) 
   VkPhysicalDeviceProperties props;
   vkGetPhysicalDeviceProperties(context.physical_device(), &props);
   m.max_groups_x = props.limits.maxComputeWorkGroupCount[0];
+  m.max_groups_y = props.limits.maxComputeWorkGroupCount[1];
   // CPU devices (lavapipe) run a workgroup's invocations a few at a time and pay for every barrier
   // per invocation: 64 there, where longer serial runs of masks per invocation cost little.
   const uint32_t scan_cap = context.info().type == VK_PHYSICAL_DEVICE_TYPE_CPU ? 64u : GLINT_CULL_SCAN_MAX_THREADS;
@@ -396,6 +399,14 @@ LightCuller::~LightCuller() = default;
 
 const LightCullConfig& LightCuller::config() const { return impl_->config; }
 
+uint32_t LightCuller::max_groups_per_instance() const {
+  const Impl& m = *impl_;
+  // capacity x groups workgroups as rows of max_groups_x: at most max_groups_y rows, and the
+  // scan's groups + max_groups_x - 1 must not wrap in 32 bits.
+  const uint64_t total = std::min<uint64_t>(uint64_t(m.max_groups_x) * m.max_groups_y, (1ull << 32) - m.max_groups_x);
+  return uint32_t(std::min<uint64_t>(65535, total / std::max(1u, m.config.capacity)));
+}
+
 void LightCuller::record(VkCommandBuffer cmd, HiZPyramid& hiz, Image& depth, Buffer& lights, uint32_t count,
                          const LightCullFrame& frame, LightCullOutputs& out, Profiler* profiler) {
   detail::check_command_buffer("LightCuller::record", cmd);
@@ -405,12 +416,13 @@ void LightCuller::record(VkCommandBuffer cmd, HiZPyramid& hiz, Image& depth, Buf
   // Everything is checked before anything is recorded.
   check_uint("LightCuller::record: count", count, 0, m.config.max_lights);
   check_uint("LightCullFrame::vertex_count", frame.vertex_count, 0, 1 << 20);
-  check_uint("LightCullFrame::groups_per_instance", frame.groups_per_instance, 0, 65535);
-  if (uint64_t(m.config.capacity) * frame.groups_per_instance > m.max_groups_x) {
+  if (frame.groups_per_instance > max_groups_per_instance()) {
     throw Error(ErrorCode::invalid_argument,
                 concat("LightCullFrame::groups_per_instance = ", frame.groups_per_instance,
-                       " times LightCullConfig::capacity = ", m.config.capacity,
-                       " exceeds the device's maxComputeWorkGroupCount[0] = ", m.max_groups_x));
+                       " is out of range for LightCullConfig::capacity = ", m.config.capacity,
+                       " on this device: accepted 0 to ", max_groups_per_instance(),
+                       " (capacity x groups must fit maxComputeWorkGroupCount[0] x [1] = ", m.max_groups_x, " x ",
+                       m.max_groups_y, ")"));
   }
   for (int i = 0; i < 16; ++i) {
     if (!std::isfinite(frame.view_proj[i])) {
@@ -515,6 +527,7 @@ void LightCuller::record(VkCommandBuffer cmd, HiZPyramid& hiz, Image& depth, Buf
   cp.vertex_count = frame.vertex_count;
   cp.groups_per_instance = frame.groups_per_instance;
   cp.flags = flags;
+  cp.max_group_count_x = m.max_groups_x;
   b.use(m.groups_state, kCompute, kStorageRead | kStorageWrite);
   b.use(out.indirect, kCompute, kStorageWrite);
   b.use(out.stats, kCompute, kStorageWrite);

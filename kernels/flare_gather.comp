@@ -4,8 +4,8 @@
 // Lens flares for compute-only engines (issue 5 "Compute path"), accumulated by gathering: one
 // workgroup per screen tile of GLINT_FLARE_GATHER_ROWS x workgroup pixels (each invocation keeps
 // its column's pixels in registers), no atomics on the image or on any global buffer.
-// 1. Binning: invocation t takes instance base + t (the count is group_count_x of the indirect
-//    arguments, read here, over groups_per_instance() = 1; indices past the buffer are skipped) and
+// 1. Binning: invocation t takes instance base + t (the count is instance_count of the indirect
+//    arguments, read here; indices past the buffer are skipped) and
 //    lists each of its sprites whose conservative rectangle (glint_flare_bounds) meets the tile in
 //    a shared list, at a position given by an exclusive prefix sum of the invocations' hit counts
 //    (Hillis & Steele 1986, in shared memory): the list is in (instance, slot) order, the order the
@@ -46,7 +46,7 @@ void main() {
   const vec2 tile_lo = vec2(tile0), tile_hi = vec2(tile0 + uvec2(pc.tile_w, pc.tile_h));
   const uvec2 p0 = tile0 + gl_LocalInvocationID.xy;
 
-  uint count = indirect_words[pc.indirect_word] / pc.groups_per_instance;
+  uint count = indirect_words[pc.indirect_word];  // GlintFlareIndirect::instance_count
   count = min(count, uint(instances.length()));
 
   vec3 sum[GLINT_FLARE_GATHER_ROWS];  // indexed by unrolled loops only, so it stays in registers

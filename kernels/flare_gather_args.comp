@@ -14,7 +14,7 @@ layout(std430, binding = 1) writeonly buffer Args { uint args[3]; };            
 layout(push_constant) uniform Push { GlintFlareGatherArgsPush pc; };
 
 void main() {
-  uint count = indirect_words[pc.indirect_word] / pc.groups_per_instance;
+  uint count = indirect_words[pc.indirect_word];  // GlintFlareIndirect::instance_count
   args[0] = count > 0u ? pc.tiles_x : 0u;
   args[1] = pc.tiles_y;
   args[2] = 1u;

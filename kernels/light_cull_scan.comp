@@ -59,8 +59,11 @@ void main() {
   indirect.instance_count = written;
   indirect.first_vertex = 0u;
   indirect.first_instance = 0u;
-  indirect.group_count_x = written * pc.groups_per_instance;
-  indirect.group_count_y = 1u;
+  // instances x groups_per_instance workgroups, as rows of at most maxComputeWorkGroupCount[0]
+  // (GlintFlareIndirect says how a kernel recovers its linear workgroup index).
+  const uint groups = written * pc.groups_per_instance;
+  indirect.group_count_x = min(groups, pc.max_group_count_x);
+  indirect.group_count_y = max(1u, (groups + pc.max_group_count_x - 1u) / pc.max_group_count_x);
   indirect.group_count_z = 1u;
   indirect.reserved = 0u;
   stats.total = pc.count;

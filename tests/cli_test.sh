@@ -241,13 +241,15 @@ import json, sys
 s = json.load(open(sys.argv[1]))
 assert s["total"] == 14 and s["frustum_culled"] == 2 and s["disabled"] == 1 and s["occluded"] > 3, s
 ' "$tmp/s_rev.json" || fail "glint flare --reverse-z stats: $(head -c 200 "$tmp/s_rev.json")"
-python3 - "$d/lights.json" "$tmp/empty_lights.json" "$tmp/many.json" <<'PY'
+python3 - "$d/lights.json" "$tmp/empty_lights.json" "$tmp/many.json" "$tmp/70k.json" <<'PY'
 import json, sys
 src = json.load(open(sys.argv[1]))
 json.dump({"view_proj": src["view_proj"], "lights": []}, open(sys.argv[2], "w"))
 # 2000 copies of the demo's first (visible) light: more than the compute path's capacity on some
 # devices is fine, overflow is reported per light.
 json.dump({"view_proj": src["view_proj"], "lights": [src["lights"][0]] * 2000}, open(sys.argv[3], "w"))
+# 70000 lights: more instances than one row of dispatch workgroups holds on some devices (65535).
+json.dump({"view_proj": src["view_proj"], "lights": [src["lights"][0]] * 70000}, open(sys.argv[4], "w"))
 PY
 ok flare --color "$d/scene.exr" --depth "$d/depth.exr" --lights "$tmp/empty_lights.json" "$tmp/f_none.exr" \
   --stats "$tmp/s_none.json"
@@ -260,6 +262,12 @@ s = json.load(open(sys.argv[1]))
 assert s["total"] == 2000 and s["visible"] == 2000 and len(s["lights"]) == 2000, s["total"]
 assert sum(l["culled"] is None for l in s["lights"]) + s["overflow"] == 2000
 ' "$tmp/s_many.json" || fail "glint flare with 2000 lights on one spot"
+ok flare --color "$d/scene.exr" --depth "$d/depth.exr" --lights "$tmp/70k.json" "$tmp/f_70k.exr" --stats "$tmp/s_70k.json"
+python3 -c '
+import json, sys
+s = json.load(open(sys.argv[1]))
+assert s["total"] == 70000 and s["visible"] == 70000 and s["overflow"] == 0, {k: s[k] for k in s if k != "lights"}
+' "$tmp/s_70k.json" || fail "glint flare with 70000 lights"
 
 # glint flare: bad command lines, files and light lists (exit 2, one line).
 bad flare "${flare_args[@]}"

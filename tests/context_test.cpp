@@ -276,3 +276,41 @@ TEST_F(ContextTest, PipelinesAreSharedAndACachedHelperCanMakeOne) {
 
 }  // namespace
 }  // namespace glint::test
+
+namespace glint::test {
+namespace {
+
+// Device memory is checked before it is allocated: a request beyond what the heap can give (its
+// VK_EXT_memory_budget budget where the device has the extension, else its size) is an Error
+// naming the bytes and the heap, not VK_ERROR_OUT_OF_DEVICE_MEMORY from deep inside an effect.
+TEST_F(ContextTest, AllocationBeyondTheHeapIsRefusedBeforeAllocating) {
+  detail::OwnedBuffer probe(context(), 256, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, false);
+  VkMemoryRequirements req;
+  vkGetBufferMemoryRequirements(context().device(), probe.buffer(), &req);
+  auto& s = context().state();
+  const uint32_t type = s.memory_type(req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+  const uint32_t heap = s.memory.memoryTypes[type].heapIndex;
+  req.size = s.memory.memoryHeaps[heap].size + req.alignment;
+  const uint64_t objects = context().objects_created();
+  try {
+    (void)s.allocate(req, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, "a test request");
+    ADD_FAILURE() << "no error for " << req.size << " bytes";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::unsupported_size);
+    const std::string what = e.what();
+    EXPECT_NE(what.find("a test request needs " + std::to_string(req.size) + " bytes of memory heap " +
+                        std::to_string(heap)),
+              std::string::npos)
+        << what;
+  }
+  EXPECT_EQ(context().objects_created(), objects);
+  // A request that fits is allocated and counted.
+  req.size = 4096;
+  VkDeviceMemory m = s.allocate(req, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, "a small request");
+  EXPECT_NE(m, VK_NULL_HANDLE);
+  EXPECT_EQ(context().objects_created(), objects + 1);
+  vkFreeMemory(context().device(), m, nullptr);
+}
+
+}  // namespace
+}  // namespace glint::test

@@ -171,7 +171,7 @@ struct CullRun {
 
 CullRun run_cull(const reference::DepthImage& depth, VkFormat format, bool reversed,
                  const std::vector<GlintFlareLight>& lights, const float view_proj[16], const LightCullConfig& config,
-                 uint32_t max_cell_px = 0, int frames = 1) {
+                 uint32_t max_cell_px = 0, int frames = 1, uint32_t groups_per_instance = 3) {
   auto img = make_depth(depth, format);
   HiZConfig hc;
   hc.extent = {depth.width, depth.height};
@@ -192,7 +192,7 @@ CullRun run_cull(const reference::DepthImage& depth, VkFormat format, bool rever
   LightCullFrame frame;
   std::copy(view_proj, view_proj + 16, frame.view_proj);
   frame.vertex_count = 6;
-  frame.groups_per_instance = 3;
+  frame.groups_per_instance = groups_per_instance;
   context().run_once([&](VkCommandBuffer cmd) {
     for (int f = 0; f < frames; ++f) {
       hiz.record(cmd, img.state);
@@ -383,6 +383,51 @@ TEST_F(OcclusionTest, CullOverflowAndRepeatedFrames) {
     EXPECT_EQ(run.indirect.instance_count, capacity);
     EXPECT_EQ(run.stats.overflow, run.stats.visible - capacity);
     expect_cull_matches(run, scene, config, false, 7, "overflow " + std::to_string(capacity));
+  }
+}
+
+// The README's maximum: a million lights, all visible, with more workgroups in their dispatch
+// arguments than one row of maxComputeWorkGroupCount[0] holds on lavapipe (65535): the scan writes
+// rows, and the largest groups_per_instance the culler reports still fits.
+TEST_F(OcclusionTest, AMillionVisibleLightsGiveDispatchArgumentsEveryDeviceAccepts) {
+  const uint32_t n = 1000000;
+  reference::DepthImage far{256, 256, std::vector<float>(256 * 256, 1.0f)};
+  std::vector<GlintFlareLight> lights(n);
+  for (uint32_t i = 0; i < n; ++i) {
+    GlintFlareLight& l = lights[i];
+    l = GlintFlareLight{};
+    l.position_x = -0.9f + 1.8f * float(i % 1000) / 999.0f;  // NDC with an identity view_proj
+    l.position_y = -0.9f + 1.8f * float(i / 1000) / 999.0f;
+    l.position_z = 0.5f;
+    l.intensity = l.color_r = l.color_g = l.color_b = 1.0f;
+    l.size_px = 2.0f;
+    l.enabled = 1;
+  }
+  const float vp[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+  LightCullConfig config;
+  config.capacity = n;
+  config.max_lights = n;
+  VkPhysicalDeviceProperties props;
+  vkGetPhysicalDeviceProperties(context().physical_device(), &props);
+  const uint64_t max_x = props.limits.maxComputeWorkGroupCount[0], max_y = props.limits.maxComputeWorkGroupCount[1];
+  const uint32_t most = LightCuller(context(), config).max_groups_per_instance();
+  ASSERT_GE(most, 3u);
+  for (uint32_t groups : {3u, most}) {
+    const auto run = run_cull(far, VK_FORMAT_D32_SFLOAT, false, lights, vp, config, 0, 1, groups);
+    const std::string what = "groups_per_instance " + std::to_string(groups);
+    EXPECT_EQ(run.stats.total, n) << what;
+    EXPECT_EQ(run.stats.visible, n) << what;
+    EXPECT_EQ(run.indirect.instance_count, n) << what;
+    ASSERT_EQ(run.instances.size(), n) << what;
+    for (uint32_t i = 0; i < n; i += 9973) EXPECT_EQ(run.instances[i].light_index, i) << what;
+    EXPECT_EQ(run.instances[n - 1].light_index, n - 1) << what;
+    // G = n x groups workgroups as rows: x within the device's limit, y rows cover G, no spare row.
+    const uint64_t g = uint64_t(n) * groups, x = run.indirect.group_count_x, y = run.indirect.group_count_y;
+    EXPECT_EQ(x, std::min(g, max_x)) << what;
+    EXPECT_LE(y, max_y) << what;
+    EXPECT_GE(x * y, g) << what;
+    EXPECT_LT((y - 1) * x, g) << what;
+    EXPECT_EQ(run.indirect.group_count_z, 1u) << what;
   }
 }
 
@@ -693,7 +738,12 @@ TEST_F(OcclusionTest, BadConfigAndArgumentsThrow) {
   VkPhysicalDeviceProperties props;
   vkGetPhysicalDeviceProperties(context().physical_device(), &props);
   LightCullConfig wide_config = cc;
-  wide_config.capacity = props.limits.maxComputeWorkGroupCount[0] / 65535 + 1;
+  // The dispatch arguments are rows of maxComputeWorkGroupCount[0] groups, at most [1] rows, and
+  // the group count must stay below 2^32 - [0]: a capacity just above that limit / 65535 cannot
+  // take 65535 groups per instance.
+  const uint64_t max_x = props.limits.maxComputeWorkGroupCount[0], max_y = props.limits.maxComputeWorkGroupCount[1];
+  const uint64_t group_limit = std::min(max_x * max_y, (uint64_t(1) << 32) - max_x);
+  wide_config.capacity = uint32_t(group_limit / 65535 + 1);
   LightCuller wide(context(), wide_config);
   HostBuffer wide_inst(size_t(wide_config.capacity) * sizeof(GlintFlareInstance));
   LightCullOutputs wide_out{wide_inst.view, indirect.view, stats.view, {}};
@@ -719,10 +769,10 @@ TEST_F(OcclusionTest, BadConfigAndArgumentsThrow) {
     bad.stats = {};
     expect_error([&] { culler.record(cmd, hiz, img.state, lights.view, 10, frame, bad); }, ErrorCode::invalid_argument,
                  "stats buffer is null");
-    // capacity x groups_per_instance groups must fit the device's maxComputeWorkGroupCount[0]
-    // (65535 on lavapipe, 2^31 - 1 on the H100): a capacity just above limit / 65535 exceeds it.
     LightCullFrame big = frame;
     big.groups_per_instance = 65535;
+    ASSERT_EQ(wide.max_groups_per_instance(), uint32_t(group_limit / wide_config.capacity));
+    ASSERT_LT(wide.max_groups_per_instance(), 65535u);
     expect_error([&] { wide.record(cmd, hiz, img.state, lights.view, 10, big, wide_out); },
                  ErrorCode::invalid_argument, "maxComputeWorkGroupCount");
     LightCullFrame nan = frame;

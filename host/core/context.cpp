@@ -49,6 +49,41 @@ uint32_t ContextState::memory_type(uint32_t type_bits, VkMemoryPropertyFlags fla
   throw Error(ErrorCode::vulkan_failure, concat("no memory type with flags 0x", std::hex, flags));
 }
 
+VkDeviceMemory ContextState::allocate(const VkMemoryRequirements& req, VkMemoryPropertyFlags flags,
+                                      const std::string& what, uint32_t* type_index) {
+  const uint32_t type = memory_type(req.memoryTypeBits, flags);
+  const uint32_t heap = memory.memoryTypes[type].heapIndex;
+  VkDeviceSize available = memory.memoryHeaps[heap].size;
+  const char* source = "the heap's size";
+  if (memory_budget) {
+    // VK_EXT_memory_budget: heapBudget is what this process may use in all, heapUsage what it uses.
+    VkPhysicalDeviceMemoryBudgetPropertiesEXT budget{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MEMORY_BUDGET_PROPERTIES_EXT};
+    VkPhysicalDeviceMemoryProperties2 props{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MEMORY_PROPERTIES_2};
+    props.pNext = &budget;
+    vkGetPhysicalDeviceMemoryProperties2(physical_device, &props);
+    available = budget.heapBudget[heap] > budget.heapUsage[heap] ? budget.heapBudget[heap] - budget.heapUsage[heap] : 0;
+    source = "the budget left (VK_EXT_memory_budget)";
+  }
+  auto refuse = [&](const char* why) {
+    return Error(ErrorCode::unsupported_size,
+                 concat(what, " needs ", req.size, " bytes of memory heap ", heap, "; ", why, " ", available,
+                        " bytes: make it smaller or free memory"));
+  };
+  if (req.size > available) throw refuse(concat(source, " is").c_str());
+  VkMemoryAllocateInfo alloc{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+  alloc.allocationSize = req.size;
+  alloc.memoryTypeIndex = type;
+  VkDeviceMemory out = VK_NULL_HANDLE;
+  const VkResult r = vkAllocateMemory(device, &alloc, nullptr, &out);
+  if (r == VK_ERROR_OUT_OF_DEVICE_MEMORY || r == VK_ERROR_OUT_OF_HOST_MEMORY) {
+    throw refuse("vkAllocateMemory ran out of memory; the heap reported");
+  }
+  vk_check(r, "vkAllocateMemory");
+  count_object();
+  if (type_index) *type_index = type;
+  return out;
+}
+
 namespace {
 std::atomic<uint64_t> g_validation_messages{0};
 }
@@ -224,6 +259,13 @@ void fill_info(ContextState& s) {
   s.info.timestamps_supported = s.queue_family < n && families[s.queue_family].timestampValidBits > 0;
   s.graphics_queue = s.queue_family < n && (families[s.queue_family].queueFlags & VK_QUEUE_GRAPHICS_BIT) != 0;
   vkGetPhysicalDeviceMemoryProperties(s.physical_device, &s.memory);
+  uint32_t extension_count = 0;
+  vkEnumerateDeviceExtensionProperties(s.physical_device, nullptr, &extension_count, nullptr);
+  std::vector<VkExtensionProperties> extensions(extension_count);
+  vkEnumerateDeviceExtensionProperties(s.physical_device, nullptr, &extension_count, extensions.data());
+  for (const VkExtensionProperties& e : extensions) {
+    if (std::strcmp(e.extensionName, VK_EXT_MEMORY_BUDGET_EXTENSION_NAME) == 0) s.memory_budget = true;
+  }
 }
 
 // dynamicRendering of an adopted device: from the engine's vkCreateDevice feature chain when it

@@ -30,6 +30,9 @@ struct ContextState {
   // ContextOptions::workgroup_2d (0x0: each kernel's device-specific choice).
   VkExtent2D workgroup_2d{0, 0};
   VkPhysicalDeviceMemoryProperties memory{};
+  // Whether the physical device supports VK_EXT_memory_budget (a physical-device query, usable
+  // whether or not the engine enabled the extension on its device).
+  bool memory_budget = false;
 
   // Standalone helpers for run_once(). The pool, the fence and the queue need external
   // synchronization (Vulkan, "Threading Behavior"): run_once() holds submit_mutex from allocating
@@ -48,6 +51,14 @@ struct ContextState {
   /// Index of a memory type allowed by `type_bits` with all `flags`; throws if none.
   uint32_t memory_type(uint32_t type_bits, VkMemoryPropertyFlags flags) const;
   void count_object(uint64_t n = 1) { objects_created += n; }
+
+  /// Allocates `req` from a memory type with `flags` for `what` ("a 16384x16384 image"): refuses
+  /// with Error(unsupported_size), before allocating, a request larger than the heap's budget
+  /// (VK_EXT_memory_budget: what this process may still allocate) or, without the extension, than
+  /// the heap; turns VK_ERROR_OUT_OF_DEVICE_MEMORY / _HOST_MEMORY into the same error, naming the
+  /// bytes asked for and the heap. Returns the memory and the type index chosen.
+  VkDeviceMemory allocate(const VkMemoryRequirements& req, VkMemoryPropertyFlags flags, const std::string& what,
+                          uint32_t* type_index = nullptr);
 
   /// Objects owned by the context for helpers without an owner of their own (the demo scene's
   /// pipeline): made on first use, destroyed with the context, before the device.

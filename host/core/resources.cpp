@@ -67,11 +67,8 @@ OwnedImage::OwnedImage(const Context& context, VkExtent2D extent, VkFormat forma
   try {
     VkMemoryRequirements req;
     vkGetImageMemoryRequirements(device_, state.image, &req);
-    VkMemoryAllocateInfo alloc{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
-    alloc.allocationSize = req.size;
-    alloc.memoryTypeIndex = s.memory_type(req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
-    vk_check(vkAllocateMemory(device_, &alloc, nullptr, &memory_), "vkAllocateMemory (image)");
-    s.count_object();
+    memory_ = s.allocate(req, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT,
+                         concat("a ", extent.width, "x", extent.height, " ", format_name(format), " image"));
     vk_check(vkBindImageMemory(device_, state.image, memory_, 0), "vkBindImageMemory");
     VkImageViewCreateInfo view{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
     view.image = state.image;
@@ -134,14 +131,11 @@ OwnedBuffer::OwnedBuffer(const Context& context, VkDeviceSize size, VkBufferUsag
   try {
     VkMemoryRequirements req;
     vkGetBufferMemoryRequirements(device_, buffer_, &req);
-    VkMemoryAllocateInfo alloc{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
-    alloc.allocationSize = req.size;
     VkMemoryPropertyFlags flags =
         host_visible ? VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT : VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT;
-    alloc.memoryTypeIndex = s.memory_type(req.memoryTypeBits, flags);
-    coherent_ = (s.memory.memoryTypes[alloc.memoryTypeIndex].propertyFlags & VK_MEMORY_PROPERTY_HOST_COHERENT_BIT) != 0;
-    vk_check(vkAllocateMemory(device_, &alloc, nullptr, &memory_), "vkAllocateMemory (buffer)");
-    s.count_object();
+    uint32_t type = 0;
+    memory_ = s.allocate(req, flags, concat("a ", size, "-byte buffer"), &type);
+    coherent_ = (s.memory.memoryTypes[type].propertyFlags & VK_MEMORY_PROPERTY_HOST_COHERENT_BIT) != 0;
     vk_check(vkBindBufferMemory(device_, buffer_, memory_, 0), "vkBindBufferMemory");
     if (host_visible) vk_check(vkMapMemory(device_, memory_, 0, VK_WHOLE_SIZE, 0, &mapped_), "vkMapMemory");
   } catch (...) {

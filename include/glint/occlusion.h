@@ -120,9 +120,8 @@ struct LightCullFrame {
   float view_proj[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};  //!< column-major (GLM)
   uint32_t vertex_count = 54;        //!< written to GlintFlareIndirect::vertex_count (0 to 2^20);
                                      //!< the default is LensFlare::vertices_per_instance()
-  uint32_t groups_per_instance = 1;  //!< GlintFlareIndirect::group_count_x = instances x this
-                                     //!< (0 to 65535; capacity x this must fit the device's
-                                     //!< maxComputeWorkGroupCount[0])
+  uint32_t groups_per_instance = 1;  //!< the dispatch arguments cover instances x this
+                                     //!< workgroups (0 to LightCuller::max_groups_per_instance())
 };
 
 /// The buffers one cull writes. The caller owns them; their state fields are updated.
@@ -171,6 +170,12 @@ class LightCuller {
               const LightCullFrame& frame, LightCullOutputs& outputs, Profiler* profiler = nullptr);
 
   const LightCullConfig& config() const;
+
+  /// The largest LightCullFrame::groups_per_instance this culler's capacity allows on this device:
+  /// capacity x groups_per_instance workgroups must fit maxComputeWorkGroupCount[0] x [1] (the
+  /// dispatch arguments are rows of at most [0] groups; see GlintFlareIndirect) and 32 bits.
+  /// At least 1 for every capacity the config accepts. Composite effects check it at construction.
+  uint32_t max_groups_per_instance() const;
 
   struct Impl;
 

@@ -99,17 +99,15 @@ struct GlintFlarePush {
   GLINT_FLOAT ghost_pos2;
   GLINT_FLOAT ghost_pos3;
   GLINT_FLOAT ghost_pos4;
-  GLINT_UINT groups_per_instance;  // compute: group_count_x / groups_per_instance = instance count
-  GLINT_UINT tile_w;               // compute: the gather's tile in pixels (workgroup x)
-  GLINT_UINT tile_h;               // (workgroup y * GLINT_FLARE_GATHER_ROWS)
-  GLINT_UINT indirect_word;        // compute: index of group_count_x in the bound indirect words
+  GLINT_UINT tile_w;         // compute: the gather's tile in pixels (workgroup x)
+  GLINT_UINT tile_h;         // (workgroup y * GLINT_FLARE_GATHER_ROWS)
+  GLINT_UINT indirect_word;  // compute: index of instance_count in the bound indirect words
 };
 
-// Push constants of flare_gather_args.comp (16 bytes).
+// Push constants of flare_gather_args.comp (12 bytes).
 struct GlintFlareGatherArgsPush {
-  GLINT_UINT indirect_word;        // index of group_count_x in the bound indirect words
-  GLINT_UINT groups_per_instance;  // group_count_x / this = instance count
-  GLINT_UINT tiles_x;              // the gather's grid when any instance is visible
+  GLINT_UINT indirect_word;  // index of instance_count in the bound indirect words
+  GLINT_UINT tiles_x;        // the gather's grid when any instance is visible
   GLINT_UINT tiles_y;
 };
 

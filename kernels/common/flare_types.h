@@ -63,8 +63,12 @@ struct GlintFlareInstance {
 
 // Indirect arguments, 32 bytes: a VkDrawIndirectCommand at offset 0 and a
 // VkDispatchIndirectCommand at offset 16. The compaction writes instance_count = visible
-// (clamped to the capacity) and group_count_x = instance_count * groups_per_instance, with
-// vertex_count and groups_per_instance given by the draw side when recording the cull.
+// (clamped to the capacity), vertex_count as the draw side gave it, and G = instance_count *
+// groups_per_instance workgroups as rows of at most maxComputeWorkGroupCount[0]:
+// group_count_x = min(G, maxComputeWorkGroupCount[0]), group_count_y = ceil(G / group_count_x)
+// (1 when G = 0). A kernel dispatched with them takes the linear workgroup index
+// gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x and returns when it is G or more,
+// G being read from instance_count; so a million instances launch on every conformant device.
 struct GlintFlareIndirect {
   GLINT_UINT vertex_count;
   GLINT_UINT instance_count;

@@ -71,9 +71,10 @@ struct GlintCullCompactPush {
   GLINT_UINT count;                // lights in the list
   GLINT_UINT capacity;             // GlintFlareInstance slots in the instance buffer
   GLINT_UINT vertex_count;         // scan: GlintFlareIndirect::vertex_count
-  GLINT_UINT groups_per_instance;  // scan: GlintFlareIndirect::group_count_x = instances x this
+  GLINT_UINT groups_per_instance;  // scan: the dispatch arguments cover instances x this groups
   GLINT_UINT flags;                // scatter: GLINT_CULL_WRITE_RESULTS
-  GLINT_UINT reserved[3];
+  GLINT_UINT max_group_count_x;    // scan: the device's maxComputeWorkGroupCount[0]
+  GLINT_UINT reserved[2];
 };
 
 #endif
