@@ -129,18 +129,18 @@ float max_value_for(VkFormat a, VkFormat b) {
   return (a == VK_FORMAT_R16G16B16A16_SFLOAT || b == VK_FORMAT_R16G16B16A16_SFLOAT) ? 65504.0f : 1.0e37f;
 }
 
-// Throws Error(unsupported_size) "<what> WxH is out of range: accepted 1 to N on each side".
-void check_extent_named(const Context& context, VkExtent2D e, const std::string& what) {
+// Throws Error(unsupported_size) "<where>: <role> extent WxH is out of range: accepted 1 to N on
+// each side" (role may be empty). The message is built only when it is thrown.
+void check_extent_named(const Context& context, VkExtent2D e, const char* where, const char* role) {
   const uint32_t max_dim = context.info().max_image_dimension_2d;
   if (e.width == 0 || e.height == 0 || e.width > max_dim || e.height > max_dim) {
-    throw Error(ErrorCode::unsupported_size, concat(what, " ", e.width, "x", e.height,
-                                                    " is out of range: accepted 1 to ", max_dim, " on each side"));
+    throw Error(ErrorCode::unsupported_size, concat(where, ": ", role, *role ? " " : "", "extent ", e.width, "x",
+                                                    e.height, " is out of range: accepted 1 to ", max_dim,
+                                                    " on each side"));
   }
 }
 
-void check_extent(const Context& context, VkExtent2D e, const char* where) {
-  check_extent_named(context, e, concat(where, ": extent"));
-}
+void check_extent(const Context& context, VkExtent2D e, const char* where) { check_extent_named(context, e, where, ""); }
 
 void check_image(const Context& context, const Image& img, const char* where, const char* role, VkImageUsageFlags need,
                  const char* need_name) {
@@ -151,7 +151,7 @@ void check_image(const Context& context, const Image& img, const char* where, co
                 concat(where, ": ", role, " format is ", detail::format_name(img.format),
                        "; accepted VK_FORMAT_R16G16B16A16_SFLOAT or VK_FORMAT_R32G32B32A32_SFLOAT"));
   }
-  check_extent_named(context, img.extent, concat(where, ": ", role, " extent"));
+  check_extent_named(context, img.extent, where, role);
   if ((img.usage & need) != need)
     throw Error(ErrorCode::missing_usage, concat(where, ": ", role, " image lacks ", need_name, " usage"));
 }

@@ -1,5 +1,6 @@
 // Lens-flare driver (issue 5, drawing half): validates, generates the element atlas, owns the
 // raster and compute pipelines, and records either path. docs/FLARE.md explains the choices.
+#include <cstdio>
 #include <glint/flare.h>
 #include <glint/occlusion.h>
 
@@ -80,11 +81,15 @@ void FlareConfig::validate() const {
   check_range("FlareConfig::halo_weight", halo_weight, 0.0, 10.0);
   check_range("FlareConfig::starburst_weight", starburst_weight, 0.0, 10.0);
   check_range("FlareConfig::ghost_weight", ghost_weight, 0.0, 10.0);
+  // Names on the stack: validate() runs in every record() and allocates nothing.
+  char name[48];
   for (size_t i = 0; i < ghost_positions.size(); ++i) {
-    check_range(concat("FlareConfig::ghost_positions[", i, "]").c_str(), ghost_positions[i], -2.0, 3.0);
+    std::snprintf(name, sizeof(name), "FlareConfig::ghost_positions[%zu]", i);
+    check_range(name, ghost_positions[i], -2.0, 3.0);
   }
   for (size_t i = 0; i < tint_color.size(); ++i) {
-    check_range(concat("FlareConfig::tint_color[", i, "]").c_str(), tint_color[i], 0.0, 1.0);
+    std::snprintf(name, sizeof(name), "FlareConfig::tint_color[%zu]", i);
+    check_range(name, tint_color[i], 0.0, 1.0);
   }
 }
 

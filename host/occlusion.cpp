@@ -1,6 +1,7 @@
 // Visibility driver for lens flares: the Hi-Z pyramid and the light culler (docs/OCCLUSION.md).
 #include "occlusion.h"
 
+#include <array>
 #include <glint/occlusion.h>
 
 #include <algorithm>
@@ -328,7 +329,10 @@ struct LightCuller::Impl {
   struct Sets {
     VkDescriptorSet cull = VK_NULL_HANDLE, scan = VK_NULL_HANDLE, scatter = VK_NULL_HANDLE;
   };
-  std::map<std::vector<uint64_t>, Sets> sets;
+  // Sets by the resources they name: the depth and Hi-Z views and (buffer, offset, size) of the
+  // lights, instances, results, indirect and stats buffers. A fixed-size key: no allocation.
+  using SetKey = std::array<uint64_t, 17>;
+  std::map<SetKey, Sets> sets;
   detail::DescriptorArena arena;  // pools of 16 sets, 8 descriptors of a type each (the scatter binds 5 buffers)
   detail::OwnedBuffer dummy_results;  // bound when the caller wants no per-light results
   Buffer dummy_state;
@@ -338,10 +342,10 @@ struct LightCuller::Impl {
     return arena.make_mixed_set(p, b);
   }
 
-  static void key_add(std::vector<uint64_t>& key, const Buffer& b) {
-    key.push_back(reinterpret_cast<uint64_t>(b.buffer));
-    key.push_back(b.offset);
-    key.push_back(b.size);
+  static void key_add(SetKey& key, size_t& at, const Buffer& b) {
+    key[at++] = reinterpret_cast<uint64_t>(b.buffer);
+    key[at++] = b.offset;
+    key[at++] = b.size;
   }
 };
 
@@ -455,12 +459,13 @@ void LightCuller::record(VkCommandBuffer cmd, HiZPyramid& hiz, Image& depth, Buf
   Buffer& results = want_results ? out.results : m.dummy_state;
 
   // Descriptor sets for these resources (made once, then reused).
-  std::vector<uint64_t> key{reinterpret_cast<uint64_t>(depth.view), reinterpret_cast<uint64_t>(hiz.image().view)};
-  Impl::key_add(key, lights);
-  Impl::key_add(key, out.instances);
-  Impl::key_add(key, results);
-  Impl::key_add(key, out.indirect);
-  Impl::key_add(key, out.stats);
+  Impl::SetKey key{reinterpret_cast<uint64_t>(depth.view), reinterpret_cast<uint64_t>(hiz.image().view)};
+  size_t at = 2;
+  Impl::key_add(key, at, lights);
+  Impl::key_add(key, at, out.instances);
+  Impl::key_add(key, at, results);
+  Impl::key_add(key, at, out.indirect);
+  Impl::key_add(key, at, out.stats);
   auto it = m.sets.find(key);
   if (it == m.sets.end()) {
     Impl::Sets s;

@@ -4,10 +4,41 @@
 
 #include <glint/glint.h>
 
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
 namespace glint::detail {
+
+/// A vector whose first N elements live inside the object, so that a frame's barriers (a handful
+/// per flush) never touch the heap; past N it moves everything to a std::vector.
+template <typename T, size_t N>
+class InlineVector {
+ public:
+  void push_back(const T& v) {
+    if (heap_.empty() && size_ < N) {
+      inline_[size_++] = v;
+      return;
+    }
+    if (heap_.empty()) heap_.assign(inline_, inline_ + size_);
+    heap_.push_back(v);
+    ++size_;
+  }
+  T* data() { return heap_.empty() ? inline_ : heap_.data(); }
+  T* begin() { return data(); }
+  T* end() { return data() + size_; }
+  size_t size() const { return size_; }
+  bool empty() const { return size_ == 0; }
+  void clear() {
+    size_ = 0;
+    heap_.clear();
+  }
+
+ private:
+  T inline_[N];
+  size_t size_ = 0;
+  std::vector<T> heap_;
+};
 
 class Barriers {
  public:
@@ -26,8 +57,8 @@ class Barriers {
  private:
   void queue_read_chain(VkPipelineStageFlags2 readers, VkPipelineStageFlags2 stage, VkAccessFlags2 access,
                         const Image* image, const Buffer* buffer);
-  std::vector<VkImageMemoryBarrier2> pending_;
-  std::vector<VkBufferMemoryBarrier2> pending_buffers_;
+  InlineVector<VkImageMemoryBarrier2, 16> pending_;
+  InlineVector<VkBufferMemoryBarrier2, 16> pending_buffers_;
 };
 
 /// Commands glint has recorded into any command buffer since the process started. Every vkCmd* call

@@ -518,6 +518,9 @@ Profiler::Profiler(const Context& context, uint32_t capacity) : context_(&contex
   info.queryCount = capacity;
   vk_check(vkCreateQueryPool(context.device(), &info, nullptr, &pool_), "vkCreateQueryPool");
   context.state().count_object();
+  // Every label's storage is made here, so that mark() in the frame path never allocates.
+  labels_.resize(capacity);
+  for (std::string& l : labels_) l.reserve(kLabelBytes);
 }
 
 Profiler::~Profiler() {
@@ -525,26 +528,26 @@ Profiler::~Profiler() {
 }
 
 void Profiler::reset(VkCommandBuffer cmd) {
-  labels_.clear();
+  marks_ = 0;
   if (!pool_) return;
   detail::count_recorded_command();
   vkCmdResetQueryPool(cmd, pool_, 0, capacity_);
 }
 
-void Profiler::mark(VkCommandBuffer cmd, const std::string& label) {
+void Profiler::mark(VkCommandBuffer cmd, std::string_view label) {
   if (!pool_) return;
-  if (labels_.size() >= capacity_) {
+  if (marks_ >= capacity_) {
     throw Error(ErrorCode::invalid_argument, concat("Profiler: more than ", capacity_, " marks in one frame"));
   }
   detail::count_recorded_command();
-  vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, pool_, static_cast<uint32_t>(labels_.size()));
-  labels_.push_back(label);
+  vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, pool_, marks_);
+  labels_[marks_++].assign(label.data(), label.size());
 }
 
 std::vector<Profiler::Stage> Profiler::results() const {
   std::vector<Stage> out;
-  if (!pool_ || labels_.size() < 2) return out;
-  std::vector<uint64_t> ticks(labels_.size());
+  if (!pool_ || marks_ < 2) return out;
+  std::vector<uint64_t> ticks(marks_);
   vk_check(vkGetQueryPoolResults(context_->device(), pool_, 0, static_cast<uint32_t>(ticks.size()),
                                  ticks.size() * sizeof(uint64_t), ticks.data(), sizeof(uint64_t),
                                  VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),

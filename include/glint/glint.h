@@ -27,6 +27,7 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace glint {
@@ -220,8 +221,10 @@ class Profiler {
   /// Resets the query pool; record once per frame before any mark().
   void reset(VkCommandBuffer cmd);
   /// Writes a timestamp once all earlier commands are done; `label` names the work since the
-  /// previous mark (the first mark only starts the clock).
-  void mark(VkCommandBuffer cmd, const std::string& label);
+  /// previous mark (the first mark only starts the clock). Allocates nothing for labels of up to
+  /// kLabelBytes characters (their storage is made by the constructor).
+  void mark(VkCommandBuffer cmd, std::string_view label);
+  static constexpr size_t kLabelBytes = 64;
 
   struct Stage {
     std::string label;
@@ -237,6 +240,7 @@ class Profiler {
   const Context* context_;
   VkQueryPool pool_ = VK_NULL_HANDLE;
   uint32_t capacity_;
+  uint32_t marks_ = 0;
   std::vector<std::string> labels_;
 };
 
