@@ -10,7 +10,7 @@
 
 #include "core/check.h"
 #include "core/resources.h"
-#include "flare_types.h"
+#include <glint/gpu/flare_types.h>
 
 namespace glint {
 

@@ -15,7 +15,7 @@
 #include "core/context_state.h"
 #include "core/pipeline.h"
 #include "core/resources.h"
-#include "flare_types.h"
+#include <glint/gpu/flare_types.h>
 
 namespace glint {
 

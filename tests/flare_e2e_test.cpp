@@ -16,7 +16,7 @@
 
 #include "core/barriers.h"
 #include "core/half.h"
-#include "flare_types.h"
+#include <glint/gpu/flare_types.h>
 #include "support/flare_scene.h"
 #include "support/gpu_test.h"
 

@@ -32,7 +32,7 @@
 #include "core/barriers.h"
 #include "core/half.h"
 #include "core/transfer.h"
-#include "flare_types.h"
+#include <glint/gpu/flare_types.h>
 #include "reference/flare_reference.h"
 #include "reference/occlusion_reference.h"
 #include "support/flare_check.h"

@@ -14,8 +14,8 @@
 #include "core/barriers.h"
 #include "core/half.h"
 #include "flare_params.h"
-#include "flare_types.h"
-#include "lod.h"
+#include <glint/gpu/flare_types.h>
+#include <glint/gpu/lod.h>
 #include "reference/flare_reference.h"
 #include "reference/lod_reference.h"
 #include "support/flare_check.h"
@@ -361,7 +361,8 @@ TEST_F(FlareTest, ChosenLevelsKeepFootprintsInsideThePadding) {
 // level, cleared to NaN before, must come out finite and equal to the standalone atlas.
 TEST_F(FlareTest, AdoptedContextGeneratesTheAtlasInTheFirstRecordOverPoison) {
   Context engine = Context::adopt(
-      {context().instance(), context().physical_device(), context().device(), context().queue_family_index()});
+      {context().instance(), VK_API_VERSION_1_3, context().physical_device(), context().device(),
+       context().queue_family_index()});
   LensFlare flare(engine, kF32, {kW, kH});
   EXPECT_FALSE(flare.atlas().generated);
   const FlareAtlasInfo a = flare.atlas();
@@ -394,8 +395,9 @@ TEST_F(FlareTest, AdoptedContextGeneratesTheAtlasInTheFirstRecordOverPoison) {
   // The engine enabled no dynamicRendering (its feature chain says so): the raster path refuses.
   VkPhysicalDeviceVulkan13Features f13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
   f13.synchronization2 = VK_TRUE;
-  AdoptInfo info{context().instance(), context().physical_device(), context().device(), context().queue_family_index(),
-                 &f13};
+  f13.maintenance4 = VK_TRUE;
+  AdoptInfo info{context().instance(),         VK_API_VERSION_1_3, context().physical_device(), context().device(),
+                 context().queue_family_index(), &f13};
   Context no_rendering = Context::adopt(info);
   LensFlare compute_only(no_rendering, kF32, {kW, kH});
   detail::OwnedImage color(context(), {kW, kH}, kF32, kUsage);

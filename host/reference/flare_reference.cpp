@@ -5,7 +5,7 @@
 #include <stdexcept>
 
 #include "flare_params.h"
-#include "lod.h"
+#include <glint/gpu/lod.h>
 #include "reference/lod_reference.h"
 
 namespace glint::reference {

@@ -13,8 +13,8 @@
 #include <vector>
 
 #include "core/cpu_image.h"
-#include "flare_types.h"
-#include "lod.h"
+#include <glint/gpu/flare_types.h>
+#include <glint/gpu/lod.h>
 
 namespace glint::reference {
 

@@ -5,7 +5,7 @@
 // padding cap. CPU only: no Vulkan call is made here.
 #pragma once
 
-#include "lod.h"
+#include <glint/gpu/lod.h>
 
 namespace glint::reference {
 

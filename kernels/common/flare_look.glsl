@@ -3,9 +3,9 @@
 // evaluate exactly the same function. docs/FLARE.md describes it; host/reference/flare_reference.cpp
 // is its float64 twin. `precise` keeps the compiler from contracting or reordering these
 // expressions differently in the vertex and compute stages.
-#include "flare_types.h"
+#include "glint/gpu/flare_types.h"
 #include "flare_params.h"
-#include "lod.glsl"
+#include "glint/gpu/lod.glsl"
 
 // One screen-aligned rectangle of one light, in pixels (y down, pixel centres at +0.5).
 struct GlintFlareSprite {

@@ -4,7 +4,7 @@
 // every number here. The visibility half meets the drawing half only in flare_types.h.
 #ifndef GLINT_FLARE_PARAMS_H
 #define GLINT_FLARE_PARAMS_H
-#include "glint_types.h"
+#include "glint/gpu/types.h"
 
 // ---- Element atlas ------------------------------------------------------------------------------
 // One RGBA16F image, premultiplied alpha, every tile surrounded by GLINT_FLARE_ATLAS_PADDING texels

@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "core/resources.h"
-#include "flare_types.h"
+#include <glint/gpu/flare_types.h>
 #include "reference/occlusion_reference.h"
 
 namespace glint::test {
