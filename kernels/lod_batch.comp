@@ -1,6 +1,6 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
-// Evaluates the atlas-aware LOD (kernels/common/lod_impl.h, docs/LOD.md; Vulkan spec "LOD
+// Evaluates the atlas-aware LOD (include/glint/gpu/lod_impl.h, docs/LOD.md; Vulkan spec "LOD
 // Operation") for N queries: one invocation per query.
 layout(local_size_x_id = 0, local_size_y_id = 1) in;
 

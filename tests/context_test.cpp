@@ -73,7 +73,8 @@ TEST_F(ContextTest, WorkgroupOverrideIsCheckedAndUsed) {
 }
 
 // The tools' environment mapping: GLINT_* variables become ContextOptions fields, malformed values
-// are errors naming the variable (the library itself reads none: ctest consumer_check looks for getenv in the installed library).
+// are errors naming the variable (the library itself reads none: ctest's consumer_check looks for
+// getenv in the installed library).
 TEST(ContextEnvironment, ToolsMapGlintVariablesToOptions) {
   struct Restore {
     ~Restore() {

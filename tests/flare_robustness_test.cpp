@@ -710,7 +710,7 @@ TEST_F(FlareRobustnessTest, HiZMatchesTheReferenceAtDegenerateAndThinSizes) {
 
 // ---- LOD finiteness on the GPU ---------------------------------------------------------------------
 
-// glint_lod_finite (kernels/common/lod_impl.h) reads the exponent bits. Written as
+// glint_lod_finite (include/glint/gpu/lod_impl.h) reads the exponent bits. Written as
 // x == x && x - x == 0, a compiler that assumes finite floats folds it to true, and an infinite
 // derivative then reaches the top level instead of the documented fallback, level 0.
 TEST_F(FlareRobustnessTest, LodNonFiniteQueriesFallBackToLevelZeroOnTheGpu) {

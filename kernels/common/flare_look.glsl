@@ -13,7 +13,7 @@ struct GlintFlareSprite {
   vec2 size;  // width and height; 0: nothing to draw
   vec3 rgb;   // light colour * light intensity * visible fraction * global intensity * weight * tint
   uint tile;  // GLINT_FLARE_ELEMENT_*: the atlas tile
-  float lod;  // atlas level (atlas-aware LOD of kernels/common/lod_impl.h, padding-capped)
+  float lod;  // atlas level (atlas-aware LOD of include/glint/gpu/lod_impl.h, padding-capped)
 };
 
 // x, y, w, h of a tile in level-0 texels.
