@@ -1,6 +1,7 @@
 // Lens-flare driver (issue 5, drawing half): validates, generates the element atlas, owns the
 // raster and compute pipelines, and records either path. docs/FLARE.md explains the choices.
 #include <glint/flare.h>
+#include <glint/gpu/flare_types.h>
 #include <glint/occlusion.h>
 
 #include <algorithm>
@@ -19,7 +20,6 @@
 #include "core/pipeline.h"
 #include "core/resources.h"
 #include "flare_params.h"
-#include <glint/gpu/flare_types.h>
 
 namespace glint {
 

@@ -2,6 +2,7 @@
 #include "occlusion.h"
 
 #include <glint/occlusion.h>
+#include <glint/gpu/flare_types.h>
 
 #include <algorithm>
 #include <cmath>
@@ -15,7 +16,6 @@
 #include "core/context_state.h"
 #include "core/pipeline.h"
 #include "core/resources.h"
-#include <glint/gpu/flare_types.h>
 
 namespace glint {
 

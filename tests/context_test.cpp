@@ -148,7 +148,8 @@ TEST_F(ContextTest, AdoptedDeviceRunsBloomInTheEnginesCommandBuffer) {
   VkCommandPool pool;
   ASSERT_EQ(vkCreateCommandPool(device, &pi, nullptr, &pool), VK_SUCCESS);
   {
-    Context engine = Context::adopt({mine.instance(), VK_API_VERSION_1_3, mine.physical_device(), device, family, &f13});
+    Context engine =
+        Context::adopt({mine.instance(), VK_API_VERSION_1_3, mine.physical_device(), device, family, &f13});
     EXPECT_TRUE(engine.is_adopted());
     EXPECT_THROW(engine.run_once([](VkCommandBuffer) {}), Error);
 
@@ -290,8 +291,9 @@ TEST_F(ContextTest, AdoptChecksTheApiVersionsAndTheFeaturesGlintNeeds) {
   no_sync2.dynamicRendering = VK_TRUE;
   EngineDevice without_sync2(mine, &no_sync2);
   ASSERT_NE(without_sync2.device, VK_NULL_HANDLE);
-  expect_adopt_error({mine.instance(), VK_API_VERSION_1_3, mine.physical_device(), without_sync2.device, family, &no_sync2},
-                     ErrorCode::invalid_argument, "VkPhysicalDeviceVulkan13Features::synchronization2 is not enabled");
+  expect_adopt_error(
+      {mine.instance(), VK_API_VERSION_1_3, mine.physical_device(), without_sync2.device, family, &no_sync2},
+      ErrorCode::invalid_argument, "VkPhysicalDeviceVulkan13Features::synchronization2 is not enabled");
 
   VkPhysicalDeviceVulkan13Features no_m4{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
   no_m4.synchronization2 = VK_TRUE;
@@ -317,15 +319,15 @@ TEST_F(ContextTest, AdoptChecksTheApiVersionsAndTheFeaturesGlintNeeds) {
   s2.pNext = &m4;
   EngineDevice promoted(mine, &s2);
   ASSERT_NE(promoted.device, VK_NULL_HANDLE);
-  const Context ok = Context::adopt({mine.instance(), VK_API_VERSION_1_3, mine.physical_device(), promoted.device,
-                                     family, &s2});
+  const Context ok =
+      Context::adopt({mine.instance(), VK_API_VERSION_1_3, mine.physical_device(), promoted.device, family, &s2});
   EXPECT_TRUE(ok.is_adopted());
   EXPECT_EQ(ok.device(), promoted.device);
   // A good adopt without a chain (every 1.3 device supports both features); a later instance
   // version is fine.
-  EXPECT_TRUE(Context::adopt({mine.instance(), VK_MAKE_API_VERSION(0, 1, 4, 0), mine.physical_device(), mine.device(),
-                              family})
-                  .is_adopted());
+  EXPECT_TRUE(
+      Context::adopt({mine.instance(), VK_MAKE_API_VERSION(0, 1, 4, 0), mine.physical_device(), mine.device(), family})
+          .is_adopted());
 }
 
 // Compiled kernels (and samplers) are shared per context: a second pipeline of the same description compiles

@@ -42,8 +42,8 @@ constexpr uint32_t kW = 128, kH = 96;
 constexpr VkFormat kColor = VK_FORMAT_R16G16B16A16_SFLOAT;  // storage and blending are mandatory
 constexpr VkFormat kDepth = VK_FORMAT_R32_SFLOAT;           // written by the engine's compute pass
 constexpr float kBackground = 0.05f, kDisc = 20.0f, kDiscRadius = 3.0f;
-constexpr int kDiscX = 32, kDiscY = 48;                     // the visible light sits on the disc
-constexpr int kOccluder[4] = {80, 32, 112, 64};             // near rectangle (depth 0.2)
+constexpr int kDiscX = 32, kDiscY = 48;          // the visible light sits on the disc
+constexpr int kOccluder[4] = {80, 32, 112, 64};  // near rectangle (depth 0.2)
 constexpr uint32_t kQueries = 64;
 
 // Push constants of engine_fill.comp (std430: every member 4-byte aligned, ivec4 at 48).
@@ -76,9 +76,12 @@ VKAPI_ATTR VkBool32 VKAPI_CALL on_message(VkDebugUtilsMessageSeverityFlagBitsEXT
 float half_to_float(uint16_t h) {
   const uint32_t sign = (h >> 15) & 1u, exp = (h >> 10) & 0x1fu, mant = h & 0x3ffu;
   float v;
-  if (exp == 0) v = std::ldexp(float(mant), -24);
-  else if (exp == 31) v = mant ? NAN : INFINITY;
-  else v = std::ldexp(float(mant | 0x400u), int(exp) - 25);
+  if (exp == 0)
+    v = std::ldexp(float(mant), -24);
+  else if (exp == 31)
+    v = mant ? NAN : INFINITY;
+  else
+    v = std::ldexp(float(mant | 0x400u), int(exp) - 25);
   return sign ? -v : v;
 }
 
@@ -111,7 +114,8 @@ struct Engine {
     vf.enabledValidationFeatureCount = 1;
     vf.pEnabledValidationFeatures = &sync;
     VkDebugUtilsMessengerCreateInfoEXT mi{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
-    mi.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
+    mi.messageSeverity =
+        VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
     mi.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
                      VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
     mi.pfnUserCallback = on_message;
@@ -270,8 +274,8 @@ struct EngineBuffer {
     vkGetBufferMemoryRequirements(device, buffer.buffer, &req);
     VkMemoryAllocateInfo alloc{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
     alloc.allocationSize = req.size;
-    alloc.memoryTypeIndex = e.memory_type(req.memoryTypeBits, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT |
-                                                                  VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
+    alloc.memoryTypeIndex =
+        e.memory_type(req.memoryTypeBits, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
     vk(vkAllocateMemory(device, &alloc, nullptr, &memory), "vkAllocateMemory");
     vk(vkBindBufferMemory(device, buffer.buffer, memory, 0), "vkBindBufferMemory");
     vk(vkMapMemory(device, memory, 0, VK_WHOLE_SIZE, 0, &mapped), "vkMapMemory");
@@ -355,7 +359,8 @@ struct FillPass {
     const VkResult r = vkCreateComputePipelines(device, VK_NULL_HANDLE, 1, &ci, nullptr, &pipeline);
     vkDestroyShaderModule(device, module, nullptr);
     vk(r, "vkCreateComputePipelines");
-    const VkDescriptorPoolSize sizes[2] = {{VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 2}, {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 2}};
+    const VkDescriptorPoolSize sizes[2] = {{VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 2},
+                                           {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 2}};
     VkDescriptorPoolCreateInfo pi{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
     pi.maxSets = 1;
     pi.poolSizeCount = 2;
@@ -376,8 +381,10 @@ struct FillPass {
       w[i].dstBinding = i;
       w[i].descriptorCount = 1;
       w[i].descriptorType = i < 2 ? VK_DESCRIPTOR_TYPE_STORAGE_IMAGE : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-      if (i < 2) w[i].pImageInfo = &images[i];
-      else w[i].pBufferInfo = &buffers[i - 2];
+      if (i < 2)
+        w[i].pImageInfo = &images[i];
+      else
+        w[i].pBufferInfo = &buffers[i - 2];
     }
     vkUpdateDescriptorSets(device, 4, w, 0, nullptr);
   }
@@ -443,12 +450,14 @@ int run() {
                 ctx.info().name.c_str());
 
     // The engine's resources.
-    EngineImage hdr(engine, kColor, VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT);
+    EngineImage hdr(engine, kColor,
+                    VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT);
     EngineImage depth(engine, kDepth, VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT);
     EngineImage bloomed(engine, kColor, VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT);
     EngineImage blurred(engine, kColor, VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT);
-    EngineImage flares(engine, kColor, VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT |
-                                           VK_IMAGE_USAGE_TRANSFER_SRC_BIT);
+    EngineImage flares(
+        engine, kColor,
+        VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT);
     const VkDeviceSize image_bytes = VkDeviceSize(kW) * kH * 8;
     EngineBuffer readback(engine, 3 * image_bytes + sizeof(GlintFlareStats) + 4 * sizeof(GlintFlareLightResult),
                           VK_BUFFER_USAGE_TRANSFER_DST_BIT);
@@ -555,8 +564,8 @@ int run() {
       image_barrier(cmd, to_read[i]->image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_PIPELINE_STAGE_2_COPY_BIT,
                     VK_ACCESS_2_TRANSFER_READ_BIT);
       region.bufferOffset = VkDeviceSize(i) * image_bytes;
-      vkCmdCopyImageToBuffer(cmd, to_read[i]->image.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
-                             readback.buffer.buffer, 1, &region);
+      vkCmdCopyImageToBuffer(cmd, to_read[i]->image.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, readback.buffer.buffer,
+                             1, &region);
     }
     glint::Buffer* glint_buffers[2] = {&flare_pass.stats(), &flare_pass.results()};
     VkBufferMemoryBarrier2 bb[2];
@@ -696,7 +705,8 @@ int run() {
       const glint::LodQuery& q = qs[i];
       const GlintLodQuery g{q.dudx, q.dvdx, q.dudy, q.dvdy, q.tex_w, q.tex_h, q.off_x, q.off_y};
       const float twin = glint::lod_math::glint_lod(g, push.atlas);
-      f.check(std::fabs(twin - cpu) <= 1e-6f, "lod: glint::lod_math and glint::lod_level differ at query " + std::to_string(i));
+      f.check(std::fabs(twin - cpu) <= 1e-6f,
+              "lod: glint::lod_math and glint::lod_level differ at query " + std::to_string(i));
       worst = std::max({worst, std::fabs(double(lg[i]) - cpu), std::fabs(double(le[i]) - cpu)});
       if (!std::isfinite(lg[i]) || !std::isfinite(le[i])) worst = INFINITY;
       distinct.insert(int(std::lround(cpu)));

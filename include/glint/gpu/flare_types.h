@@ -1,8 +1,9 @@
-// The buffers that connect the lens-flare stages, declared once for GLSL and C++: the caller's light list, the instance buffer that the cull/occlusion/
-// compaction kernel appends visible lights to, the indirect arguments it writes, its statistics,
-// and one result per input light. The raster draw (vkCmdDrawIndirect) and the compute gather
-// (which reads group_count_x) both read GlintFlareInstance and GlintFlareIndirect and nothing else
-// from the visibility stage, so the two halves meet only here.
+// The buffers that connect the lens-flare stages, declared once for GLSL and C++: the caller's
+// light list, the instance buffer that the cull/occlusion/compaction kernel appends visible lights
+// to, the indirect arguments it writes, its statistics, and one result per input light. The
+// raster draw (vkCmdDrawIndirect) and the compute gather (which reads group_count_x) both read
+// GlintFlareInstance and GlintFlareIndirect and nothing else from the visibility stage, so the two
+// halves meet only here.
 // Installed with the library: C++ includes <glint/gpu/flare_types.h>, GLSL "glint/gpu/flare_types.h"
 // and declares buffers as `layout(std430) buffer X { GlintFlareInstance instances[]; };`.
 // Only 4-byte scalars, so std430 and C++ layouts agree; the C++ side static_asserts them below.
