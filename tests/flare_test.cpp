@@ -423,7 +423,7 @@ TEST_F(FlareTest, AdoptedContextGeneratesTheAtlasInTheFirstRecordOverPoison) {
         << e.what();
   }
   pc.draw = FlareDrawPath::compute;
-  EXPECT_NO_THROW(LensFlarePass{no_rendering, pc});
+  EXPECT_NO_THROW((LensFlarePass{no_rendering, pc}));
 }
 
 // ---- Drawing --------------------------------------------------------------------------------------
