@@ -4,8 +4,9 @@
 #   ./glint.sh demo [args]   install what is missing, build, run `glint demo [args]`
 #   ./glint.sh test [args]   install, build the suite with ASan+UBSan (build-asan) and run ctest
 #                            [args] on lavapipe with validation (leak checking for the CPU-only
-#                            tests) and the CLI smoke test there, install into a temporary prefix
-#                            and build and run tests/consumer against it through find_package(glint);
+#                            tests) and the CLI smoke test there; ctest's consumer_check installs into
+#                            a temporary prefix, checks the library for getenv, and builds and runs
+#                            tests/consumer against it through find_package(glint) and pkg-config;
 #                            then each libFuzzer target for GLINT_FUZZ_SECONDS (default 10)
 #   ./glint.sh fuzz [seconds] build the libFuzzer targets (clang, build-fuzz) and run each one for
 #                            `seconds` (default 600) on a copy of fuzz/corpus/<name>; crashes are
@@ -144,27 +145,6 @@ use_lavapipe_unless_told_otherwise() {
   fi
 }
 
-# consumer_check [BUILD]: installs BUILD (default $BUILD_DIR) and builds tests/consumer against it.
-consumer_check() {
-  local from="${1:-$BUILD_DIR}" tmp
-  tmp="$(mktemp -d)"
-  # shellcheck disable=SC2064  # expand $tmp now
-  trap "rm -rf '$tmp'" EXIT
-  log "installing into $tmp/prefix and building tests/consumer with find_package(glint)"
-  cmake --install "$from" --prefix "$tmp/prefix" >"$tmp/install.log" ||
-    { cat "$tmp/install.log" >&2; die "cmake --install failed"; }
-  cmake -S tests/consumer -B "$tmp/build" -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH="$tmp/prefix" \
-    >"$tmp/configure.log" 2>&1 || { cat "$tmp/configure.log" >&2; die "configuring tests/consumer failed"; }
-  cmake --build "$tmp/build" -j"$(nproc)" >"$tmp/build.log" 2>&1 ||
-    { cat "$tmp/build.log" >&2; die "building tests/consumer failed"; }
-  local out
-  # Leak checking off: against the sanitized install, the Vulkan loader and driver keep allocations
-  # until exit that LeakSanitizer would report (our own leaks are caught by the suite).
-  out="$(ASAN_OPTIONS=detect_leaks=0 "$tmp/build/glint_consumer")" || { printf '%s\n' "$out" >&2; die "glint_consumer failed"; }
-  printf '%s\n' "$out"
-  [[ "$(tail -n 1 <<<"$out")" == ok ]] || die "glint_consumer did not print ok"
-}
-
 cmd="${1:-}"
 [[ $# -gt 0 ]] && shift
 case "$cmd" in
@@ -186,14 +166,13 @@ case "$cmd" in
       log "CLI smoke test"
       tests/cli_test.sh "$BUILD_DIR/host/glint"
       gpu_assisted_tests "$BUILD_DIR"
-      consumer_check
     else
-      # Everything runs once, in the ASan+UBSan build (build-asan): the suite with validation, the
-      # CLI smoke test, and the consumer, which links the sanitized library (the exported target
-      # carries the sanitizer link flags). Building a second, Release copy of the suite would
-      # double the CI's compile time on 2 cores; `demo` and `bench` use the Release build.
+      # Everything runs once, in the ASan+UBSan build (build-asan): the suite with validation
+      # (consumer_check included: the example links the sanitized library, whose exported target
+      # and glint.pc carry the sanitizer link flags) and the CLI smoke test. Building a second,
+      # Release copy of the suite would double the CI's compile time on 2 cores; `demo` and
+      # `bench` use the Release build.
       asan_test "$@"
-      consumer_check build-asan
     fi
     if [[ "${GLINT_FUZZ_SECONDS:-10}" != 0 ]]; then run_fuzz "${GLINT_FUZZ_SECONDS:-10}"; fi
     log "all tests passed"

@@ -17,6 +17,7 @@
 // reference's sprite geometry: the fill work) and fill_pixels_per_second.
 #include <benchmark/benchmark.h>
 #include <glint/flare.h>
+#include <glint/gpu/flare_types.h>
 
 #include <algorithm>
 #include <cmath>
@@ -29,7 +30,6 @@
 #include "core/resources.h"
 #include "core/transfer.h"
 #include "flare_params.h"
-#include "flare_types.h"
 #include "reference/flare_reference.h"
 
 namespace glint::bench {
@@ -152,7 +152,8 @@ void BM_FlareAtlas(benchmark::State& state) {
   std::vector<double> ms;
   for (auto _ : state) {
     LensFlare flare(ctx, VK_FORMAT_R16G16B16A16_SFLOAT, {64, 64});  // generates once here
-    Context adopted = Context::adopt({ctx.instance(), ctx.physical_device(), ctx.device(), ctx.queue_family_index()});
+    Context adopted = Context::adopt(
+        {ctx.instance(), VK_API_VERSION_1_3, ctx.physical_device(), ctx.device(), ctx.queue_family_index()});
     LensFlare lazy(adopted, VK_FORMAT_R16G16B16A16_SFLOAT, {64, 64});
     ctx.run_once([&](VkCommandBuffer cmd) {
       profiler.reset(cmd);

@@ -8,7 +8,7 @@
 #include <array>
 #include <vector>
 
-#include "flare_types.h"
+#include <glint/gpu/flare_types.h>
 
 namespace glint::demo {
 

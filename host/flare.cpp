@@ -2,6 +2,7 @@
 // raster and compute pipelines, and records either path. docs/FLARE.md explains the choices.
 #include <cstdio>
 #include <glint/flare.h>
+#include <glint/gpu/flare_types.h>
 #include <glint/occlusion.h>
 
 #include <algorithm>
@@ -20,7 +21,6 @@
 #include "core/pipeline.h"
 #include "core/resources.h"
 #include "flare_params.h"
-#include "flare_types.h"
 
 namespace glint {
 
@@ -220,7 +220,7 @@ void LensFlare::Impl::record_setup(VkCommandBuffer cmd) {
 
 void LensFlare::Impl::make_raster_pipeline() {
   if (!context->state().dynamic_rendering) {
-    raster_unavailable = "the device was created without dynamicRendering (VkPhysicalDeviceVulkan13Features)";
+    raster_unavailable = "VkPhysicalDeviceVulkan13Features::dynamicRendering is not enabled on the device";
     return;
   }
   if (!context->state().graphics_queue) {

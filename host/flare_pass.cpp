@@ -4,13 +4,14 @@
 // stage"), and each part writes its own barriers from the buffers' state fields, so the frame is
 // Hi-Z -> cull -> scan -> scatter -> draw on one command buffer with no readback.
 #include <glint/flare_pass.h>
+#include <glint/gpu/flare_types.h>
 
 #include <algorithm>
 #include <cmath>
 
 #include "core/check.h"
+#include "core/context_state.h"
 #include "core/resources.h"
-#include "flare_types.h"
 
 namespace glint {
 
@@ -43,8 +44,22 @@ namespace {
 
 constexpr VkBufferUsageFlags kStorage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT;
 
-FlarePassConfig validated(const FlarePassConfig& c) {
+// The config, validated, and the raster path's needs checked against the context before any part
+// is made: LensFlare::record_raster would refuse them only after record() had recorded the Hi-Z
+// and the cull.
+FlarePassConfig validated(const Context& ctx, const FlarePassConfig& c) {
   c.validate();
+  if (c.draw != FlareDrawPath::raster) return c;
+  const detail::ContextState& s = ctx.state();
+  if (!s.dynamic_rendering) {
+    throw Error(ErrorCode::no_device,
+                "FlarePassConfig::draw = raster needs VkPhysicalDeviceVulkan13Features::dynamicRendering, which is not "
+                "enabled on the device; enable it or use FlareDrawPath::compute");
+  }
+  if (!s.graphics_queue) {
+    throw Error(ErrorCode::no_device, concat("FlarePassConfig::draw = raster needs a graphics queue; queue family ",
+                                             ctx.queue_family_index(), " has none; use FlareDrawPath::compute"));
+  }
   return c;
 }
 
@@ -95,7 +110,7 @@ struct LensFlarePass::Impl {
   Buffer no_results;
 
   Impl(const Context& ctx, const FlarePassConfig& c)
-      : config(validated(c)),
+      : config(validated(ctx, c)),
         flare(ctx, c.color_format, c.extent),
         hiz(ctx, hiz_config(c)),
         culler(ctx, cull_config(c, flare)) {

@@ -3,6 +3,7 @@
 
 #include <array>
 #include <glint/occlusion.h>
+#include <glint/gpu/flare_types.h>
 
 #include <algorithm>
 #include <cmath>
@@ -16,7 +17,6 @@
 #include "core/context_state.h"
 #include "core/pipeline.h"
 #include "core/resources.h"
-#include "flare_types.h"
 
 namespace glint {
 

@@ -26,7 +26,7 @@
 // resets them, in a separate dispatch (no in-shader reset race, SaschaWillems/Vulkan #748).
 layout(local_size_x_id = 0, local_size_y_id = 1) in;
 
-#include "flare_types.h"
+#include "glint/gpu/flare_types.h"
 #include "occlusion.h"
 
 layout(binding = 0) uniform texture2D depth_tex;  // level 0

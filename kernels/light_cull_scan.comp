@@ -13,7 +13,7 @@
 // reset themselves, here in a separate dispatch after the cull's atomics: SaschaWillems/Vulkan #748).
 layout(local_size_x_id = 0, local_size_y_id = 1) in;
 
-#include "flare_types.h"
+#include "glint/gpu/flare_types.h"
 #include "occlusion.h"
 
 layout(std430, binding = 0) buffer Groups {

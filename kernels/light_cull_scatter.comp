@@ -9,7 +9,7 @@
 // Writes the per-light result of visible lights (the cull wrote the others').
 layout(local_size_x_id = 0, local_size_y_id = 1) in;
 
-#include "flare_types.h"
+#include "glint/gpu/flare_types.h"
 #include "occlusion.h"
 
 layout(std430, binding = 0) readonly buffer Lights { GlintFlareLight lights[]; };

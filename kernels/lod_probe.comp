@@ -6,7 +6,7 @@
 // atlas UV by the chain rule: d(atlas_u) = d(u) * tex_w / atlas_w.
 layout(local_size_x_id = 0, local_size_y_id = 1) in;
 
-#include "lod.glsl"
+#include "glint/gpu/lod.glsl"
 
 layout(binding = 0) uniform sampler2D level_atlas;
 layout(std430, binding = 1) readonly buffer Queries { GlintLodQuery queries[]; };

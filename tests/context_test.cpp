@@ -73,7 +73,8 @@ TEST_F(ContextTest, WorkgroupOverrideIsCheckedAndUsed) {
 }
 
 // The tools' environment mapping: GLINT_* variables become ContextOptions fields, malformed values
-// are errors naming the variable (the library itself reads none: see the nm check in glint.sh).
+// are errors naming the variable (the library itself reads none: ctest's consumer_check looks for
+// getenv in the installed library).
 TEST(ContextEnvironment, ToolsMapGlintVariablesToOptions) {
   struct Restore {
     ~Restore() {
@@ -147,7 +148,8 @@ TEST_F(ContextTest, AdoptedDeviceRunsBloomInTheEnginesCommandBuffer) {
   VkCommandPool pool;
   ASSERT_EQ(vkCreateCommandPool(device, &pi, nullptr, &pool), VK_SUCCESS);
   {
-    Context engine = Context::adopt({mine.instance(), mine.physical_device(), device, family});
+    Context engine =
+        Context::adopt({mine.instance(), VK_API_VERSION_1_3, mine.physical_device(), device, family, &f13});
     EXPECT_TRUE(engine.is_adopted());
     EXPECT_THROW(engine.run_once([](VkCommandBuffer) {}), Error);
 
@@ -229,11 +231,103 @@ TEST_F(ContextTest, AdoptRejectsNullHandlesAndBadQueueFamily) {
   EXPECT_THROW(Context::adopt({}), Error);
   const Context& mine = context();
   try {
-    Context::adopt({mine.instance(), mine.physical_device(), mine.device(), 1000});
+    Context::adopt({mine.instance(), VK_API_VERSION_1_3, mine.physical_device(), mine.device(), 1000});
     FAIL() << "no error";
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("queue_family_index"), std::string::npos);
   }
+}
+
+// A device of the context's physical device, created with the given feature chain (the engine's
+// vkCreateDevice). Destroyed with the object.
+struct EngineDevice {
+  VkDevice device = VK_NULL_HANDLE;
+  EngineDevice(const Context& mine, const void* features) {
+    float priority = 1.0f;
+    VkDeviceQueueCreateInfo q{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
+    q.queueFamilyIndex = mine.queue_family_index();
+    q.queueCount = 1;
+    q.pQueuePriorities = &priority;
+    VkDeviceCreateInfo di{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
+    di.pNext = features;
+    di.queueCreateInfoCount = 1;
+    di.pQueueCreateInfos = &q;
+    if (vkCreateDevice(mine.physical_device(), &di, nullptr, &device) != VK_SUCCESS) device = VK_NULL_HANDLE;
+  }
+  EngineDevice(const EngineDevice&) = delete;
+  EngineDevice& operator=(const EngineDevice&) = delete;
+  ~EngineDevice() {
+    if (device) vkDestroyDevice(device, nullptr);
+  }
+};
+
+void expect_adopt_error(const AdoptInfo& info, ErrorCode code, const std::string& names) {
+  try {
+    Context::adopt(info);
+    ADD_FAILURE() << "adopt accepted it; expected an error naming " << names;
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), code) << e.what();
+    EXPECT_NE(std::string(e.what()).find(names), std::string::npos) << e.what();
+  }
+}
+
+// Adopt refuses, before using the device, an instance below Vulkan 1.3 (or api_version not set) and
+// a device whose feature chain lacks synchronization2 or maintenance4; each error names what is
+// missing. These devices are valid Vulkan, so the layer stays silent (the fixture checks), and a
+// chain that enables the features through the extension structs instead of
+// VkPhysicalDeviceVulkan13Features is accepted.
+TEST_F(ContextTest, AdoptChecksTheApiVersionsAndTheFeaturesGlintNeeds) {
+  const Context& mine = context();
+  const uint32_t family = mine.queue_family_index();
+  for (uint32_t version : {0u, uint32_t(VK_API_VERSION_1_2), uint32_t(VK_API_VERSION_1_0)}) {
+    expect_adopt_error({mine.instance(), version, mine.physical_device(), mine.device(), family},
+                       ErrorCode::invalid_argument, "AdoptInfo::api_version = ");
+  }
+  expect_adopt_error({mine.instance(), VK_API_VERSION_1_2, mine.physical_device(), mine.device(), family},
+                     ErrorCode::invalid_argument, "AdoptInfo::api_version = 1.2.0");
+
+  VkPhysicalDeviceVulkan13Features no_sync2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
+  no_sync2.maintenance4 = VK_TRUE;
+  no_sync2.dynamicRendering = VK_TRUE;
+  EngineDevice without_sync2(mine, &no_sync2);
+  ASSERT_NE(without_sync2.device, VK_NULL_HANDLE);
+  expect_adopt_error(
+      {mine.instance(), VK_API_VERSION_1_3, mine.physical_device(), without_sync2.device, family, &no_sync2},
+      ErrorCode::invalid_argument, "VkPhysicalDeviceVulkan13Features::synchronization2 is not enabled");
+
+  VkPhysicalDeviceVulkan13Features no_m4{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
+  no_m4.synchronization2 = VK_TRUE;
+  VkPhysicalDeviceFeatures2 head{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};  // the chain as a whole
+  head.pNext = &no_m4;
+  EngineDevice without_m4(mine, &head);
+  ASSERT_NE(without_m4.device, VK_NULL_HANDLE);
+  expect_adopt_error({mine.instance(), VK_API_VERSION_1_3, mine.physical_device(), without_m4.device, family, &head},
+                     ErrorCode::invalid_argument, "VkPhysicalDeviceVulkan13Features::maintenance4 is not enabled");
+
+  // No feature chain at all: nothing is enabled, and a chain saying so is refused the same way.
+  EngineDevice bare(mine, nullptr);
+  ASSERT_NE(bare.device, VK_NULL_HANDLE);
+  VkPhysicalDeviceFeatures2 nothing{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
+  expect_adopt_error({mine.instance(), VK_API_VERSION_1_3, mine.physical_device(), bare.device, family, &nothing},
+                     ErrorCode::invalid_argument, "synchronization2");
+
+  // The same features through the structs of the extensions Vulkan 1.3 promoted.
+  VkPhysicalDeviceMaintenance4Features m4{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MAINTENANCE_4_FEATURES};
+  m4.maintenance4 = VK_TRUE;
+  VkPhysicalDeviceSynchronization2Features s2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SYNCHRONIZATION_2_FEATURES};
+  s2.synchronization2 = VK_TRUE;
+  s2.pNext = &m4;
+  EngineDevice promoted(mine, &s2);
+  ASSERT_NE(promoted.device, VK_NULL_HANDLE);
+  const Context ok =
+      Context::adopt({mine.instance(), VK_API_VERSION_1_3, mine.physical_device(), promoted.device, family, &s2});
+  EXPECT_TRUE(ok.is_adopted());
+  EXPECT_EQ(ok.device(), promoted.device);
+  // A good adopt without a chain (every 1.3 device supports both features); a later instance
+  // version is fine.
+  EXPECT_TRUE(
+      Context::adopt({mine.instance(), VK_MAKE_API_VERSION(0, 1, 4, 0), mine.physical_device(), mine.device(), family})
+          .is_adopted());
 }
 
 // Compiled kernels (and samplers) are shared per context: a second pipeline of the same description compiles

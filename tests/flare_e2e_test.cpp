@@ -6,6 +6,7 @@
 // safely, and zero lights leave the image bit for bit. Validation with synchronization validation
 // is on for every test (support/gpu_test.h).
 #include <glint/flare_pass.h>
+#include <glint/gpu/flare_types.h>
 
 #include <algorithm>
 #include <array>
@@ -16,7 +17,6 @@
 
 #include "core/barriers.h"
 #include "core/half.h"
-#include "flare_types.h"
 #include "support/flare_scene.h"
 #include "support/gpu_test.h"
 

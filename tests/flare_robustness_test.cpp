@@ -15,6 +15,7 @@
 //   by a compiler that assumes finite floats would give the top level).
 // Validation with synchronization validation is on for every test (support/gpu_test.h).
 #include <glint/flare_pass.h>
+#include <glint/gpu/flare_types.h>
 #include <glint/lod.h>
 #include <glint/occlusion.h>
 
@@ -32,7 +33,6 @@
 #include "core/barriers.h"
 #include "core/half.h"
 #include "core/transfer.h"
-#include "flare_types.h"
 #include "reference/flare_reference.h"
 #include "reference/occlusion_reference.h"
 #include "support/flare_check.h"
@@ -710,7 +710,7 @@ TEST_F(FlareRobustnessTest, HiZMatchesTheReferenceAtDegenerateAndThinSizes) {
 
 // ---- LOD finiteness on the GPU ---------------------------------------------------------------------
 
-// glint_lod_finite (kernels/common/lod_impl.h) reads the exponent bits. Written as
+// glint_lod_finite (include/glint/gpu/lod_impl.h) reads the exponent bits. Written as
 // x == x && x - x == 0, a compiler that assumes finite floats folds it to true, and an infinite
 // derivative then reaches the top level instead of the documented fallback, level 0.
 TEST_F(FlareRobustnessTest, LodNonFiniteQueriesFallBackToLevelZeroOnTheGpu) {

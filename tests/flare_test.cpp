@@ -4,6 +4,9 @@
 // so the barriers from a writer to DRAW_INDIRECT / INDIRECT_COMMAND_READ are exercised. Validation
 // with synchronization validation is on for every test (support/gpu_test.h).
 #include <glint/flare.h>
+#include <glint/flare_pass.h>
+#include <glint/gpu/flare_types.h>
+#include <glint/gpu/lod.h>
 
 #include <algorithm>
 #include <cmath>
@@ -14,8 +17,6 @@
 #include "core/barriers.h"
 #include "core/half.h"
 #include "flare_params.h"
-#include "flare_types.h"
-#include "lod.h"
 #include "reference/flare_reference.h"
 #include "reference/lod_reference.h"
 #include "support/flare_check.h"
@@ -360,8 +361,8 @@ TEST_F(FlareTest, ChosenLevelsKeepFootprintsInsideThePadding) {
 // Poisoning: an adopted context records the generation in the first frame; every texel of every
 // level, cleared to NaN before, must come out finite and equal to the standalone atlas.
 TEST_F(FlareTest, AdoptedContextGeneratesTheAtlasInTheFirstRecordOverPoison) {
-  Context engine = Context::adopt(
-      {context().instance(), context().physical_device(), context().device(), context().queue_family_index()});
+  Context engine = Context::adopt({context().instance(), VK_API_VERSION_1_3, context().physical_device(),
+                                   context().device(), context().queue_family_index()});
   LensFlare flare(engine, kF32, {kW, kH});
   EXPECT_FALSE(flare.atlas().generated);
   const FlareAtlasInfo a = flare.atlas();
@@ -394,8 +395,10 @@ TEST_F(FlareTest, AdoptedContextGeneratesTheAtlasInTheFirstRecordOverPoison) {
   // The engine enabled no dynamicRendering (its feature chain says so): the raster path refuses.
   VkPhysicalDeviceVulkan13Features f13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
   f13.synchronization2 = VK_TRUE;
-  AdoptInfo info{context().instance(), context().physical_device(), context().device(), context().queue_family_index(),
-                 &f13};
+  f13.maintenance4 = VK_TRUE;
+  AdoptInfo info{context().instance(),           VK_API_VERSION_1_3,
+                 context().physical_device(),    context().device(),
+                 context().queue_family_index(), &f13};
   Context no_rendering = Context::adopt(info);
   LensFlare compute_only(no_rendering, kF32, {kW, kH});
   detail::OwnedImage color(context(), {kW, kH}, kF32, kUsage);
@@ -408,6 +411,19 @@ TEST_F(FlareTest, AdoptedContextGeneratesTheAtlasInTheFirstRecordOverPoison) {
       EXPECT_NE(std::string(e.what()).find("dynamicRendering"), std::string::npos) << e.what();
     }
   });
+  // LensFlarePass refuses the raster path when it is made, not after recording the Hi-Z and cull.
+  FlarePassConfig pc;
+  pc.extent = {kW, kH};
+  pc.color_format = kF32;
+  try {
+    LensFlarePass raster(no_rendering, pc);
+    ADD_FAILURE() << "LensFlarePass raster without dynamicRendering did not throw";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("VkPhysicalDeviceVulkan13Features::dynamicRendering"), std::string::npos)
+        << e.what();
+  }
+  pc.draw = FlareDrawPath::compute;
+  EXPECT_NO_THROW((LensFlarePass{no_rendering, pc}));
 }
 
 // ---- Drawing --------------------------------------------------------------------------------------

@@ -1,5 +1,5 @@
 // Tests of glint's atlas-aware LOD on the CPU (issue 4, docs/LOD.md): the C++ twin of the GLSL
-// function (host/lod_math.h, the same source as kernels/common/lod.glsl) against the float64
+// function (host/lod_math.h, the same source as include/glint/gpu/lod.glsl) against the float64
 // reference written from the Vulkan specification (host/reference/lod_reference.h), the seed's
 // cases a to g, and the properties the specification implies. No Vulkan: the GPU's own sampler is
 // compared in tests/lod_test.cpp. Random inputs come from std::mt19937 with fixed seeds.

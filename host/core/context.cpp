@@ -268,26 +268,58 @@ void fill_info(ContextState& s) {
   }
 }
 
-// dynamicRendering of an adopted device: from the engine's vkCreateDevice feature chain when it
-// gives one (the feature is off unless a struct in the chain turns it on), else the physical
-// device's support, which the AdoptInfo contract asks the engine to have enabled.
-bool adopted_dynamic_rendering(const AdoptInfo& a) {
+// The device features glint relies on, as an adopted device has them enabled. From the engine's
+// vkCreateDevice feature chain when it gives one (a feature is off unless a struct in the chain
+// turns it on: VkPhysicalDeviceVulkan13Features or the extension structs it absorbed), else from
+// what the physical device supports, which the AdoptInfo contract asks the engine to have enabled
+// (Vulkan cannot be asked which features a device was created with).
+struct AdoptedFeatures {
+  bool synchronization2 = false;  // vkCmdPipelineBarrier2, vkCmdWriteTimestamp2: every barrier glint records
+  bool maintenance4 = false;      // LocalSizeId: every kernel takes its workgroup size from specialization
+  bool dynamic_rendering = false; // vkCmdBeginRendering: LensFlare's raster path only
+};
+
+AdoptedFeatures adopted_features(const AdoptInfo& a) {
+  AdoptedFeatures f;
   if (a.enabled_features) {
-    bool on = false;
     for (auto* p = static_cast<const VkBaseInStructure*>(a.enabled_features); p; p = p->pNext) {
-      if (p->sType == VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES) {
-        on = on || reinterpret_cast<const VkPhysicalDeviceVulkan13Features*>(p)->dynamicRendering == VK_TRUE;
-      } else if (p->sType == VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DYNAMIC_RENDERING_FEATURES) {
-        on = on || reinterpret_cast<const VkPhysicalDeviceDynamicRenderingFeatures*>(p)->dynamicRendering == VK_TRUE;
+      switch (p->sType) {
+        case VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES: {
+          const auto* v = reinterpret_cast<const VkPhysicalDeviceVulkan13Features*>(p);
+          f.synchronization2 = f.synchronization2 || v->synchronization2 == VK_TRUE;
+          f.maintenance4 = f.maintenance4 || v->maintenance4 == VK_TRUE;
+          f.dynamic_rendering = f.dynamic_rendering || v->dynamicRendering == VK_TRUE;
+          break;
+        }
+        case VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SYNCHRONIZATION_2_FEATURES:
+          f.synchronization2 = f.synchronization2 ||
+                               reinterpret_cast<const VkPhysicalDeviceSynchronization2Features*>(p)->synchronization2 == VK_TRUE;
+          break;
+        case VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MAINTENANCE_4_FEATURES:
+          f.maintenance4 = f.maintenance4 ||
+                           reinterpret_cast<const VkPhysicalDeviceMaintenance4Features*>(p)->maintenance4 == VK_TRUE;
+          break;
+        case VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DYNAMIC_RENDERING_FEATURES:
+          f.dynamic_rendering = f.dynamic_rendering ||
+                                reinterpret_cast<const VkPhysicalDeviceDynamicRenderingFeatures*>(p)->dynamicRendering == VK_TRUE;
+          break;
+        default: break;
       }
     }
-    return on;
+    return f;
   }
   VkPhysicalDeviceVulkan13Features f13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
   VkPhysicalDeviceFeatures2 supported{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
   supported.pNext = &f13;
   vkGetPhysicalDeviceFeatures2(a.physical_device, &supported);
-  return f13.dynamicRendering == VK_TRUE;
+  f.synchronization2 = f13.synchronization2 == VK_TRUE;
+  f.maintenance4 = f13.maintenance4 == VK_TRUE;
+  f.dynamic_rendering = f13.dynamicRendering == VK_TRUE;
+  return f;
+}
+
+std::string version_string(uint32_t v) {
+  return concat(VK_API_VERSION_MAJOR(v), ".", VK_API_VERSION_MINOR(v), ".", VK_API_VERSION_PATCH(v));
 }
 
 }  // namespace
@@ -363,14 +395,20 @@ Context Context::create(const ContextOptions& options) {
   VkPhysicalDeviceFeatures2 supported{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
   supported.pNext = &f12;
   vkGetPhysicalDeviceFeatures2(s.physical_device, &supported);
-  if (!f13.synchronization2) throw Error(ErrorCode::no_device, "device lacks synchronization2");
+  for (auto [name, supported_feature] : {std::pair{"synchronization2", f13.synchronization2},
+                                         std::pair{"maintenance4", f13.maintenance4}}) {
+    if (!supported_feature) {
+      throw Error(ErrorCode::no_device, concat("device '", props.deviceName, "' does not support VkPhysicalDeviceVulkan13Features::",
+                                               name, ", which glint needs"));
+    }
+  }
 
   VkPhysicalDeviceVulkan13Features e13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
   e13.synchronization2 = VK_TRUE;
   e13.dynamicRendering = f13.dynamicRendering;  // a Vulkan 1.3 requirement; LensFlare draws with it
   e13.subgroupSizeControl = f13.subgroupSizeControl;
   e13.computeFullSubgroups = f13.computeFullSubgroups;
-  e13.maintenance4 = f13.maintenance4;
+  e13.maintenance4 = VK_TRUE;
   VkPhysicalDeviceVulkan12Features e12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
   e12.pNext = &e13;
   e12.hostQueryReset = f12.hostQueryReset;
@@ -436,6 +474,32 @@ Context Context::adopt(const AdoptInfo& a) {
     throw Error(ErrorCode::invalid_argument, concat("AdoptInfo::queue_family_index = ", a.queue_family_index,
                                                     " has no compute capability"));
   }
+  // The instance's version bounds what the device may use (Vulkan spec, "Version Numbers": a
+  // physical device's apiVersion above the instance's is not available to the application).
+  if (a.api_version < VK_API_VERSION_1_3) {
+    throw Error(ErrorCode::invalid_argument,
+                concat("AdoptInfo::api_version = ", a.api_version == 0 ? std::string("0 (not set)") : detail::version_string(a.api_version),
+                       " is out of range: glint needs the instance created with VkApplicationInfo::apiVersion >= 1.3 "
+                       "(VK_API_VERSION_1_3), and api_version must say what it was created with"));
+  }
+  VkPhysicalDeviceProperties props;
+  vkGetPhysicalDeviceProperties(a.physical_device, &props);
+  if (props.apiVersion < VK_API_VERSION_1_3) {
+    throw Error(ErrorCode::no_device, concat("AdoptInfo::physical_device '", props.deviceName, "' supports Vulkan ",
+                                             detail::version_string(props.apiVersion), "; glint needs 1.3"));
+  }
+  const detail::AdoptedFeatures features = detail::adopted_features(a);
+  const char* source = a.enabled_features ? " is not enabled (AdoptInfo::enabled_features)"
+                                          : " is not supported by the physical device";
+  const ErrorCode code = a.enabled_features ? ErrorCode::invalid_argument : ErrorCode::no_device;
+  if (!features.synchronization2) {
+    throw Error(code, concat("VkPhysicalDeviceVulkan13Features::synchronization2", source,
+                                             "; glint records every barrier with vkCmdPipelineBarrier2"));
+  }
+  if (!features.maintenance4) {
+    throw Error(code, concat("VkPhysicalDeviceVulkan13Features::maintenance4", source,
+                                             "; glint's kernels take their workgroup size from specialization (LocalSizeId)"));
+  }
   auto state = std::make_unique<detail::ContextState>();
   state->instance = a.instance;
   state->physical_device = a.physical_device;
@@ -443,7 +507,7 @@ Context Context::adopt(const AdoptInfo& a) {
   state->queue_family = a.queue_family_index;
   state->adopted = true;
   detail::fill_info(*state);
-  state->dynamic_rendering = detail::adopted_dynamic_rendering(a);
+  state->dynamic_rendering = features.dynamic_rendering;
   return Context(std::move(state));
 }
 

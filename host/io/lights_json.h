@@ -27,7 +27,7 @@
 #include <string_view>
 #include <vector>
 
-#include "flare_types.h"
+#include <glint/gpu/flare_types.h>
 
 namespace glint::io {
 

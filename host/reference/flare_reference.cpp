@@ -1,11 +1,12 @@
 #include "reference/flare_reference.h"
 
+#include <glint/gpu/lod.h>
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
 #include "flare_params.h"
-#include "lod.h"
 #include "reference/lod_reference.h"
 
 namespace glint::reference {

@@ -7,14 +7,14 @@
 #pragma once
 
 #include <glint/flare.h>
+#include <glint/gpu/flare_types.h>
+#include <glint/gpu/lod.h>
 
 #include <array>
 #include <cstdint>
 #include <vector>
 
 #include "core/cpu_image.h"
-#include "flare_types.h"
-#include "lod.h"
 
 namespace glint::reference {
 

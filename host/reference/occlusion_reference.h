@@ -18,7 +18,7 @@
 #include <utility>
 #include <vector>
 
-#include "flare_types.h"
+#include <glint/gpu/flare_types.h>
 
 namespace glint::reference {
 

@@ -3,11 +3,12 @@
 // instanced vkCmdDrawIndirect (raster path) or a per-screen-tile gather (compute path) that
 // gives the same image within a stated tolerance. The visibility half (Hi-Z, cull, occlusion,
 // compaction) writes the two buffers this class reads: GlintFlareInstance[] and GlintFlareIndirect
-// (kernels/common/flare_types.h). docs/FLARE.md describes the look, the atlas and the tolerance;
+// (<glint/gpu/flare_types.h>, installed). docs/FLARE.md describes the look, the atlas and the tolerance;
 // host/reference/flare_reference.h is the float64 twin.
 #pragma once
 
 #include <glint/glint.h>
+#include <glint/gpu/flare_types.h>
 
 #include <array>
 #include <cstdint>

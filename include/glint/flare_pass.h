@@ -7,7 +7,7 @@
 //
 //   glint::FlarePassConfig pc;  pc.extent = {1920, 1080};  pc.cull.capacity = 256;
 //   glint::LensFlarePass pass(ctx, pc);
-//   // per frame, after the depth pass; lights: GlintFlareLight[count] (flare_types.h)
+//   // per frame, after the depth pass; lights: GlintFlareLight[count] (<glint/gpu/flare_types.h>)
 //   pass.record(cmd, hdr_color, depth, lights, count, view_proj, glint::FlareConfig::preset(...));
 //   // pass.stats() holds GlintFlareStats of that frame, to read whenever the caller wants.
 #pragma once

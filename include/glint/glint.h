@@ -86,23 +86,28 @@ struct ContextOptions {
 
 /// What an engine hands glint when it adopts the engine's own Vulkan objects. glint never
 /// destroys them and never submits work: the engine records glint's commands and submits them.
+/// Context::adopt() checks everything below and throws Error naming what is missing; README.md
+/// "Embedding" lists what an engine must enable, and tests/consumer is a complete example.
 struct AdoptInfo {
-  VkInstance instance = VK_NULL_HANDLE;              //!< must not be null
-  VkPhysicalDevice physical_device = VK_NULL_HANDLE; //!< must not be null
-  VkDevice device = VK_NULL_HANDLE;                  //!< must not be null; Vulkan 1.3 with the
-                                                     //!< synchronization2 and maintenance4
-                                                     //!< features enabled (every 1.3 device has
-                                                     //!< both; kernels size their workgroups by
-                                                     //!< specialization, which needs maintenance4)
-  uint32_t queue_family_index = 0;                   //!< family the command buffers come from;
-                                                     //!< must support compute (and graphics for
-                                                     //!< LensFlare::record_raster)
-  /// Optional: the pNext chain the engine passed to vkCreateDevice (a VkPhysicalDeviceFeatures2,
-  /// VkPhysicalDeviceVulkan13Features or VkPhysicalDeviceDynamicRenderingFeatures, walked through
-  /// pNext). When given, glint reads which optional features are enabled from it: LensFlare's
-  /// raster path needs dynamicRendering and reports a clear error if the chain says it is off.
-  /// When null, glint checks that the physical device supports the feature and trusts the engine
-  /// to have enabled it (Vulkan cannot be asked which features a device was created with).
+  VkInstance instance = VK_NULL_HANDLE;  //!< must not be null
+  /// The VkApplicationInfo::apiVersion the engine created `instance` with (Vulkan cannot be asked
+  /// for it): VK_API_VERSION_1_3 or later. Required: 0 (not set) is refused like 1.2.
+  uint32_t api_version = 0;
+  VkPhysicalDevice physical_device = VK_NULL_HANDLE;  //!< must not be null; apiVersion >= 1.3
+  /// Must not be null; created on physical_device with the Vulkan 1.3 features synchronization2
+  /// (every barrier is vkCmdPipelineBarrier2) and maintenance4 (kernels size their workgroups by
+  /// specialization, LocalSizeId) enabled, and dynamicRendering for LensFlare's raster path
+  /// (LensFlarePass with FlareDrawPath::raster); no extension is needed.
+  VkDevice device = VK_NULL_HANDLE;
+  uint32_t queue_family_index = 0;  //!< family the command buffers come from; must support compute
+                                    //!< (and graphics for the raster flare path)
+  /// Optional: the pNext chain the engine passed in VkDeviceCreateInfo (VkPhysicalDeviceFeatures2,
+  /// VkPhysicalDeviceVulkan13Features, VkPhysicalDeviceSynchronization2Features,
+  /// VkPhysicalDeviceMaintenance4Features, VkPhysicalDeviceDynamicRenderingFeatures, walked through
+  /// pNext; other structs are skipped). When given, a feature counts as enabled only if a struct in
+  /// the chain turns it on: adopt() refuses a chain without synchronization2 or maintenance4, and
+  /// the raster flare path reports an Error when dynamicRendering is off. When null, glint checks
+  /// that the physical device supports each feature and trusts the engine to have enabled it.
   const void* enabled_features = nullptr;
 };
 
@@ -131,7 +136,10 @@ class Context {
   static Context create(const ContextOptions& options = {});
 
   /// Wraps an engine's instance, physical device and device. Throws Error(invalid_argument) for
-  /// null handles or a queue family without compute.
+  /// null handles, a queue family without compute, api_version below 1.3 or an enabled_features
+  /// chain without synchronization2 or maintenance4; Error(no_device) for a physical device below
+  /// Vulkan 1.3 or (enabled_features null) without support for those features. Every message names
+  /// the field or the feature (e.g. "VkPhysicalDeviceVulkan13Features::synchronization2").
   static Context adopt(const AdoptInfo& info);
 
   Context(Context&&) noexcept;

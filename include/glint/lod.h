@@ -1,22 +1,31 @@
 // Atlas-aware texture LOD: the mip level a sampler should use for a sub-texture inside an atlas,
 // following the Vulkan specification's LOD operation with the exact gradient length. The same
-// function is available to every glint kernel (kernels/common/lod.glsl), on the host
-// (lod_level()), and as a batch kernel (LodBatch). docs/LOD.md derives it.
+// function is available to any GLSL shader (<glint/gpu/lod.glsl>, installed), on the host
+// (lod_level(), or the header-only twin glint::lod_math in <glint/gpu/lod_impl.h>), and as a batch
+// kernel (LodBatch). docs/LOD.md derives it.
 #pragma once
 
 #include <glint/glint.h>
+#include <glint/gpu/lod.h>
 
+#include <cstddef>
 #include <cstdint>
 
 namespace glint {
 
-/// One query. Layout matches kernels/common/lod.h (GlintLodQuery): 8 floats, 32 bytes.
+/// One query. Layout equals GlintLodQuery (<glint/gpu/lod.h>, what the GPU reads): 8 floats, 32 bytes.
 struct LodQuery {
   float dudx = 0, dvdx = 0;    //!< derivatives of the tile's own UV (0..1 across the tile) along screen x
   float dudy = 0, dvdy = 0;    //!< ... along screen y. For REPEAT inside a tile, of the unwrapped UV.
   float tex_w = 1, tex_h = 1;  //!< tile size in texels at level 0 (>= 1)
   float off_x = 0, off_y = 0;  //!< tile offset in the atlas in texels (tile must lie inside the atlas)
 };
+
+static_assert(sizeof(LodQuery) == sizeof(GlintLodQuery) && offsetof(LodQuery, dudx) == offsetof(GlintLodQuery, dudx) &&
+                  offsetof(LodQuery, dvdy) == offsetof(GlintLodQuery, dvdy) &&
+                  offsetof(LodQuery, tex_w) == offsetof(GlintLodQuery, tex_w) &&
+                  offsetof(LodQuery, off_y) == offsetof(GlintLodQuery, off_y),
+              "LodQuery is laid out as GlintLodQuery");
 
 /// The atlas and sampling settings for a batch of queries. Checked by validate().
 struct LodAtlasConfig {

@@ -18,6 +18,7 @@
 #pragma once
 
 #include <glint/glint.h>
+#include <glint/gpu/flare_types.h>
 
 #include <cstdint>
 #include <memory>
@@ -136,7 +137,7 @@ struct LightCullOutputs {
                      //!< buffer == VK_NULL_HANDLE writes none (saves 8 bytes per light)
 };
 
-/// Cull + occlusion grid test + compaction of a light list (GlintFlareLight, flare_types.h).
+/// Cull + occlusion grid test + compaction of a light list (GlintFlareLight, <glint/gpu/flare_types.h>).
 class LightCuller {
  public:
   /// Drops the descriptor sets cached for the caller's images/buffers passed to record(). Vulkan

@@ -1,7 +1,7 @@
 // Push constants of every bloom kernel (kernels/bloom_*.comp), shared with host/bloom.cpp.
 #ifndef GLINT_BLOOM_PARAMS_H
 #define GLINT_BLOOM_PARAMS_H
-#include "glint_types.h"
+#include "glint/gpu/types.h"
 
 // BloomPush::flags bits.
 #define GLINT_BLOOM_FLAG_KARIS 1u       // Karis average (first downsample only)

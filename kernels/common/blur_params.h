@@ -2,7 +2,7 @@
 // (STYLE rule 2). The algorithms are in docs/BLUR.md.
 #ifndef GLINT_BLUR_PARAMS_H
 #define GLINT_BLUR_PARAMS_H
-#include "glint_types.h"
+#include "glint/gpu/types.h"
 
 // BlurPush::flags bits.
 #define GLINT_BLUR_FLAG_SANITIZE 1u  // the source is the caller's input: NaN -> 0, clamp to +-max_value

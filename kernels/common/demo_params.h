@@ -1,7 +1,7 @@
 // Push constants of kernels/demo_starfield.comp, shared with host/demo_scene.cpp.
 #ifndef GLINT_DEMO_PARAMS_H
 #define GLINT_DEMO_PARAMS_H
-#include "glint_types.h"
+#include "glint/gpu/types.h"
 
 struct StarfieldPush {
   GLINT_INT width;

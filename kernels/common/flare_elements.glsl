@@ -6,7 +6,7 @@
 // tile border, so the padding (zeros) is each tile's own edge value. Only exp, smoothstep, sqrt and
 // products are used (no atan, no pow: Vulkan allows atan 4096 ulp, which would move thin spikes);
 // host/reference/flare_reference.cpp evaluates the same formulas in float64.
-#include "flare_types.h"
+#include "glint/gpu/flare_types.h"
 
 float glint_flare_window(float r) {  // (1 - r^2)^2 inside the unit disc, 0 outside
   float t = max(1.0 - r * r, 0.0);

@@ -3,9 +3,9 @@
 // evaluate exactly the same function. docs/FLARE.md describes it; host/reference/flare_reference.cpp
 // is its float64 twin. `precise` keeps the compiler from contracting or reordering these
 // expressions differently in the vertex and compute stages.
-#include "flare_types.h"
+#include "glint/gpu/flare_types.h"
 #include "flare_params.h"
-#include "lod.glsl"
+#include "glint/gpu/lod.glsl"
 
 // One screen-aligned rectangle of one light, in pixels (y down, pixel centres at +0.5).
 struct GlintFlareSprite {
@@ -13,7 +13,7 @@ struct GlintFlareSprite {
   vec2 size;  // width and height; 0: nothing to draw
   vec3 rgb;   // light colour * light intensity * visible fraction * global intensity * weight * tint
   uint tile;  // GLINT_FLARE_ELEMENT_*: the atlas tile
-  float lod;  // atlas level (atlas-aware LOD of kernels/common/lod_impl.h, padding-capped)
+  float lod;  // atlas level (atlas-aware LOD of include/glint/gpu/lod_impl.h, padding-capped)
 };
 
 // x, y, w, h of a tile in level-0 texels.

@@ -4,14 +4,14 @@
 // every number here. The visibility half meets the drawing half only in flare_types.h.
 #ifndef GLINT_FLARE_PARAMS_H
 #define GLINT_FLARE_PARAMS_H
-#include "glint_types.h"
+#include "glint/gpu/types.h"
 
 // ---- Element atlas ------------------------------------------------------------------------------
 // One RGBA16F image, premultiplied alpha, every tile surrounded by GLINT_FLARE_ATLAS_PADDING texels
 // of zeros (its own edge value: every element fades to 0 at the tile border). Tile offsets and
 // sizes are multiples of 2^(levels - 1) = 16, so at every mip level a texel belongs to exactly one
 // tile or to padding: the 2x2 box mips never mix two tiles. The level count is the padding cap of
-// kernels/common/lod_impl.h plus one (floor(log2(32)) - 1 = 4, so levels 0..4): no level is built
+// include/glint/gpu/lod_impl.h plus one (floor(log2(32)) - 1 = 4, so levels 0..4): no level is built
 // that the atlas-aware LOD would refuse to use.
 #define GLINT_FLARE_ATLAS_WIDTH 832u
 #define GLINT_FLARE_ATLAS_HEIGHT 320u

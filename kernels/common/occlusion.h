@@ -7,7 +7,7 @@
 // docs/OCCLUSION.md explains the algorithms.
 #ifndef GLINT_OCCLUSION_H
 #define GLINT_OCCLUSION_H
-#include "glint_types.h"
+#include "glint/gpu/types.h"
 
 // Hi-Z levels: level 0 is the depth image itself, level k (k >= 1) is max(1, size >> k) on a side
 // and is stored in mip k - 1 of the pyramid image. 16384 needs 14 levels.

@@ -5,13 +5,14 @@
 
 #include <glint/glint.h>
 
+#include <glint/gpu/flare_types.h>
+
 #include <array>
 #include <cmath>
 #include <cstdint>
 #include <vector>
 
 #include "core/resources.h"
-#include "flare_types.h"
 #include "reference/occlusion_reference.h"
 
 namespace glint::test {

@@ -1,11 +1,34 @@
 // The LOD functions, in the common subset of GLSL and C++ (scalars, sqrt, log2, floor, min, max,
-// clamp, floatBitsToUint). GLSL: included by lod.glsl. C++: included by host/lod_math.h inside a
-// namespace that supplies those names. Every path ends in clamp(.., 0, levels - 1). docs/LOD.md derives it.
-#ifndef GLINT_LOD_IMPL_H
-#define GLINT_LOD_IMPL_H
+// clamp, floatBitsToUint). GLSL: include "glint/gpu/lod.glsl" (or this file) and call
+// glint_lod(query, atlas). C++: include <glint/gpu/lod_impl.h>; the functions are in namespace
+// glint::lod_math, next to the GLSL built-ins they use, mapped onto <cmath>. glint's own
+// glint::lod_level() and LodBatch kernel are this source. Every path ends in
+// clamp(.., 0, levels - 1). docs/LOD.md derives it.
+#ifndef GLINT_GPU_LOD_IMPL_H
+#define GLINT_GPU_LOD_IMPL_H
+#include "lod.h"
 
-// C++ (host/lod_math.h) defines GLINT_LOD_FN as inline; GLSL needs nothing.
-#ifndef GLINT_LOD_FN
+#ifdef __cplusplus
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+namespace glint {
+namespace lod_math {
+// The GLSL built-ins used below, for float.
+inline float sqrt(float x) { return std::sqrt(x); }
+inline float log2(float x) { return std::log2(x); }
+inline float floor(float x) { return std::floor(x); }
+inline float min(float a, float b) { return std::min(a, b); }
+inline float max(float a, float b) { return std::max(a, b); }
+inline float clamp(float x, float lo, float hi) { return std::min(std::max(x, lo), hi); }
+inline uint32_t floatBitsToUint(float x) {
+  uint32_t u;
+  std::memcpy(&u, &x, sizeof u);
+  return u;
+}
+#define GLINT_LOD_FN inline
+#else
 #define GLINT_LOD_FN
 #endif
 
@@ -84,5 +107,11 @@ GLINT_LOD_FN float glint_lod(GlintLodQuery q, GlintLodAtlas a) {
   if ((a.flags & GLINT_LOD_PADDING_CAP) != 0u) lambda = min(lambda, glint_lod_padding_cap(q, a));
   return clamp(lambda, 0.0, top);
 }
+
+#ifdef __cplusplus
+}  // namespace lod_math
+}  // namespace glint
+#endif
+#undef GLINT_LOD_FN
 
 #endif

@@ -1,11 +1,12 @@
-// Atlas-aware texture LOD (issue 4, seed 002), written once for GLSL and C++ (STYLE rule 2):
-// GLSL includes it through lod.glsl; C++ includes it through host/lod_math.h, which maps the few
-// GLSL names it uses onto <cmath>. The derivation is in docs/LOD.md; the Vulkan specification's
-// "LOD Operation" (texel-space scale factors, anisotropy, bias, clamps) is followed exactly, with
-// the exact gradient length (the specification also allows approximations, which hardware uses).
-#ifndef GLINT_LOD_H
-#define GLINT_LOD_H
-#include "glint_types.h"
+// Atlas-aware texture LOD, the data half, written once for GLSL and C++: the query and atlas
+// structs and their flags. The functions are in lod_impl.h (GLSL: include lod.glsl; C++: include
+// <glint/gpu/lod_impl.h>, which supplies the few GLSL built-ins it uses from <cmath>). The
+// derivation is in docs/LOD.md; the Vulkan specification's "LOD Operation" (texel-space scale
+// factors, anisotropy, bias, clamps) is followed exactly, with the exact gradient length (the
+// specification also allows approximations, which hardware uses).
+#ifndef GLINT_GPU_LOD_H
+#define GLINT_GPU_LOD_H
+#include "types.h"
 
 // GlintLodQuery::flags and GlintLodAtlas::flags bits.
 #define GLINT_LOD_ANISOTROPIC 1u  // use the anisotropic LOD (eta = min(rho_max / rho_min, max_aniso))
@@ -35,5 +36,12 @@ struct GlintLodAtlas {
   GLINT_UINT flags;
   GLINT_UINT reserved;
 };
+
+#ifdef __cplusplus
+static_assert(sizeof(GlintLodQuery) == 32 && offsetof(GlintLodQuery, tex_w) == 16 && offsetof(GlintLodQuery, off_y) == 28,
+              "GlintLodQuery std430 layout (8 floats)");
+static_assert(sizeof(GlintLodAtlas) == 32 && offsetof(GlintLodAtlas, padding) == 20 && offsetof(GlintLodAtlas, flags) == 24,
+              "GlintLodAtlas std430 layout");
+#endif
 
 #endif

@@ -1,15 +1,15 @@
-// The buffers that connect the lens-flare stages (issue 5, seed 004), declared once for GLSL and
-// C++ (STYLE rule 2): the caller's light list, the instance buffer that the cull/occlusion/
-// compaction kernel appends visible lights to, the indirect arguments it writes, its statistics,
-// and one result per input light. The raster draw (vkCmdDrawIndirect) and the compute gather
-// (which reads group_count_x) both read GlintFlareInstance and GlintFlareIndirect and nothing else
-// from the visibility stage, so the two halves meet only here.
-// GLSL: declare buffers as `layout(std430) buffer X { GlintFlareInstance instances[]; };`.
-// Only 4-byte scalars, so std430 and C++ layouts agree; the C++ side static_asserts them
-// (host/flare_types_check.cpp).
-#ifndef GLINT_FLARE_TYPES_H
-#define GLINT_FLARE_TYPES_H
-#include "glint_types.h"
+// The buffers that connect the lens-flare stages, declared once for GLSL and C++: the caller's
+// light list, the instance buffer that the cull/occlusion/compaction kernel appends visible lights
+// to, the indirect arguments it writes, its statistics, and one result per input light. The
+// raster draw (vkCmdDrawIndirect) and the compute gather (which reads group_count_x) both read
+// GlintFlareInstance and GlintFlareIndirect and nothing else from the visibility stage, so the two
+// halves meet only here.
+// Installed with the library: C++ includes <glint/gpu/flare_types.h>, GLSL "glint/gpu/flare_types.h"
+// and declares buffers as `layout(std430) buffer X { GlintFlareInstance instances[]; };`.
+// Only 4-byte scalars, so std430 and C++ layouts agree; the C++ side static_asserts them below.
+#ifndef GLINT_GPU_FLARE_TYPES_H
+#define GLINT_GPU_FLARE_TYPES_H
+#include "types.h"
 
 // Flare elements: the tiles of the element atlas, and GlintFlareLight::element.
 #define GLINT_FLARE_ELEMENT_GLOW 0u
@@ -44,7 +44,7 @@ struct GlintFlareLight {
 };
 
 // One visible light, as the compaction writes it for the draw (48 bytes). Instances are in
-// increasing light_index (issue 6: the compaction preserves order), so the additive draw sums in
+// increasing light_index (the compaction preserves order), so the additive draw sums in
 // the same order, and gives the same bits, on every run.
 struct GlintFlareInstance {
   GLINT_FLOAT center_x_px;       // the light's pixel position, (ndc.xy * 0.5 + 0.5) * viewport
@@ -97,5 +97,25 @@ struct GlintFlareLightResult {
   GLINT_FLOAT visible_fraction;  // [0, 1]; 0 when culled for any reason
   GLINT_UINT culled;             // GLINT_FLARE_VISIBLE / _FRUSTUM / _OCCLUDED / _DISABLED / _OVERFLOW
 };
+
+#ifdef __cplusplus
+// The std430 layout of each struct (every member a 4-byte scalar: offset = 4 x member index).
+static_assert(sizeof(GlintFlareLight) == 48, "GlintFlareLight is 48 bytes");
+static_assert(offsetof(GlintFlareLight, intensity) == 12 && offsetof(GlintFlareLight, size_px) == 28 &&
+                  offsetof(GlintFlareLight, element) == 32 && offsetof(GlintFlareLight, enabled) == 36,
+              "GlintFlareLight std430 offsets");
+static_assert(sizeof(GlintFlareInstance) == 48, "GlintFlareInstance is 48 bytes");
+static_assert(offsetof(GlintFlareInstance, visible_fraction) == 12 && offsetof(GlintFlareInstance, intensity) == 28 &&
+                  offsetof(GlintFlareInstance, light_index) == 32 && offsetof(GlintFlareInstance, ndc_depth) == 40,
+              "GlintFlareInstance std430 offsets");
+static_assert(sizeof(GlintFlareIndirect) == 32, "GlintFlareIndirect is 32 bytes");
+static_assert(offsetof(GlintFlareIndirect, instance_count) == 4 && offsetof(GlintFlareIndirect, group_count_x) == 16,
+              "GlintFlareIndirect: VkDrawIndirectCommand at 0, VkDispatchIndirectCommand at 16");
+static_assert(sizeof(GlintFlareStats) == 32, "GlintFlareStats is 32 bytes");
+static_assert(offsetof(GlintFlareStats, visible) == 12 && offsetof(GlintFlareStats, disabled) == 20,
+              "GlintFlareStats std430 offsets");
+static_assert(sizeof(GlintFlareLightResult) == 8 && offsetof(GlintFlareLightResult, culled) == 4,
+              "GlintFlareLightResult std430 layout");
+#endif
 
 #endif
