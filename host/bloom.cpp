@@ -13,6 +13,7 @@
 #include "core/context_state.h"
 #include "core/pipeline.h"
 #include "core/resources.h"
+#include "core/size_cache.h"
 
 namespace glint {
 
@@ -160,26 +161,32 @@ struct Bloom::Impl {
   detail::ComputePipeline prefilter_down, down, blur, up;
   detail::ComputePipeline composite[2], copy[2];  // [0] rgba16f, [1] rgba32f
 
-  // Pyramid for the current extent.
-  VkExtent2D extent{0, 0};
-  std::vector<LevelSize> chain;
-  bool was_clamped = false;
-  std::vector<LevelSize> pre_chain;            // level0_height's 2:1 steps before level 0
-  std::vector<detail::OwnedImage> pre_levels;
-  std::vector<VkDescriptorSet> pre_sets;        // pre_levels[k] -> pre_levels[k + 1] or level 0
-  std::vector<detail::OwnedImage> levels;
-  std::vector<detail::OwnedImage> temps;  // gauss9 horizontal pass, one per level
-  detail::DescriptorArena internal_sets;
-  std::vector<VkDescriptorSet> down_sets, blur_h_sets, blur_v_sets, up_sets;
-
   // Descriptor sets that name caller images, made once per (input view, output view).
   struct CallerSets {
     VkDescriptorSet prefilter = VK_NULL_HANDLE;
     VkDescriptorSet composite = VK_NULL_HANDLE;
     VkDescriptorSet copy = VK_NULL_HANDLE;
   };
-  std::map<std::pair<VkImageView, VkImageView>, CallerSets> caller_sets;
-  detail::DescriptorArena caller_arena;  // grows by pools of 24 sets
+
+  // The pyramid of one input extent (and config generation). Kept per size in `cache` until no
+  // submitted work can use it (core/size_cache.h), so one Bloom may be recorded at several sizes.
+  struct Pyramid {
+    VkExtent2D extent{0, 0};
+    std::vector<LevelSize> chain;
+    bool was_clamped = false;
+    std::vector<LevelSize> pre_chain;            // level0_height's 2:1 steps before level 0
+    std::vector<detail::OwnedImage> pre_levels;
+    std::vector<VkDescriptorSet> pre_sets;        // pre_levels[k] -> pre_levels[k + 1] or level 0
+    std::vector<detail::OwnedImage> levels;
+    std::vector<detail::OwnedImage> temps;  // gauss9 horizontal pass, one per level
+    detail::DescriptorArena internal_sets;
+    std::vector<VkDescriptorSet> down_sets, blur_h_sets, blur_v_sets, up_sets;
+    std::map<std::pair<VkImageView, VkImageView>, CallerSets> caller_sets;  // they name this pyramid's levels
+    detail::DescriptorArena caller_arena;  // grows by pools of 24 sets
+  };
+  detail::SizeCache<Pyramid> cache;
+  Pyramid* cur = nullptr;   // the pyramid of the last prepare() or record()
+  uint32_t generation = 0;  // bumped by a shape change: older pyramids are never found again
 
   VkFormat level_format() const {
     return config.precision == Precision::fp32 ? VK_FORMAT_R32G32B32A32_SFLOAT : VK_FORMAT_R16G16B16A16_SFLOAT;
@@ -214,27 +221,26 @@ struct Bloom::Impl {
     }
   }
 
-  void release_pyramid() {
-    caller_sets.clear();
-    caller_arena.reset();
-    down_sets.clear();
-    pre_sets.clear();
-    blur_h_sets.clear();
-    blur_v_sets.clear();
-    up_sets.clear();
-    internal_sets.reset();
-    levels.clear();
-    temps.clear();
-    pre_levels.clear();
-    pre_chain.clear();
-    extent = {0, 0};
+  // The pyramid for `size`, from the cache or made now; it becomes `cur`. Throws (before anything
+  // is recorded) when the cache is full of pyramids that submitted work may still use.
+  Pyramid& pyramid_for(VkExtent2D size, const char* who) {
+    cur = &cache.get({size, VK_FORMAT_UNDEFINED, generation}, cur, who, [&] { return make_pyramid(size); });
+    return *cur;
   }
 
-  void make_pyramid(VkExtent2D size) {
-    release_pyramid();
+  std::unique_ptr<Pyramid> make_pyramid(VkExtent2D size) const {
+    auto made = std::make_unique<Pyramid>();
+    Pyramid& P = *made;
+    P.caller_arena = detail::DescriptorArena(*context, 24);
+    std::vector<LevelSize>& chain = P.chain;
+    std::vector<LevelSize>& pre_chain = P.pre_chain;
+    std::vector<detail::OwnedImage>& pre_levels = P.pre_levels;
+    std::vector<detail::OwnedImage>& levels = P.levels;
+    std::vector<detail::OwnedImage>& temps = P.temps;
+    detail::DescriptorArena& internal_sets = P.internal_sets;
     chain = bloom_mip_chain(size, config.iterations, config.level0_height);
     pre_chain = bloom_pre_levels(size, config.level0_height);
-    was_clamped = chain.size() < config.iterations;
+    P.was_clamped = chain.size() < config.iterations;
     const VkImageUsageFlags usage = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT;
     const bool gauss = config.filter == BloomFilter::gauss9;
     for (const LevelSize& l : pre_chain) pre_levels.emplace_back(*context, VkExtent2D{l.width, l.height}, level_format(), usage);
@@ -248,26 +254,29 @@ struct Bloom::Impl {
     const VkImageLayout G = VK_IMAGE_LAYOUT_GENERAL;  // pyramid images stay in GENERAL
     for (uint32_t k = 0; k < m; ++k) {
       const VkImageView next = k + 1 < m ? pre_levels[k + 1].state.view : levels[0].state.view;
-      pre_sets.push_back(internal_sets.make_set(down, {{pre_levels[k].state.view, G}, {next, G}}));
+      P.pre_sets.push_back(internal_sets.make_set(down, {{pre_levels[k].state.view, G}, {next, G}}));
     }
     for (uint32_t k = 1; k < n; ++k) {
-      down_sets.push_back(internal_sets.make_set(down, {{levels[k - 1].state.view, G}, {levels[k].state.view, G}}));
+      P.down_sets.push_back(internal_sets.make_set(down, {{levels[k - 1].state.view, G}, {levels[k].state.view, G}}));
     }
     for (uint32_t k = 0; gauss && k < n; ++k) {
-      blur_h_sets.push_back(internal_sets.make_set(blur, {{levels[k].state.view, G}, {temps[k].state.view, G}}));
-      blur_v_sets.push_back(internal_sets.make_set(blur, {{temps[k].state.view, G}, {levels[k].state.view, G}}));
+      P.blur_h_sets.push_back(internal_sets.make_set(blur, {{levels[k].state.view, G}, {temps[k].state.view, G}}));
+      P.blur_v_sets.push_back(internal_sets.make_set(blur, {{temps[k].state.view, G}, {levels[k].state.view, G}}));
     }
     for (uint32_t k = 0; k + 1 < n; ++k) {
-      up_sets.push_back(internal_sets.make_set(up, {{levels[k + 1].state.view, G}, {levels[k].state.view, G}}));
+      P.up_sets.push_back(internal_sets.make_set(up, {{levels[k + 1].state.view, G}, {levels[k].state.view, G}}));
     }
-    extent = size;
+    P.extent = size;
+    return made;
   }
 
-  const CallerSets& sets_for(const Image& in, const Image& out) {
+  const CallerSets& sets_for(Pyramid& P, const Image& in, const Image& out) {
     auto key = std::make_pair(in.view, out.view);
-    auto it = caller_sets.find(key);
-    if (it != caller_sets.end()) return it->second;
-    auto& arena = caller_arena;
+    auto it = P.caller_sets.find(key);
+    if (it != P.caller_sets.end()) return it->second;
+    auto& arena = P.caller_arena;
+    const auto& pre_levels = P.pre_levels;
+    const auto& levels = P.levels;
     const bool in_place = in.image == out.image;
     const VkImageLayout in_layout = in_place ? VK_IMAGE_LAYOUT_GENERAL : VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
     const VkImageLayout G = VK_IMAGE_LAYOUT_GENERAL;
@@ -277,10 +286,10 @@ struct Bloom::Impl {
     s.prefilter = arena.make_set(prefilter_down, {{in.view, in_layout}, {first, G}});
     s.composite = arena.make_set(composite[o], {{in.view, in_layout}, {levels[0].state.view, G}, {out.view, G}});
     s.copy = arena.make_set(copy[o], {{in.view, in_layout}, {out.view, G}});
-    return caller_sets.emplace(key, s).first->second;
+    return P.caller_sets.emplace(key, s).first->second;
   }
 
-  BloomPush push(LevelSize src, LevelSize dst, uint32_t flags = 0) const {
+  BloomPush push(const Pyramid& P, LevelSize src, LevelSize dst, uint32_t flags = 0) const {
     BloomPush p{};
     p.src_width = static_cast<int32_t>(src.width);
     p.src_height = static_cast<int32_t>(src.height);
@@ -290,7 +299,7 @@ struct Bloom::Impl {
     p.knee = config.threshold * config.soft_knee;
     p.max_brightness = config.max_brightness;
     p.radius = config.radius;
-    p.composite_scale = config.intensity / static_cast<float>(chain.size());
+    p.composite_scale = config.intensity / static_cast<float>(P.chain.size());
     p.flags = flags;
     return p;
   }
@@ -338,20 +347,27 @@ void Bloom::Impl::record(VkCommandBuffer cmd, Image& input, Image& output, Profi
   if (config.intensity == 0.0f) {
     // Nothing to add: the output is the input. In place that is no work at all.
     if (in_place) return;
-    if (input.extent.width != extent.width || input.extent.height != extent.height) make_pyramid(input.extent);
-    const CallerSets& s = sets_for(input, output);
+    Pyramid& P = pyramid_for(input.extent, "Bloom::record");
+    const CallerSets& s = sets_for(P, input, output);
+    cache.recorded(&P, cmd);
     detail::Barriers b;
     b.use(input, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, kSampled);
     b.use(output, VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, kStorageWrite);
     b.flush(cmd);
     const LevelSize full{input.extent.width, input.extent.height};
-    copy[output.format == VK_FORMAT_R32G32B32A32_SFLOAT].dispatch(cmd, s.copy, push(full, full), full.width,
+    copy[output.format == VK_FORMAT_R32G32B32A32_SFLOAT].dispatch(cmd, s.copy, push(P, full, full), full.width,
                                                                   full.height);
     if (profiler) profiler->mark(cmd, "bloom copy (intensity 0)");
     return;
   }
-  if (input.extent.width != extent.width || input.extent.height != extent.height) make_pyramid(input.extent);
-  const CallerSets& sets = sets_for(input, output);
+  Pyramid& P = pyramid_for(input.extent, "Bloom::record");
+  const CallerSets& sets = sets_for(P, input, output);
+  cache.recorded(&P, cmd);
+  const std::vector<LevelSize>& chain = P.chain;
+  const std::vector<LevelSize>& pre_chain = P.pre_chain;
+  std::vector<detail::OwnedImage>& levels = P.levels;
+  std::vector<detail::OwnedImage>& temps = P.temps;
+  std::vector<detail::OwnedImage>& pre_levels = P.pre_levels;
 
   // In place, one state tracks the one image; it is copied back to `input` at the end.
   Image& scene = in_place ? output : input;
@@ -366,11 +382,11 @@ void Bloom::Impl::record(VkCommandBuffer cmd, Image& input, Image& output, Profi
     b.use(levels[k].state, G, kCompute, kSampled);
     b.use(temps[k].state, G, kCompute, kStorageWrite);
     b.flush(cmd);
-    blur.dispatch(cmd, blur_h_sets[k], push(chain[k], chain[k]), chain[k].width, chain[k].height);
+    blur.dispatch(cmd, P.blur_h_sets[k], push(P, chain[k], chain[k]), chain[k].width, chain[k].height);
     b.use(temps[k].state, G, kCompute, kSampled);
     b.use(levels[k].state, G, kCompute, kStorageWrite);
     b.flush(cmd);
-    blur.dispatch(cmd, blur_v_sets[k], push(chain[k], chain[k], GLINT_BLOOM_FLAG_VERTICAL), chain[k].width,
+    blur.dispatch(cmd, P.blur_v_sets[k], push(P, chain[k], chain[k], GLINT_BLOOM_FLAG_VERTICAL), chain[k].width,
                   chain[k].height);
   };
 
@@ -382,14 +398,14 @@ void Bloom::Impl::record(VkCommandBuffer cmd, Image& input, Image& output, Profi
   b.use(scene, scene_layout, kCompute, kSampled);
   b.use(first, G, kCompute, kStorageWrite);
   b.flush(cmd);
-  prefilter_down.dispatch(cmd, sets.prefilter, push(full, first_size, karis), first_size.width, first_size.height);
+  prefilter_down.dispatch(cmd, sets.prefilter, push(P, full, first_size, karis), first_size.width, first_size.height);
   for (uint32_t k = 0; k < m; ++k) {
     Image& next = k + 1 < m ? pre_levels[k + 1].state : levels[0].state;
     const LevelSize next_size = k + 1 < m ? pre_chain[k + 1] : chain[0];
     b.use(pre_levels[k].state, G, kCompute, kSampled);
     b.use(next, G, kCompute, kStorageWrite);
     b.flush(cmd);
-    down.dispatch(cmd, pre_sets[k], push(pre_chain[k], next_size), next_size.width, next_size.height);
+    down.dispatch(cmd, P.pre_sets[k], push(P, pre_chain[k], next_size), next_size.width, next_size.height);
   }
   if (gauss) blur_level(0);
   if (profiler) profiler->mark(cmd, "bloom bright-pass + down 0");
@@ -399,7 +415,7 @@ void Bloom::Impl::record(VkCommandBuffer cmd, Image& input, Image& output, Profi
     b.use(levels[k - 1].state, G, kCompute, kSampled);
     b.use(levels[k].state, G, kCompute, kStorageWrite);
     b.flush(cmd);
-    down.dispatch(cmd, down_sets[k - 1], push(chain[k - 1], chain[k]), chain[k].width, chain[k].height);
+    down.dispatch(cmd, P.down_sets[k - 1], push(P, chain[k - 1], chain[k]), chain[k].width, chain[k].height);
     if (gauss) blur_level(k);
   }
   if (profiler && n > 1) profiler->mark(cmd, "bloom downsample");
@@ -409,7 +425,7 @@ void Bloom::Impl::record(VkCommandBuffer cmd, Image& input, Image& output, Profi
     b.use(levels[k + 1].state, G, kCompute, kSampled);
     b.use(levels[k].state, G, kCompute, kStorageRead | kStorageWrite);
     b.flush(cmd);
-    up.dispatch(cmd, up_sets[k], push(chain[k + 1], chain[k]), chain[k].width, chain[k].height);
+    up.dispatch(cmd, P.up_sets[k], push(P, chain[k + 1], chain[k]), chain[k].width, chain[k].height);
   }
   if (profiler && n > 1) profiler->mark(cmd, "bloom upsample");
 
@@ -418,7 +434,7 @@ void Bloom::Impl::record(VkCommandBuffer cmd, Image& input, Image& output, Profi
   b.use(scene, scene_layout, kCompute, kSampled);
   b.use(output, G, kCompute, in_place ? (kSampled | kStorageWrite) : kStorageWrite);
   b.flush(cmd);
-  composite[output.format == VK_FORMAT_R32G32B32A32_SFLOAT].dispatch(cmd, sets.composite, push(chain[0], full),
+  composite[output.format == VK_FORMAT_R32G32B32A32_SFLOAT].dispatch(cmd, sets.composite, push(P, chain[0], full),
                                                                      full.width, full.height);
   if (profiler) profiler->mark(cmd, "bloom composite");
   if (in_place) input = output;
@@ -429,7 +445,7 @@ Bloom::Bloom(const Context& context, const BloomConfig& config) : impl_(std::mak
   impl_->context = &context;
   impl_->config = config;
   impl_->workgroup = bloom_workgroup(context);
-  impl_->caller_arena = detail::DescriptorArena(context, 24);
+  impl_->cache.bind(context);
   impl_->make_pipelines();
 }
 
@@ -447,10 +463,11 @@ void Bloom::set_config(const BloomConfig& config) {
   const bool shape_changed =
       old.iterations != config.iterations || old.level0_height != config.level0_height || pipelines_changed;
   if (!shape_changed) return;
-  const VkExtent2D size = impl_->extent;
-  impl_->release_pyramid();
+  // Pyramids of the old shape stay cached, never found again, until no submitted work uses them.
+  // Their descriptor sets name set layouts of compiled kernels, which live as long as the context.
+  ++impl_->generation;
   if (pipelines_changed) impl_->make_pipelines();
-  if (size.width) impl_->make_pyramid(size);
+  if (impl_->cur) impl_->pyramid_for(impl_->cur->extent, "Bloom::set_config");
 }
 
 const BloomConfig& Bloom::config() const { return impl_->config; }
@@ -461,7 +478,7 @@ void Bloom::prepare(VkExtent2D extent) {
     throw Error(ErrorCode::unsupported_size, concat("Bloom::prepare: extent ", extent.width, "x", extent.height,
                                                     " is out of range: accepted 1 to ", max_dim, " on each side"));
   }
-  if (extent.width != impl_->extent.width || extent.height != impl_->extent.height) impl_->make_pyramid(extent);
+  impl_->pyramid_for(extent, "Bloom::prepare");
 }
 
 void Bloom::record(VkCommandBuffer cmd, Image& input, Image& output, Profiler* profiler) {
@@ -472,22 +489,29 @@ void Bloom::record(VkCommandBuffer cmd, Image& input, Image& output, Profiler* p
 }
 
 void Bloom::forget_caller_resources() {
-  impl_->caller_sets.clear();
-  impl_->caller_arena.reset();
+  impl_->cache.for_each([](Impl::Pyramid& p) {
+    p.caller_sets.clear();
+    p.caller_arena.reset();
+  });
 }
 
-uint32_t Bloom::levels() const { return static_cast<uint32_t>(impl_->chain.size()); }
-bool Bloom::clamped() const { return impl_->was_clamped; }
-std::vector<LevelSize> Bloom::level_sizes() const { return impl_->chain; }
+void Bloom::release_unused() { impl_->cache.release_unused(impl_->cur); }
+uint32_t Bloom::cached_sizes() const { return impl_->cache.size(); }
+
+uint32_t Bloom::levels() const { return impl_->cur ? static_cast<uint32_t>(impl_->cur->chain.size()) : 0u; }
+bool Bloom::clamped() const { return impl_->cur && impl_->cur->was_clamped; }
+std::vector<LevelSize> Bloom::level_sizes() const { return impl_->cur ? impl_->cur->chain : std::vector<LevelSize>{}; }
 
 uint64_t Bloom::min_bytes_moved(VkFormat input_format, VkFormat output_format) const {
-  const uint64_t pixels = uint64_t(impl_->extent.width) * impl_->extent.height;
+  if (!impl_->cur) return 0;
+  const Impl::Pyramid& p = *impl_->cur;
+  const uint64_t pixels = uint64_t(p.extent.width) * p.extent.height;
   const uint64_t in_bytes = input_format == VK_FORMAT_R32G32B32A32_SFLOAT ? 16 : 8;
   const uint64_t out_bytes = output_format == VK_FORMAT_R32G32B32A32_SFLOAT ? 16 : 8;
   const uint64_t level_bytes = impl_->config.precision == Precision::fp32 ? 16 : 8;
   uint64_t total = pixels * (in_bytes + out_bytes);
-  for (const LevelSize& l : impl_->chain) total += 2 * uint64_t(l.width) * l.height * level_bytes;
-  for (const LevelSize& l : impl_->pre_chain) total += 2 * uint64_t(l.width) * l.height * level_bytes;
+  for (const LevelSize& l : p.chain) total += 2 * uint64_t(l.width) * l.height * level_bytes;
+  for (const LevelSize& l : p.pre_chain) total += 2 * uint64_t(l.width) * l.height * level_bytes;
   return total;
 }
 

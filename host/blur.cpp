@@ -18,6 +18,7 @@
 #include "core/context_state.h"
 #include "core/pipeline.h"
 #include "core/resources.h"
+#include "core/size_cache.h"
 
 namespace glint {
 
@@ -173,10 +174,14 @@ struct Step {
   std::string label;
 };
 
-// Owned pipelines keyed by what specializes them, owned images, steps, and the descriptor sets.
+// Pipelines keyed by what specializes them, shared by every size of one effect (a std::map, so the
+// steps' pointers stay valid while the effect lives).
+using PipelineMap = std::map<std::string, detail::ComputePipeline>;
+
+// The program of one size: owned images, steps, and the descriptor sets.
 struct StepProgram {
   const Context* context = nullptr;
-  std::map<std::string, detail::ComputePipeline> pipelines;
+  PipelineMap* pipelines = nullptr;
   std::vector<detail::OwnedImage> images;
   std::vector<detail::OwnedBuffer> tap_buffers;
   std::vector<Step> steps;
@@ -190,27 +195,19 @@ struct StepProgram {
     caller_arena.reset();
   }
 
-  void clear_size() {
-    steps.clear();
-    forget_caller_sets();
-    internal_sets.reset();
-    images.clear();
-    tap_buffers.clear();
-  }
-
   const detail::ComputePipeline& pipeline(const std::string& kernel, VkFormat dst_format, detail::Workgroup2D wg,
                                           std::vector<uint32_t> spec, std::vector<VkDescriptorType> bindings) {
     std::string key = concat(kernel, "_", detail::format_variant(dst_format), "/", wg.x, "x", wg.y);
     for (uint32_t v : spec) key += concat("/", v);
-    auto it = pipelines.find(key);
-    if (it != pipelines.end()) return it->second;
+    auto it = pipelines->find(key);
+    if (it != pipelines->end()) return it->second;
     detail::PipelineDesc d;
     d.kernel_id = concat(kernel, "_", detail::format_variant(dst_format));
     d.bindings = std::move(bindings);
     d.push_constant_bytes = sizeof(BlurPush);
     d.workgroup = wg;
     d.specialization = std::move(spec);
-    return pipelines.emplace(key, detail::ComputePipeline(*context, d)).first->second;
+    return pipelines->emplace(key, detail::ComputePipeline(*context, d)).first->second;
   }
 
   // Owned images can also be copied from (BlurPyramid hands its levels to the caller).
@@ -247,7 +244,6 @@ struct StepProgram {
     uint32_t n = 0;
     for (const Step& s : steps) n += (s.src >= 0 && s.dst >= 0);
     internal_sets = detail::DescriptorArena(*context, std::max(1u, n));
-    caller_sets.clear();  // they name the steps of the size before
     caller_arena = detail::DescriptorArena(*context, 8);
     for (Step& s : steps) {
       if (s.src >= 0 && s.dst >= 0)
@@ -352,17 +348,35 @@ Step simple_step(StepProgram& prog, const char* kernel, int src, int dst, VkExte
 // BlurPyramid
 
 struct BlurPyramid::Impl {
+  const Context* context = nullptr;
   BlurPyramidConfig config;
-  StepProgram prog;
-  VkExtent2D extent{0, 0};
-  std::array<VkExtent2D, 3> sizes{};
+  PipelineMap pipelines;
+  // The program of one input size (and config generation), kept per size until no submitted work
+  // can use it (core/size_cache.h).
+  struct Size {
+    StepProgram prog;
+    VkExtent2D extent{0, 0};
+    std::array<VkExtent2D, 3> sizes{};
+  };
+  detail::SizeCache<Size> cache;
+  Size* cur = nullptr;      // the size of the last prepare() or record()
+  uint32_t generation = 0;  // bumped by set_config()
 
   VkFormat level_format() const { return precision_format(config.precision); }
 
-  void make(VkExtent2D size) {
-    prog.clear_size();
-    extent = size;
-    const DeviceInfo& info = prog.context->info();
+  Size& size_for(VkExtent2D size, const char* who) {
+    cur = &cache.get({size, VK_FORMAT_UNDEFINED, generation}, cur, who, [&] { return make(size); });
+    return *cur;
+  }
+
+  std::unique_ptr<Size> make(VkExtent2D size) {
+    auto made = std::make_unique<Size>();
+    StepProgram& prog = made->prog;
+    std::array<VkExtent2D, 3>& sizes = made->sizes;
+    prog.context = context;
+    prog.pipelines = &pipelines;
+    made->extent = size;
+    const DeviceInfo& info = context->info();
     VkExtent2D prev = size;
     for (int k = 0; k < 3; ++k) {
       sizes[k] = half_extent(prev);
@@ -380,13 +394,15 @@ struct BlurPyramid::Impl {
       prev = sizes[k];
     }
     prog.make_internal_sets();
+    return made;
   }
 };
 
 BlurPyramid::BlurPyramid(const Context& context, const BlurPyramidConfig& config) : impl_(std::make_unique<Impl>()) {
   config.validate();
   impl_->config = config;
-  impl_->prog.context = &context;
+  impl_->context = &context;
+  impl_->cache.bind(context);
   // Fail now, not at the first record, if the largest radius cannot fit the device.
   for (float s : config.sigma_texels) {
     fused_shape(context.info(),
@@ -400,41 +416,44 @@ BlurPyramid::~BlurPyramid() = default;
 void BlurPyramid::set_config(const BlurPyramidConfig& config) {
   config.validate();
   impl_->config = config;
-  impl_->prog.pipelines.clear();
-  const VkExtent2D size = impl_->extent;
-  impl_->prog.clear_size();
-  impl_->extent = {0, 0};
-  if (size.width) impl_->make(size);
+  // Programs of the old config stay cached, never found again, until no submitted work uses them.
+  ++impl_->generation;
+  if (impl_->cur) impl_->size_for(impl_->cur->extent, "BlurPyramid::set_config");
 }
 const BlurPyramidConfig& BlurPyramid::config() const { return impl_->config; }
 
 void BlurPyramid::prepare(VkExtent2D input_extent) {
-  check_extent(*impl_->prog.context, input_extent, "BlurPyramid::prepare");
-  if (input_extent.width != impl_->extent.width || input_extent.height != impl_->extent.height)
-    impl_->make(input_extent);
+  check_extent(*impl_->context, input_extent, "BlurPyramid::prepare");
+  impl_->size_for(input_extent, "BlurPyramid::prepare");
 }
 
 void BlurPyramid::record(VkCommandBuffer cmd, Image& input, Profiler* profiler) {
   detail::check_command_buffer("BlurPyramid::record", cmd);
   detail::check_image_layout("BlurPyramid::record", "input", input);
-  check_image(*impl_->prog.context, input, "BlurPyramid::record", "input", VK_IMAGE_USAGE_SAMPLED_BIT,
+  check_image(*impl_->context, input, "BlurPyramid::record", "input", VK_IMAGE_USAGE_SAMPLED_BIT,
               "VK_IMAGE_USAGE_SAMPLED_BIT");
-  prepare(input.extent);
-  impl_->prog.record(cmd, input, nullptr, profiler);
+  Impl::Size& size = impl_->size_for(input.extent, "BlurPyramid::record");
+  impl_->cache.recorded(&size, cmd);
+  size.prog.record(cmd, input, nullptr, profiler);
 }
 
 const Image& BlurPyramid::level(uint32_t k) const {
   if (k < 1 || k > 3)
     throw Error(ErrorCode::invalid_argument,
                 concat("BlurPyramid::level: k = ", k, " is out of range: accepted 1 to 3"));
-  if (impl_->prog.images.size() != 3)
+  if (!impl_->cur)
     throw Error(ErrorCode::invalid_argument, "BlurPyramid::level: call prepare() or record() first");
-  return impl_->prog.images[k - 1].state;
+  return impl_->cur->prog.images[k - 1].state;
 }
 
 Image& BlurPyramid::level(uint32_t k) { return const_cast<Image&>(std::as_const(*this).level(k)); }
 
-void BlurPyramid::forget_caller_resources() { impl_->prog.forget_caller_sets(); }
+void BlurPyramid::forget_caller_resources() {
+  impl_->cache.for_each([](Impl::Size& s) { s.prog.forget_caller_sets(); });
+}
+
+void BlurPyramid::release_unused() { impl_->cache.release_unused(impl_->cur); }
+uint32_t BlurPyramid::cached_sizes() const { return impl_->cache.size(); }
 
 LevelSize BlurPyramid::level_size(uint32_t k) const {
   const Image& l = level(k);
@@ -444,16 +463,18 @@ LevelSize BlurPyramid::level_size(uint32_t k) const {
 EffectiveSigma BlurPyramid::effective_sigma_px(uint32_t k) const {
   level(k);  // validates k and that a size is prepared
   const std::vector<double> s(impl_->config.sigma_texels.begin(), impl_->config.sigma_texels.end());
-  return {blur_plan::pyramid_effective_sigma(impl_->extent.width, s)[k - 1],
-          blur_plan::pyramid_effective_sigma(impl_->extent.height, s)[k - 1]};
+  return {blur_plan::pyramid_effective_sigma(impl_->cur->extent.width, s)[k - 1],
+          blur_plan::pyramid_effective_sigma(impl_->cur->extent.height, s)[k - 1]};
 }
 
 uint64_t BlurPyramid::min_bytes_moved(VkFormat input_format) const {
+  if (!impl_->cur) return 0;
+  const Impl::Size& size = *impl_->cur;
   const uint64_t in_bytes = detail::texel_bytes(input_format);
   const uint64_t level_bytes = detail::texel_bytes(impl_->level_format());
-  uint64_t total = uint64_t(impl_->extent.width) * impl_->extent.height * in_bytes;
+  uint64_t total = uint64_t(size.extent.width) * size.extent.height * in_bytes;
   for (int k = 0; k < 3; ++k) {
-    const uint64_t texels = uint64_t(impl_->sizes[k].width) * impl_->sizes[k].height;
+    const uint64_t texels = uint64_t(size.sizes[k].width) * size.sizes[k].height;
     total += texels * level_bytes * (k < 2 ? 2 : 1);  // written; read by the next level
   }
   return total;
@@ -463,16 +484,31 @@ uint64_t BlurPyramid::min_bytes_moved(VkFormat input_format) const {
 // GaussianBlur
 
 struct GaussianBlur::Impl {
+  const Context* context = nullptr;
   GaussianBlurConfig config;
-  StepProgram prog;
-  VkExtent2D extent{0, 0};
-  VkFormat output_format = VK_FORMAT_UNDEFINED;  // steps writing the output are specialized for it
-  BlurChoice choice;
-  std::vector<std::pair<VkExtent2D, VkFormat>> intermediates;  // for min_bytes_moved
+  PipelineMap pipelines;
+  // The plan and program of one (input size, output format, config generation): steps writing the
+  // output are specialized for its format. Kept until no submitted work can use it
+  // (core/size_cache.h).
+  struct Size {
+    StepProgram prog;
+    VkExtent2D extent{0, 0};
+    VkFormat output_format = VK_FORMAT_UNDEFINED;
+    BlurChoice choice;
+    std::vector<std::pair<VkExtent2D, VkFormat>> intermediates;  // for min_bytes_moved
+  };
+  detail::SizeCache<Size> cache;
+  Size* cur = nullptr;      // the size of the last prepare() or record()
+  uint32_t generation = 0;  // bumped by set_config()
 
   VkFormat level_format() const { return precision_format(config.precision); }
 
-  void plan(VkExtent2D size) {
+  Size& size_for(VkExtent2D size, VkFormat out_format, const char* who) {
+    cur = &cache.get({size, out_format, generation}, cur, who, [&] { return make(size, out_format); });
+    return *cur;
+  }
+
+  BlurChoice plan(VkExtent2D size) const {
     const double bound = config.max_relative_error;
     blur_plan::Plan p;
     switch (config.method) {
@@ -491,7 +527,7 @@ struct GaussianBlur::Impl {
         p = blur_plan::plan_method(blur_plan::Method::dual, config.sigma_px, size.width, size.height, bound);
         break;
     }
-    choice = {};
+    BlurChoice choice;
     choice.linear_sampling = p.method == blur_plan::Method::separable_linear;
     choice.method = (p.method == blur_plan::Method::separable || choice.linear_sampling) ? BlurMethod::separable
                     : p.method == blur_plan::Method::pyramid                             ? BlurMethod::pyramid
@@ -502,15 +538,20 @@ struct GaussianBlur::Impl {
     choice.dual_offset = p.dual_offset;
     choice.effective_sigma_px = p.effective_sigma_px;
     choice.expected_relative_error = p.expected_relative_l2;
+    return choice;
   }
 
-  void make(VkExtent2D size, VkFormat out_format) {
-    prog.clear_size();
-    intermediates.clear();
-    extent = size;
-    output_format = out_format;
-    plan(size);
-    const DeviceInfo& info = prog.context->info();
+  std::unique_ptr<Size> make(VkExtent2D size, VkFormat out_format) {
+    auto made = std::make_unique<Size>();
+    StepProgram& prog = made->prog;
+    prog.context = context;
+    prog.pipelines = &pipelines;
+    made->extent = size;
+    made->output_format = out_format;
+    made->choice = plan(size);
+    BlurChoice& choice = made->choice;
+    std::vector<std::pair<VkExtent2D, VkFormat>>& intermediates = made->intermediates;
+    const DeviceInfo& info = context->info();
     const VkFormat lf = level_format();
     const float max_value = max_value_for(lf, out_format);
     const uint32_t sanitize = GLINT_BLUR_FLAG_SANITIZE;
@@ -606,13 +647,15 @@ struct GaussianBlur::Impl {
     }
     choice.dispatches = static_cast<uint32_t>(prog.steps.size());
     prog.make_internal_sets();
+    return made;
   }
 };
 
 GaussianBlur::GaussianBlur(const Context& context, const GaussianBlurConfig& config) : impl_(std::make_unique<Impl>()) {
   config.validate();
   impl_->config = config;
-  impl_->prog.context = &context;
+  impl_->context = &context;
+  impl_->cache.bind(context);
 }
 GaussianBlur::GaussianBlur(GaussianBlur&&) noexcept = default;
 GaussianBlur& GaussianBlur::operator=(GaussianBlur&&) noexcept = default;
@@ -621,27 +664,23 @@ GaussianBlur::~GaussianBlur() = default;
 void GaussianBlur::set_config(const GaussianBlurConfig& config) {
   config.validate();
   impl_->config = config;
-  const VkExtent2D size = impl_->extent;
-  const VkFormat out = impl_->output_format;
-  impl_->prog.clear_size();
-  impl_->prog.pipelines.clear();
-  impl_->extent = {0, 0};
-  if (size.width) impl_->make(size, out);
+  // Programs of the old config stay cached, never found again, until no submitted work uses them.
+  ++impl_->generation;
+  if (impl_->cur) impl_->size_for(impl_->cur->extent, impl_->cur->output_format, "GaussianBlur::set_config");
 }
 const GaussianBlurConfig& GaussianBlur::config() const { return impl_->config; }
 
 void GaussianBlur::prepare(VkExtent2D extent) {
-  check_extent(*impl_->prog.context, extent, "GaussianBlur::prepare");
-  const VkFormat out =
-      impl_->output_format == VK_FORMAT_UNDEFINED ? VK_FORMAT_R16G16B16A16_SFLOAT : impl_->output_format;
-  if (extent.width != impl_->extent.width || extent.height != impl_->extent.height) impl_->make(extent, out);
+  check_extent(*impl_->context, extent, "GaussianBlur::prepare");
+  const VkFormat out = impl_->cur ? impl_->cur->output_format : VK_FORMAT_R16G16B16A16_SFLOAT;
+  impl_->size_for(extent, out, "GaussianBlur::prepare");
 }
 
 void GaussianBlur::record(VkCommandBuffer cmd, Image& input, Image& output, Profiler* profiler) {
   detail::check_command_buffer("GaussianBlur::record", cmd);
   detail::check_image_layout("GaussianBlur::record", "input", input);
   detail::check_image_layout("GaussianBlur::record", "output", output);
-  const Context& ctx = *impl_->prog.context;
+  const Context& ctx = *impl_->context;
   check_image(ctx, input, "GaussianBlur::record", "input", VK_IMAGE_USAGE_SAMPLED_BIT, "VK_IMAGE_USAGE_SAMPLED_BIT");
   check_image(ctx, output, "GaussianBlur::record", "output", VK_IMAGE_USAGE_STORAGE_BIT, "VK_IMAGE_USAGE_STORAGE_BIT");
   if (input.image == output.image) {
@@ -652,21 +691,29 @@ void GaussianBlur::record(VkCommandBuffer cmd, Image& input, Image& output, Prof
                 concat("GaussianBlur::record: output extent ", output.extent.width, "x", output.extent.height,
                        " differs from input extent ", input.extent.width, "x", input.extent.height));
   }
-  if (input.extent.width != impl_->extent.width || input.extent.height != impl_->extent.height ||
-      output.format != impl_->output_format) {
-    impl_->make(input.extent, output.format);
-  }
-  impl_->prog.record(cmd, input, &output, profiler);
+  Impl::Size& size = impl_->size_for(input.extent, output.format, "GaussianBlur::record");
+  impl_->cache.recorded(&size, cmd);
+  size.prog.record(cmd, input, &output, profiler);
 }
 
-void GaussianBlur::forget_caller_resources() { impl_->prog.forget_caller_sets(); }
+void GaussianBlur::forget_caller_resources() {
+  impl_->cache.for_each([](Impl::Size& s) { s.prog.forget_caller_sets(); });
+}
 
-const BlurChoice& GaussianBlur::choice() const { return impl_->choice; }
+void GaussianBlur::release_unused() { impl_->cache.release_unused(impl_->cur); }
+uint32_t GaussianBlur::cached_sizes() const { return impl_->cache.size(); }
+
+const BlurChoice& GaussianBlur::choice() const {
+  static const BlurChoice none{};
+  return impl_->cur ? impl_->cur->choice : none;
+}
 
 uint64_t GaussianBlur::min_bytes_moved(VkFormat input_format, VkFormat output_format) const {
-  const uint64_t texels = uint64_t(impl_->extent.width) * impl_->extent.height;
+  if (!impl_->cur) return 0;
+  const Impl::Size& size = *impl_->cur;
+  const uint64_t texels = uint64_t(size.extent.width) * size.extent.height;
   uint64_t total = texels * (detail::texel_bytes(input_format) + detail::texel_bytes(output_format));
-  for (const auto& [e, f] : impl_->intermediates) total += 2 * uint64_t(e.width) * e.height * detail::texel_bytes(f);
+  for (const auto& [e, f] : size.intermediates) total += 2 * uint64_t(e.width) * e.height * detail::texel_bytes(f);
   return total;
 }
 

@@ -556,7 +556,8 @@ TEST(ApiMemory, ObjectTrackerReportsALeakAtContextDestruction) {
   EXPECT_GT(detail::validation_messages_all_contexts(), before);
 }
 
-// 1000 prepare() calls at alternating sizes rebuild each effect's intermediates 1000 times (bloom
+// 1000 prepare() calls cycling through 40 sizes, more than the kMaxCachedSizes an effect keeps, so
+// that from the 33rd on each one destroys the least recently used size and makes a new one (bloom
 // with and without level0_height's pre-levels, the blur pyramid, the Gaussian blur's pyramid
 // method); the Hi-Z pyramid, whose size is part of its config, is made 1000 times instead (its
 // kernels compile once per context: before they were shared, each make grew lavapipe by ~4 MB).
@@ -579,7 +580,8 @@ TEST(ApiMemory, AThousandResizesDoNotGrowMemory) {
     gauss_config.sigma_px = 6.0f;
     GaussianBlur gauss(ctx, gauss_config);
     for (int i = 0; i < 1000; ++i) {
-      const VkExtent2D e = i % 2 ? VkExtent2D{256, 128} : VkExtent2D{200, 100};
+      static_assert(kMaxCachedSizes < 40);
+      const VkExtent2D e{200 + 2 * static_cast<uint32_t>(i % 40), 100 + static_cast<uint32_t>(i % 40)};
       bloom.prepare(e);
       bloom_stepped.prepare(e);
       pyramid.prepare(e);
@@ -589,6 +591,8 @@ TEST(ApiMemory, AThousandResizesDoNotGrowMemory) {
       HiZPyramid made(ctx, hiz);
       if (i == 99) warm = rss_bytes();
     }
+    EXPECT_EQ(bloom.cached_sizes(), kMaxCachedSizes);
+    EXPECT_EQ(gauss.cached_sizes(), kMaxCachedSizes);
     end = rss_bytes();
   }
   if (kRssIsMeaningful) {

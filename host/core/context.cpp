@@ -373,6 +373,7 @@ Context Context::create(const ContextOptions& options) {
     }
   } guard{&s};
 
+  detail::check_frames_in_flight("ContextOptions::frames_in_flight", options.frames_in_flight);
   if (options.gpu_assisted_validation && !options.validation) {
     throw Error(ErrorCode::invalid_argument,
                 "ContextOptions::gpu_assisted_validation needs ContextOptions::validation = true");
@@ -450,6 +451,7 @@ Context Context::create(const ContextOptions& options) {
     }
     s.workgroup_2d = wg;
   }
+  s.frames_in_flight = options.frames_in_flight;
   guard.done = true;
   return Context(std::move(state));
 }
@@ -462,6 +464,7 @@ Context Context::adopt(const AdoptInfo& a) {
                        a.physical_device ? "physical_device" : "null physical_device", ", ",
                        a.device ? "device" : "null device", ")"));
   }
+  detail::check_frames_in_flight("AdoptInfo::frames_in_flight", a.frames_in_flight);
   uint32_t n = 0;
   vkGetPhysicalDeviceQueueFamilyProperties(a.physical_device, &n, nullptr);
   std::vector<VkQueueFamilyProperties> families(n);
@@ -506,6 +509,7 @@ Context Context::adopt(const AdoptInfo& a) {
   state->device = a.device;
   state->queue_family = a.queue_family_index;
   state->adopted = true;
+  state->frames_in_flight = a.frames_in_flight;
   detail::fill_info(*state);
   state->dynamic_rendering = features.dynamic_rendering;
   return Context(std::move(state));
@@ -541,6 +545,27 @@ void Context::run_once(const std::function<void(VkCommandBuffer)>& record) const
     VkCommandBuffer cmd;
     ~Free() { vkFreeCommandBuffers(s.device, s.command_pool, 1, &cmd); }
   } free_cmd{s, cmd};
+  // Effects recording into `cmd` note its serial; it is pending until the fence wait below is over
+  // (or recording failed and nothing was submitted), the guard's destructor.
+  struct Once {
+    detail::ContextState& s;
+    VkCommandBuffer cmd;
+    Once(detail::ContextState& state, VkCommandBuffer c) : s(state), cmd(c) {
+      std::lock_guard<std::mutex> lock(s.once_mutex);
+      s.once_active.emplace_back(cmd, s.once_next++);
+      ++s.once_count;
+    }
+    ~Once() {
+      std::lock_guard<std::mutex> lock(s.once_mutex);
+      for (auto it = s.once_active.begin(); it != s.once_active.end(); ++it) {
+        if (it->first == cmd) {
+          s.once_active.erase(it);
+          break;
+        }
+      }
+      --s.once_count;
+    }
+  } once{s, cmd};
   VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
   begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
   vk_check(vkBeginCommandBuffer(cmd, &begin), "vkBeginCommandBuffer");
@@ -553,6 +578,53 @@ void Context::run_once(const std::function<void(VkCommandBuffer)>& record) const
   vk_check(vkQueueSubmit(s.queue, 1, &submit, s.fence), "vkQueueSubmit");
   vk_check(vkWaitForFences(s.device, 1, &s.fence, VK_TRUE, UINT64_MAX), "vkWaitForFences");
 }
+
+uint64_t Context::begin_frame() const { return ++state_->frame; }
+uint64_t Context::frame() const { return state_->frame.load(); }
+uint32_t Context::frames_in_flight() const { return state_->frames_in_flight; }
+void Context::mark_idle() const { state_->frame += state_->frames_in_flight; }
+
+void Context::wait_idle() const {
+  auto& s = *state_;
+  if (s.adopted) {
+    throw Error(ErrorCode::invalid_argument,
+                "Context::wait_idle() is for standalone contexts; with an adopted context wait for the engine's "
+                "queues, then call mark_idle()");
+  }
+  {
+    std::lock_guard<std::recursive_mutex> lock(s.submit_mutex);
+    vk_check(vkQueueWaitIdle(s.queue), "vkQueueWaitIdle");
+  }
+  mark_idle();
+}
+
+namespace detail {
+
+uint64_t ContextState::once_serial(VkCommandBuffer cmd) const {
+  if (once_count.load() == 0) return 0;
+  std::lock_guard<std::mutex> lock(once_mutex);
+  for (const auto& [c, serial] : once_active) {
+    if (c == cmd) return serial;
+  }
+  return 0;
+}
+
+bool ContextState::once_pending(uint64_t serial) const {
+  if (serial == 0 || once_count.load() == 0) return false;
+  std::lock_guard<std::mutex> lock(once_mutex);
+  for (const auto& entry : once_active) {
+    if (entry.second == serial) return true;
+  }
+  return false;
+}
+
+void check_frames_in_flight(const char* name, uint32_t frames) {
+  if (frames < 1 || frames > 16) {
+    throw Error(ErrorCode::invalid_argument, concat(name, " = ", frames, " is out of range: accepted 1 to 16"));
+  }
+}
+
+}  // namespace detail
 
 std::vector<DeviceDescription> list_devices() {
   VkInstance instance = detail::make_instance(false, false, nullptr, nullptr);

@@ -7,6 +7,7 @@
 #include <functional>
 #include <map>
 #include <tuple>
+#include <utility>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -41,6 +42,22 @@ struct ContextState {
   VkCommandPool command_pool = VK_NULL_HANDLE;
   VkFence fence = VK_NULL_HANDLE;
   std::recursive_mutex submit_mutex;
+
+  // Frames (Context::begin_frame()): the current frame number and the caller's frames in flight.
+  std::atomic<uint64_t> frame{0};
+  uint32_t frames_in_flight = 3;
+
+  // Command buffers of run_once() calls that are recording or executing, with a serial number
+  // each (run_once() may nest on one thread). Work recorded into one of them is complete once its
+  // serial leaves this list, which lets effects retire a size used only there (core/size_cache.h).
+  std::atomic<uint32_t> once_count{0};
+  mutable std::mutex once_mutex;
+  std::vector<std::pair<VkCommandBuffer, uint64_t>> once_active;
+  uint64_t once_next = 1;
+  /// The serial of the run_once() command buffer `cmd`, or 0 if `cmd` is not one.
+  uint64_t once_serial(VkCommandBuffer cmd) const;
+  /// Whether the run_once() call of `serial` (non-zero) is still recording or executing.
+  bool once_pending(uint64_t serial) const;
 
   VkDebugUtilsMessengerEXT messenger = VK_NULL_HANDLE;
   mutable std::mutex log_mutex;
@@ -87,5 +104,8 @@ struct ContextState {
 /// context is being destroyed (the object tracker reports leaked objects in vkDestroyDevice, after
 /// which the context's own count is gone). Tests of leaks compare it before and after.
 uint64_t validation_messages_all_contexts();
+
+/// Throws Error(invalid_argument) "<name> = N is out of range: accepted 1 to 16".
+void check_frames_in_flight(const char* name, uint32_t frames);
 
 }  // namespace glint::detail

@@ -76,7 +76,14 @@ std::vector<LevelSize> bloom_pre_levels(VkExtent2D input, uint32_t level0_height
 /// Per size and config shape, images, pipelines and descriptor sets are made once: by prepare(),
 /// or by the first record() at that size. A record() at a prepared size with seen images creates
 /// no Vulkan object. Each distinct (input view, output view) pair gets its descriptor sets on
-/// first use; they live until the Bloom is destroyed or resized.
+/// first use, per size.
+///
+/// Several sizes (dynamic resolution, several views): one Bloom may be recorded at different
+/// extents, in one command buffer or in consecutive frames. Each size keeps its own pyramid; the
+/// pyramid of a size is destroyed only when no submitted work can use it: by a later record(),
+/// prepare() or release_unused() once the size was unused for Context::frames_in_flight() frames
+/// (the caller calls Context::begin_frame() once per frame), or once the run_once() it was recorded
+/// in has returned. At most kMaxCachedSizes sizes are kept (glint.h).
 class Bloom {
  public:
   /// Throws Error(invalid_argument) if config is invalid.
@@ -88,8 +95,8 @@ class Bloom {
   ~Bloom();
 
   /// Replaces the config. Per-frame fields take effect at the next record(); changed shape fields
-  /// rebuild the pyramid and pipelines then. The caller must not have frames in flight that use
-  /// this Bloom when shape fields change (as for a swapchain resize).
+  /// make new pyramids (here for the current size, else at the next record()). The pyramids of the
+  /// old shape are retired like unused sizes, so frames in flight may still use them.
   void set_config(const BloomConfig& config);
   const BloomConfig& config() const;
 
@@ -98,11 +105,20 @@ class Bloom {
   void prepare(VkExtent2D extent);
 
   /// Records the bloom of `input` into `output` on `cmd` (which must be in the recording state,
-  /// on a queue family with compute). Updates the state fields of both images. A different extent
-  /// than the last one re-makes the pyramid (see set_config for the in-flight rule).
+  /// on a queue family with compute). Updates the state fields of both images. An extent not seen
+  /// (or retired) makes its pyramid; the pyramids of other sizes stay as the class comment says.
   /// `profiler` (may be null) gets a mark after each stage.
-  /// Throws Error before recording anything if an image has the wrong format, usage or extent.
+  /// Throws Error before recording anything if an image has the wrong format, usage or extent, or
+  /// (invalid_argument) if a new size is needed while kMaxCachedSizes sizes may all still be in use.
   void record(VkCommandBuffer cmd, Image& input, Image& output, Profiler* profiler = nullptr);
+
+  /// Destroys the pyramid of every size other than the last one prepared or recorded that no
+  /// submitted work can use (Context::begin_frame() says which), without waiting for them to age.
+  /// After Context::wait_idle() or mark_idle() that is every other size. Creates nothing.
+  void release_unused();
+  /// Sizes (with config shapes) whose pyramids are kept now: at most kMaxCachedSizes, and with one
+  /// size per frame and begin_frame() every frame at most Context::frames_in_flight().
+  uint32_t cached_sizes() const;
 
   /// Drops the descriptor sets cached for the caller's images/buffers passed to record(). Vulkan
   /// may give a new object the handle of a destroyed one, and these sets are keyed by handle: call
@@ -111,8 +127,8 @@ class Bloom {
   /// targets alive never need it. Creates nothing; the next record() makes the sets again.
   void forget_caller_resources();
 
-  /// Levels the current size uses (after the small-size clamp), and whether iterations were
-  /// reduced to get there. Valid after prepare() or record().
+  /// Levels the current size (the last one prepared or recorded) uses (after the small-size clamp),
+  /// and whether iterations were reduced to get there. Valid after prepare() or record().
   uint32_t levels() const;
   bool clamped() const;
   std::vector<LevelSize> level_sizes() const;

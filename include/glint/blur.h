@@ -43,6 +43,14 @@ struct EffectiveSigma {
 /// Per input size, images, pipelines and descriptor sets are made once (prepare(), or the first
 /// record() at that size); record() at a prepared size with a seen input view creates no Vulkan
 /// object.
+///
+/// Several sizes: one pyramid may be recorded at different input extents, in one command buffer
+/// or in consecutive frames. Each size keeps its own levels; level(k) is the level of the size of
+/// the last prepare() or record(), so read (or copy) it before recording another size. A size's
+/// levels are destroyed only when no submitted work can use them: by a later record(), prepare()
+/// or release_unused() once the size was unused for Context::frames_in_flight() frames (the
+/// caller calls Context::begin_frame() once per frame), or once the run_once() it was recorded in
+/// has returned. At most kMaxCachedSizes sizes are kept (glint.h).
 class BlurPyramid {
  public:
   /// Throws Error(invalid_argument) if config is invalid, Error(no_device) if the device's shared
@@ -54,8 +62,9 @@ class BlurPyramid {
   BlurPyramid& operator=(BlurPyramid&&) noexcept;
   ~BlurPyramid();
 
-  /// Replaces the config; rebuilds pipelines and levels at the next record() or here if prepared.
-  /// No frame using this pyramid may be in flight.
+  /// Replaces the config; makes new levels here for the current size if one is prepared, else at
+  /// the next record(). The levels of the old config are retired like unused sizes, so frames in
+  /// flight may still use them.
   void set_config(const BlurPyramidConfig& config);
   const BlurPyramidConfig& config() const;
 
@@ -64,8 +73,17 @@ class BlurPyramid {
   void prepare(VkExtent2D input_extent);
 
   /// Records the three levels of `input` into `cmd`. Throws before recording anything if the
-  /// image has the wrong format, usage or extent. `profiler` (may be null) gets a mark per level.
+  /// image has the wrong format, usage or extent, or (invalid_argument) if a new size is needed
+  /// while kMaxCachedSizes sizes may all still be in use. `profiler` (may be null) gets a mark per
+  /// level.
   void record(VkCommandBuffer cmd, Image& input, Profiler* profiler = nullptr);
+
+  /// Destroys the levels of every size other than the current one that no submitted work can use
+  /// (Context::begin_frame() says which), without waiting for them to age. Creates nothing.
+  void release_unused();
+  /// Sizes (with configs) whose levels are kept now: at most kMaxCachedSizes, and with one size
+  /// per frame and begin_frame() every frame at most Context::frames_in_flight().
+  uint32_t cached_sizes() const;
 
   /// Drops the descriptor sets cached for the caller's images/buffers passed to record(). Vulkan
   /// may give a new object the handle of a destroyed one, and these sets are keyed by handle: call
@@ -133,8 +151,12 @@ struct BlurChoice {
 ///
 /// Input: RGBA16F or RGBA32F with SAMPLED usage, left in SHADER_READ_ONLY_OPTIMAL. Output:
 /// RGBA16F or RGBA32F with STORAGE usage, same extent, a different image, left in GENERAL; both
-/// last used by the compute stage. Per size, everything is made once; record() at a prepared size
-/// with seen image views creates no Vulkan object.
+/// last used by the compute stage. Per size and output format, everything is made once; record()
+/// at a prepared size with seen image views creates no Vulkan object.
+///
+/// Several sizes: one blur may be recorded at different extents and output formats, in one
+/// command buffer or in consecutive frames; each (size, output format) keeps its own plan, images
+/// and descriptor sets, destroyed as BlurPyramid's levels are (Context::begin_frame()).
 class GaussianBlur {
  public:
   /// Throws Error(invalid_argument) if config is invalid.
@@ -145,6 +167,8 @@ class GaussianBlur {
   GaussianBlur& operator=(GaussianBlur&&) noexcept;
   ~GaussianBlur();
 
+  /// Replaces the config; plans again here for the current size and output format if one is
+  /// prepared, else at the next record(). The old config's resources retire like unused sizes.
   void set_config(const GaussianBlurConfig& config);
   const GaussianBlurConfig& config() const;
 
@@ -152,9 +176,16 @@ class GaussianBlur {
   /// Error(unsupported_size) for a zero extent or one above the device's maximum.
   void prepare(VkExtent2D extent);
 
-  /// Records the blur. Throws before recording anything on a wrong format, usage or extent, or
-  /// when input and output are the same image.
+  /// Records the blur. Throws before recording anything on a wrong format, usage or extent, when
+  /// input and output are the same image, or (invalid_argument) if a new size is needed while
+  /// kMaxCachedSizes sizes may all still be in use.
   void record(VkCommandBuffer cmd, Image& input, Image& output, Profiler* profiler = nullptr);
+
+  /// Destroys the resources of every (size, output format) other than the current one that no
+  /// submitted work can use, without waiting for them to age. Creates nothing.
+  void release_unused();
+  /// (Size, output format, config) entries kept now (see BlurPyramid::cached_sizes()).
+  uint32_t cached_sizes() const;
 
   /// Drops the descriptor sets cached for the caller's images/buffers passed to record(). Vulkan
   /// may give a new object the handle of a destroyed one, and these sets are keyed by handle: call
@@ -163,6 +194,7 @@ class GaussianBlur {
   /// targets alive never need it. Creates nothing; the next record() makes the sets again.
   void forget_caller_resources();
 
+  /// The plan of the last prepare() or record() (a default BlurChoice before either).
   const BlurChoice& choice() const;
 
   /// Bytes the GPU must move at least per frame (input read once, output written once, each

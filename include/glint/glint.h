@@ -18,6 +18,13 @@
 //   different command buffers on different threads at the same time, as engines record in
 //   parallel. Command buffers, pools and queues follow Vulkan's external synchronization rules;
 //   glint touches only the command buffer passed to record().
+// - Frames in flight. Effects whose images depend on the input size (Bloom, BlurPyramid,
+//   GaussianBlur) keep them per size, so one effect may be recorded at several sizes in one
+//   command buffer or in consecutive frames (dynamic resolution, several views). A size's images
+//   are destroyed only once no submitted work can use them: the engine calls
+//   Context::begin_frame() once per frame, and a size unused for ContextOptions::frames_in_flight
+//   frames is retired by the effect's next record(), prepare() or release_unused(). Work recorded
+//   inside run_once() is complete when it returns, so run_once() users need nothing else.
 #pragma once
 
 #include <vulkan/vulkan.h>
@@ -35,6 +42,11 @@ namespace glint {
 inline constexpr int kVersionMajor = 0;
 inline constexpr int kVersionMinor = 1;
 inline constexpr int kVersionPatch = 0;
+
+/// The most sizes (with output format and config shape) an effect keeps images for at once. A
+/// record() that needs a new one while all are held by frames that may still be in flight throws
+/// Error(invalid_argument) before recording anything (see Context::begin_frame()).
+inline constexpr uint32_t kMaxCachedSizes = 32;
 
 /// What kind of failure an Error reports.
 enum class ErrorCode {
@@ -82,6 +94,11 @@ struct ContextOptions {
   /// kernel choose from the device's limits; else W x H with W, H >= 1 and W * H at most
   /// maxComputeWorkGroupInvocations (checked by create()).
   VkExtent2D workgroup_2d{0, 0};
+  /// How many frames the caller may have submitted and not yet waited for (1 to 16): when
+  /// Context::begin_frame() starts frame F, every command buffer recorded in frame
+  /// F - frames_in_flight or earlier has completed. Effects keep a size's images for this many
+  /// frames after its last use (see Context::begin_frame()).
+  uint32_t frames_in_flight = 3;
 };
 
 /// What an engine hands glint when it adopts the engine's own Vulkan objects. glint never
@@ -109,6 +126,8 @@ struct AdoptInfo {
   /// the raster flare path reports an Error when dynamicRendering is off. When null, glint checks
   /// that the physical device supports each feature and trusts the engine to have enabled it.
   const void* enabled_features = nullptr;
+  /// As ContextOptions::frames_in_flight (1 to 16): the engine's frames in flight.
+  uint32_t frames_in_flight = 3;
 };
 
 /// Facts about the device that kernels are tuned by (rule: chosen per device, never assumed).
@@ -167,6 +186,29 @@ class Context {
   /// Number of Vulkan objects glint has created through this context (pipelines, images,
   /// descriptor sets, ...). Tests use it to prove that recording a frame creates nothing.
   uint64_t objects_created() const;
+
+  /// Frames. Call begin_frame() once per frame, before recording the frame's commands and after
+  /// waiting for the fence of the frame frames_in_flight() frames earlier (the usual loop over
+  /// frames_in_flight() command buffers and fences). It returns the new frame number (the first
+  /// call returns 1; frame() is 0 before it). Effects that keep images per size note the frame of
+  /// each record(); a size last recorded in frame L is destroyed by the effect's next record(),
+  /// prepare() or release_unused() once frame() >= L + frames_in_flight(). Until then a size
+  /// stays cached and costs nothing to record again. Without begin_frame() nothing recorded
+  /// outside run_once() is ever assumed complete: an effect then keeps up to kMaxCachedSizes
+  /// sizes and throws rather than destroy one (call mark_idle() after waiting for the device).
+  /// Thread-safe; one thread should own the frame loop.
+  uint64_t begin_frame() const;
+  uint64_t frame() const;
+  uint32_t frames_in_flight() const;
+  /// The caller states that every command buffer recorded so far has completed or will never be
+  /// submitted (after vkDeviceWaitIdle, or after waiting for every frame's fence, as before a
+  /// swapchain resize). Advances frame() by frames_in_flight(), so that the effects' next
+  /// record(), prepare() or release_unused() may destroy every size they do not use then.
+  void mark_idle() const;
+  /// Standalone contexts only: waits until the context's queue is idle (serialized with
+  /// run_once()), then mark_idle(). Throws Error(invalid_argument) in adopted mode, where the
+  /// engine owns the queues: wait there and call mark_idle().
+  void wait_idle() const;
 
   detail::ContextState& state() const { return *state_; }
 
