@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstddef>
 #include <map>
+#include <utility>
 #include <vector>
 
 #include "core/barriers.h"
@@ -183,6 +184,7 @@ struct ObjectCuller::Impl {
   ObjectCullConfig config;
   uint32_t max_groups_x = 65535;
   uint32_t scan_threads = 1;
+  uint64_t max_range = 1u << 27;  // the device's maxStorageBufferRange
   detail::ComputePipeline cull, phase1, scan, scatter;
   detail::OwnedBuffer groups, dummy;
   Buffer groups_state, dummy_state;
@@ -219,6 +221,21 @@ struct ObjectCuller::Impl {
     check_buffer(where, "indirect", out.indirect, sizeof(GlintObjectCullIndirect),
                  st | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT);
     check_buffer(where, "stats", out.stats, sizeof(GlintObjectCullStats), st);
+    // Storage descriptors bind each buffer's whole range, which the device limits.
+    const std::pair<const char*, const Buffer*> bound[] = {{"objects", &in.objects},
+                                                           {"payloads", &in.payloads},
+                                                           {"visibility", &in.visibility},
+                                                           {"list", &out.list},
+                                                           {"indirect", &out.indirect},
+                                                           {"stats", &out.stats}};
+    for (const auto& [role, b] : bound) {
+      if (b == &in.payloads && config.payload_words == 0) continue;
+      if (b->size > max_range) {
+        throw Error(ErrorCode::invalid_argument, concat(where, ": ", role, " buffer size = ", b->size,
+                                                        " bytes is above the device's maxStorageBufferRange = ",
+                                                        max_range, "; pass a smaller range"));
+      }
+    }
   }
 
   void check_images(const char* where, HiZPyramid& hiz, Image& depth) const {
@@ -252,6 +269,25 @@ ObjectCuller::ObjectCuller(const Context& context, const ObjectCullConfig& confi
   VkPhysicalDeviceProperties props;
   vkGetPhysicalDeviceProperties(context.physical_device(), &props);
   m.max_groups_x = props.limits.maxComputeWorkGroupCount[0];
+  m.max_range = props.limits.maxStorageBufferRange;
+  // The objects, payload and list buffers are each one storage descriptor (limits come from the
+  // device): their largest sizes must fit maxStorageBufferRange (2^27 bytes guaranteed, 4 M objects).
+  const uint64_t object_bytes = uint64_t(config.max_objects) * sizeof(GlintCullObject);
+  const uint64_t payload_bytes = uint64_t(config.max_objects) * config.payload_words * 4;
+  const uint64_t list_bytes = uint64_t(config.capacity) * std::max(1u, config.payload_words) * 4;
+  if (object_bytes > m.max_range || payload_bytes > m.max_range) {
+    throw Error(ErrorCode::unsupported_size,
+                concat("ObjectCullConfig::max_objects = ", config.max_objects, " needs ",
+                       std::max(object_bytes, payload_bytes), "-byte object/payload buffers; the device's ",
+                       "maxStorageBufferRange = ", m.max_range, " allows at most ",
+                       m.max_range / std::max<uint64_t>(sizeof(GlintCullObject), uint64_t(config.payload_words) * 4),
+                       " objects"));
+  }
+  if (list_bytes > m.max_range) {
+    throw Error(ErrorCode::unsupported_size,
+                concat("ObjectCullConfig::capacity = ", config.capacity, " x max(1, payload_words) x 4 = ", list_bytes,
+                       " bytes exceeds the device's maxStorageBufferRange = ", m.max_range));
+  }
   const uint64_t groups = (uint64_t(config.max_objects) + kGroup - 1) / kGroup;
   if ((groups + m.max_groups_x - 1) / m.max_groups_x > props.limits.maxComputeWorkGroupCount[1]) {
     throw Error(ErrorCode::invalid_argument,

@@ -538,6 +538,14 @@ TEST_F(ObjectCullTest, ErrorsBeforeRecording) {
   });
   EXPECT_THROW(ObjectCuller(context(), ObjectCullConfig{0, 1, 0, 64, false}), Error);
   EXPECT_THROW(ObjectCuller(context(), ObjectCullConfig{1, 1, 65, 64, false}), Error);
+  // 2^28 objects of 32 bytes need an 8 GiB descriptor: above any maxStorageBufferRange (a uint32).
+  try {
+    ObjectCuller big(context(), ObjectCullConfig{1u << 28, 1, 0, 64, false});
+    ADD_FAILURE() << "no error for an object buffer above maxStorageBufferRange";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::unsupported_size);
+    EXPECT_NE(std::string(e.what()).find("maxStorageBufferRange"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

@@ -85,7 +85,10 @@ struct ObjectCullOutputs {
 /// Frustum + Hi-Z occlusion cull and ordered compaction of caller objects.
 class ObjectCuller {
  public:
-  /// Throws Error(invalid_argument) if config is invalid.
+  /// Throws Error(invalid_argument) if config is invalid, Error(unsupported_size) if max_objects x 32
+  /// bytes, max_objects x payload_words x 4 or capacity x max(1, payload_words) x 4 exceeds the
+  /// device's maxStorageBufferRange (at least 2^27 bytes: 4 M objects), or if the workgroups for
+  /// max_objects exceed maxComputeWorkGroupCount.
   ObjectCuller(const Context& context, const ObjectCullConfig& config = {});
   ObjectCuller(const ObjectCuller&) = delete;
   ObjectCuller& operator=(const ObjectCuller&) = delete;
@@ -102,7 +105,8 @@ class ObjectCuller {
   /// max_objects; a view or proj entry is non-finite or the matrices do not have the form above;
   /// the projection's depth direction disagrees with reversed_z; reversed_z differs from
   /// hiz.config().reversed_z; `depth` does not match `hiz` or lacks SAMPLED usage; a buffer is
-  /// null, has size 0 or VK_WHOLE_SIZE, is smaller than stated above, has an offset that is not a
+  /// null, has size 0 or VK_WHOLE_SIZE, is smaller than stated above or larger than the device's
+  /// maxStorageBufferRange, has an offset that is not a
   /// multiple of 4 or lacks a usage.
   void record(VkCommandBuffer cmd, HiZPyramid& hiz, Image& depth, const ObjectCullFrame& frame,
               ObjectCullBuffers& buffers, ObjectCullOutputs& outputs, Profiler* profiler = nullptr);
