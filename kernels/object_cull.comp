@@ -41,7 +41,11 @@ layout(binding = 1) uniform texture2D hiz_tex;    // mip m = Hi-Z level m + 1
 #endif
 
 layout(std430, binding = BINDING_OBJECTS) readonly buffer Objects { GlintCullObject objects[]; };
+#ifdef GLINT_OBJECT_PHASE1
+layout(std430, binding = BINDING_VISIBILITY) readonly buffer Visibility { uint visibility[]; };
+#else
 layout(std430, binding = BINDING_VISIBILITY) buffer Visibility { uint visibility[]; };
+#endif
 layout(std430, binding = BINDING_GROUPS) buffer Groups {
   uint counters[GLINT_OBJECT_HEADER_WORDS];
   uvec4 groups[];  // emitted mask (x, y), first slot (z, the scan's), 0
