@@ -45,33 +45,12 @@ shared uint group_occluded;
 shared uint group_disabled;
 shared uint group_mask[2];
 
-// Not NaN, not +-Inf, tested on the bits: a compiler that assumes floats are finite may fold
-// x == x, or invert a comparison so that NaN passes it (docs/OCCLUSION.md, "Non-finite input").
-bool cull_finite(float x) { return (floatBitsToUint(x) & 0x7f800000u) != 0x7f800000u; }
+#include "hiz_read.glsl"
 
 bool light_finite(GlintFlareLight l) {
   return cull_finite(l.position_x) && cull_finite(l.position_y) && cull_finite(l.position_z) &&
          cull_finite(l.intensity) && cull_finite(l.color_r) && cull_finite(l.color_g) && cull_finite(l.color_b) &&
          cull_finite(l.size_px);
-}
-
-float fetch_level(int k, ivec2 t) {
-  return k == 0 ? texelFetch(depth_tex, t, 0).r : texelFetch(hiz_tex, t, k - 1).r;
-}
-
-// Smallest k with 2^k >= s (s >= 1), exactly: s = m * 2^e with m in [0.5, 1).
-int ceil_log2(float s) {
-  int e;
-  const float m = frexp(s, e);
-  return m == 0.5 ? e - 1 : e;
-}
-
-// Texels of level k (size `lsize`) under pixels [lo, hi) of one axis, clamped to the image (clamp
-// to edge); `pixels` is the level-0 size of that axis.
-ivec2 texel_range(float lo, float hi, int k, int pixels, int lsize) {
-  const int p0 = clamp(int(floor(lo)), 0, pixels - 1);
-  const int p1 = clamp(int(ceil(hi)) - 1, 0, pixels - 1);
-  return ivec2(min(p0 >> k, lsize - 1), min(max(p0, p1) >> k, lsize - 1));
 }
 
 // Footprint of the sample of cell (i, j) along one axis, in units of cell / (2n) from the light's

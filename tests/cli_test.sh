@@ -320,6 +320,50 @@ bad flare --color "$d/scene.exr" --depth "$d/depth.exr" --lights "$tmp/deep2.jso
 head -c 4096 /dev/urandom >"$tmp/noise.json"
 bad flare --color "$d/scene.exr" --depth "$d/depth.exr" --lights "$tmp/noise.json" "$tmp/x.exr"
 
+# glint cull: spheres and boxes against the demo's depth image; the state list and counts, and bad
+# object files (exit 2 naming the object and field, no output left behind).
+proj='[1,0,0,0, 0,1,0,0, 0,0,-1.001001,-1, 0,0,-0.1001001,0]'
+ident='[1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,1]'
+printf '%s' '{"view": '"$ident"', "proj": '"$proj"', "objects": [
+  {"sphere": [0, 0, -5, 0.5]}, {"sphere": [0, 0, 5, 1]}, {"box": [-1, -1, -3, 1, 1, -2]},
+  {"sphere": [0, 0, -0.1, 0.5]}, {"box": [100, 0, -3, 101, 1, -2]}]}' >"$tmp/objects.json"
+ok cull --depth "$d/depth.exr" --objects "$tmp/objects.json" "$tmp/cull.json" --stats
+expect_file "$tmp/cull.json"
+grep -q '^objects: 5 total' "$tmp/out" || fail "glint cull printed no statistics"
+python3 - "$tmp/cull.json" <<'PY' || fail "glint cull output: $(head -c 300 "$tmp/cull.json")"
+import json, sys
+r = json.load(open(sys.argv[1]))
+assert r["total"] == 5 and len(r["objects"]) == 5
+assert r["objects"][1] == "frustum" and r["objects"][4] == "frustum"  # behind the camera; far to the side
+assert r["objects"][3] == "visible"  # crosses the near plane
+assert r["frustum_culled"] + r["occluded"] + r["visible"] == 5
+assert r["frustum_culled"] == r["objects"].count("frustum") and r["visible"] == r["objects"].count("visible")
+PY
+rproj='[1,0,0,0, 0,1,0,0, 0,0,0.001001,-1, 0,0,0.1001001,0]'
+printf '%s' '{"view": '"$ident"', "proj": '"$rproj"', "objects": [{"sphere": [0, 0, -5, 0.5]}]}' >"$tmp/robjects.json"
+ok cull --depth "$d/depth.exr" --objects "$tmp/robjects.json" "$tmp/rcull.json" --reverse-z
+bad cull --depth "$d/depth.exr" --objects "$tmp/robjects.json" "$tmp/x.json"  # reversed projection, standard depth
+bad_cull() {  # bad_cull JSON NEEDLE
+  printf '%s' "$1" >"$tmp/bad_objects.json"
+  rm -f "$tmp/bad_out.json"
+  bad cull --depth "$d/depth.exr" --objects "$tmp/bad_objects.json" "$tmp/bad_out.json"
+  grep -q -- "$2" "$tmp/err" || fail "glint cull error for $1 does not name '$2': $(cat "$tmp/err")"
+  if [[ -e "$tmp/bad_out.json" || -e "$tmp/bad_out.json.tmp" ]]; then fail "glint cull left an output after an error"; fi
+}
+bad_cull '{"view": '"$ident"', "proj": '"$proj"', "objects": [{"sphere": [0,0,-5,1]}, {"sphere": [0,0,-5,-1]}]}' 'objects\[1\].sphere\[3\]'
+bad_cull '{"view": '"$ident"', "proj": '"$proj"', "objects": [{"box": [0,0,0,1,1]}]}' 'objects\[0\].box'
+bad_cull '{"view": '"$ident"', "proj": '"$proj"', "objects": [{"box": [2,0,0,1,1,1]}]}' 'objects\[0\].box\[0\]'
+bad_cull '{"view": '"$ident"', "proj": '"$proj"', "objects": [{"sphere": [0,"x",0,1]}]}' 'objects\[0\].sphere\[1\]'
+bad_cull '{"view": '"$ident"', "proj": '"$proj"', "objects": [{"sphere": [0,1e39,0,1]}]}' 'objects\[0\].sphere\[1\]'
+bad_cull '{"view": '"$ident"', "proj": '"$proj"', "objects": [{"cone": [0,0,0,1]}]}' 'objects\[0\]'
+bad_cull '{"view": '"$ident"', "proj": '"$proj"', "objects": [], "extra": 1}' 'unknown key'
+bad_cull '{"view": [1,2,3], "proj": '"$proj"', "objects": []}' 'view'
+bad_cull '{"view": '"$ident"', "proj": [1,0,0,0, 0,1,0,0, 0,0,-1,-1, 0,0,-0.1,1], "objects": []}' 'proj\[15\]'
+bad_cull '[1' 'not JSON'
+bad cull --depth "$tmp/missing.exr" --objects "$tmp/objects.json" "$tmp/x.json"
+bad cull --depth "$d/depth.exr" --objects "$tmp/missing.json" "$tmp/x.json"
+bad cull --depth "$d/depth.exr" --objects "$tmp/objects.json" "$tmp/no/such/dir/x.json"
+
 if ((failures)); then
   printf 'cli_test: %d failure(s)\n' "$failures" >&2
   exit 1

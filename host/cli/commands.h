@@ -8,6 +8,7 @@
 #include <CLI/CLI.hpp>
 
 #include "core/cpu_image.h"
+#include "io/exr_io.h"
 
 #include <functional>
 #include <string>
@@ -28,8 +29,14 @@ Command add_lod_command(CLI::App& app);
 Command add_blur_command(CLI::App& app);
 Command add_gauss_command(CLI::App& app);
 Command add_flare_command(CLI::App& app);
+Command add_cull_command(CLI::App& app);
 
 // ---- helpers shared by the commands (common.cpp) ----
+
+/// A depth OpenEXR file as `glint flare --depth` and `glint cull --depth` read it: channel Z, else
+/// the first channel; every value finite and in [0, 1]. Throws Error(invalid_argument) naming the
+/// pixel and value, Error(io_failure) when unreadable.
+io::ExrChannel read_depth_exr(const std::string& path);
 
 /// "discrete GPU", "CPU", ...
 const char* device_type_name(VkPhysicalDeviceType type);

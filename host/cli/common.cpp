@@ -104,4 +104,19 @@ CpuImage run_image_effect(const Context& context, const CpuImage& input, Profile
   return detail::download(context, result.image());
 }
 
+// The depth channel: Z, else the first channel; every value finite and in [0, 1].
+io::ExrChannel read_depth_exr(const std::string& path) {
+  io::ExrChannel d = io::read_exr_channel(path, "Z");
+  for (size_t i = 0; i < d.values.size(); ++i) {
+    const float v = d.values[i];
+    if (!(v >= 0.0f && v <= 1.0f)) {
+      char text[160];
+      std::snprintf(text, sizeof text, ": channel %s at pixel (%zu, %zu) is %g; depth must be in [0, 1]",
+                    d.name.c_str(), i % d.width, i / d.width, double(v));
+      throw Error(ErrorCode::invalid_argument, path + text);
+    }
+  }
+  return d;
+}
+
 }  // namespace glint::cli

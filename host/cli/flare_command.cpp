@@ -51,21 +51,6 @@ FlareConfig preset_from_name(const std::string& name) {
                                                "disabled or default (any case)");
 }
 
-// The depth channel: Z, else the first channel; every value finite and in [0, 1].
-io::ExrChannel read_depth(const std::string& path) {
-  io::ExrChannel d = io::read_exr_channel(path, "Z");
-  for (size_t i = 0; i < d.values.size(); ++i) {
-    const float v = d.values[i];
-    if (!(v >= 0.0f && v <= 1.0f)) {
-      char text[160];
-      std::snprintf(text, sizeof text, ": channel %s at pixel (%zu, %zu) is %g; depth must be in [0, 1]",
-                    d.name.c_str(), i % d.width, i / d.width, double(v));
-      throw Error(ErrorCode::invalid_argument, path + text);
-    }
-  }
-  return d;
-}
-
 const char* culled_name(uint32_t culled) {
   switch (culled) {
     case GLINT_FLARE_FRUSTUM:
@@ -110,7 +95,7 @@ void run_flare(const FlareOptions& o) {
   if (!o.stats.empty()) check_output_path(o.stats);
 
   const CpuImage color_in = io::read_exr(o.color);
-  const io::ExrChannel depth_in = read_depth(o.depth);
+  const io::ExrChannel depth_in = read_depth_exr(o.depth);
   if (depth_in.width != color_in.width || depth_in.height != color_in.height) {
     throw Error(ErrorCode::invalid_argument, "--depth " + o.depth + " is " + std::to_string(depth_in.width) + "x" +
                                                  std::to_string(depth_in.height) + " but --color " + o.color + " is " +

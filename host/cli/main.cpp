@@ -49,6 +49,7 @@ int main(int argc, char** argv) {
       glint::cli::add_blur_command(app),
       glint::cli::add_gauss_command(app),
       glint::cli::add_flare_command(app),
+      glint::cli::add_cull_command(app),
   };
 
   try {
@@ -57,7 +58,7 @@ int main(int argc, char** argv) {
     if (e.get_exit_code() == static_cast<int>(CLI::ExitCodes::Success)) return app.exit(e);  // --help, --version
     return print_error(std::string(e.what()) + " (see glint --help)", 2);
   }
-  if (app.get_subcommands().empty()) return print_error("a subcommand is required: devices, bloom, demo, lod, blur, gauss or flare (see glint --help)", 2);
+  if (app.get_subcommands().empty()) return print_error("a subcommand is required: devices, bloom, demo, lod, blur, gauss, flare or cull (see glint --help)", 2);
 
   try {
     // OpenEXR compresses and decompresses in parallel when given threads (a 1080p demo writes two).

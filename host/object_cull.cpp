@@ -1,0 +1,484 @@
+// Object occlusion cull: camera validation and reduction to the push-constant form, and the three
+// dispatches of a cull (docs/OCCLUSION.md, "Object culling").
+#include <glint/object_cull.h>
+
+#include <algorithm>
+#include <cfloat>
+#include <cmath>
+#include <cstddef>
+#include <map>
+#include <utility>
+#include <vector>
+
+#include "core/barriers.h"
+#include "core/check.h"
+#include "core/context_state.h"
+#include "core/pipeline.h"
+#include "core/resources.h"
+#include "object_cull.h"
+
+namespace glint {
+
+using detail::concat;
+
+static_assert(sizeof(GlintCullObject) == 32);
+static_assert(offsetof(GlintCullObject, box_max) == 16);
+static_assert(offsetof(GlintCullObject, kind) == 28);
+static_assert(sizeof(GlintObjectCullPush) == 112);
+static_assert(offsetof(GlintObjectCullPush, proj_x) == 48);
+static_assert(offsetof(GlintObjectCullPush, width) == 84);
+static_assert(offsetof(GlintObjectCullPush, groups_x) == 104);
+static_assert(sizeof(GlintObjectCompactPush) == 32);
+static_assert(sizeof(GlintObjectCullIndirect) == 16);
+static_assert(sizeof(GlintObjectCullStats) == 32);
+static_assert(GLINT_OBJECT_GROUP == 64, "object_cull.comp keeps a workgroup's mask in two 32-bit words");
+
+namespace {
+
+constexpr VkPipelineStageFlags2 kCompute = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
+constexpr VkAccessFlags2 kSampled = VK_ACCESS_2_SHADER_SAMPLED_READ_BIT;
+constexpr VkAccessFlags2 kRead = VK_ACCESS_2_SHADER_STORAGE_READ_BIT;
+constexpr VkAccessFlags2 kWrite = VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT;
+constexpr uint32_t kGroup = GLINT_OBJECT_GROUP;
+constexpr uint32_t kMaxObjects = 1u << 28;
+
+void check_uint(const char* name, uint64_t value, uint64_t lo, uint64_t hi) {
+  if (value < lo || value > hi) {
+    throw Error(ErrorCode::invalid_argument, concat(name, " = ", value, " is out of range: accepted ", lo, " to ", hi));
+  }
+}
+
+void check_buffer(const char* where, const char* role, const Buffer& b, VkDeviceSize need, VkBufferUsageFlags usage) {
+  if (!b.buffer) throw Error(ErrorCode::invalid_argument, concat(where, ": ", role, " buffer is null"));
+  if ((b.usage & usage) != usage) {
+    throw Error(ErrorCode::missing_usage, concat(where, ": ", role, " buffer lacks usage 0x", std::hex,
+                                                 usage & ~b.usage, std::dec, " (needs 0x", std::hex, usage, ")"));
+  }
+  if (b.size == 0 || b.size == VK_WHOLE_SIZE) {
+    throw Error(ErrorCode::invalid_argument,
+                concat(where, ": ", role, " buffer size must be its byte count (not 0 or VK_WHOLE_SIZE)"));
+  }
+  if (b.size < need) {
+    throw Error(ErrorCode::invalid_argument, concat(where, ": ", role, " buffer holds ", b.size, " bytes; ", need, " needed"));
+  }
+  if (b.offset % 4 != 0) {
+    throw Error(ErrorCode::invalid_argument, concat(where, ": ", role, " buffer offset = ", b.offset,
+                                                    " is not a multiple of 4"));
+  }
+}
+
+Buffer view_of(const detail::OwnedBuffer& b, VkBufferUsageFlags usage) {
+  Buffer v;
+  v.buffer = b.buffer();
+  v.size = b.size();
+  v.usage = usage;
+  return v;
+}
+
+// Rounds a positive double up to a float.
+float round_up(double v) {
+  float f = static_cast<float>(v);
+  if (double(f) < v) f = std::nextafter(f, FLT_MAX);
+  return f;
+}
+
+// The camera part of the push constants. Matrices are column-major: entry (row r, column c) at
+// c * 4 + r. Throws Error naming the entry that breaks the accepted form.
+void camera_push(const ObjectCullFrame& frame, bool reversed_z, GlintObjectCullPush& push) {
+  for (int i = 0; i < 16; ++i) {
+    if (!std::isfinite(frame.view[i]))
+      throw Error(ErrorCode::invalid_argument, concat("ObjectCullFrame::view[", i, "] = ", frame.view[i], " is not finite"));
+    if (!std::isfinite(frame.proj[i]))
+      throw Error(ErrorCode::invalid_argument, concat("ObjectCullFrame::proj[", i, "] = ", frame.proj[i], " is not finite"));
+  }
+  const float* v = frame.view;
+  const int affine[4] = {3, 7, 11, 15};
+  for (int k = 0; k < 4; ++k) {
+    const float want = k == 3 ? 1.0f : 0.0f;
+    if (v[affine[k]] != want) {
+      throw Error(ErrorCode::invalid_argument, concat("ObjectCullFrame::view[", affine[k], "] = ", v[affine[k]],
+                                                      " must be ", want, ": the view matrix must be affine (row 3 = 0 0 0 1)"));
+    }
+  }
+  const float* p = frame.proj;
+  for (int i : {1, 2, 3, 4, 6, 7, 12, 13, 15}) {
+    if (p[i] != 0.0f) {
+      throw Error(ErrorCode::invalid_argument,
+                  concat("ObjectCullFrame::proj[", i, "] = ", p[i],
+                         " must be 0: a Vulkan perspective projection has only P00, P11, P02, P12, P22, P23, P32"));
+    }
+  }
+  if (p[11] != 1.0f && p[11] != -1.0f) {
+    throw Error(ErrorCode::invalid_argument,
+                concat("ObjectCullFrame::proj[11] = ", p[11], " (P32) must be -1 or 1 (w = -z_view or z_view)"));
+  }
+  if (p[0] == 0.0f || p[5] == 0.0f) {
+    throw Error(ErrorCode::invalid_argument,
+                concat("ObjectCullFrame::proj[", p[0] == 0.0f ? 0 : 5, "] = 0: P00 and P11 must be non-zero"));
+  }
+  const double s = p[11];
+  for (int c = 0; c < 4; ++c) {
+    push.view_x[c] = v[c * 4 + 0];
+    push.view_y[c] = v[c * 4 + 1];
+    push.view_w[c] = static_cast<float>(s * v[c * 4 + 2]);  // exact: s = +-1
+  }
+  push.proj_x = p[0];
+  push.proj_ox = static_cast<float>(double(p[8]) * s);
+  push.proj_y = p[5];
+  push.proj_oy = static_cast<float>(double(p[9]) * s);
+  const double a = double(p[10]) * s, b = p[14];
+  push.depth_a = static_cast<float>(a);
+  push.depth_b = p[14];
+  // depth = a + b / w: the near plane is where depth is 0 (standard) or 1 (reversed), the far
+  // plane where it is 1 (standard) or 0 (reversed); no positive solution: infinitely far.
+  if (reversed_z ? !(b > 0) : !(b < 0)) {
+    throw Error(ErrorCode::invalid_argument,
+                concat("ObjectCullFrame::proj[14] = ", b, " (P23) must be ", reversed_z ? "> 0" : "< 0",
+                       " for ", reversed_z ? "reversed" : "standard", " Z (ObjectCullConfig::reversed_z)"));
+  }
+  const double near_w = reversed_z ? b / (1.0 - a) : -b / a;
+  const double far_w = reversed_z ? -b / a : b / (1.0 - a);
+  if (!(near_w > 0) || !std::isfinite(near_w) || !(float(near_w) > 0.0f)) {
+    throw Error(ErrorCode::invalid_argument, concat("ObjectCullFrame::proj: the near plane is at w = ", near_w,
+                                                    "; it must lie in front of the camera (w > 0)"));
+  }
+  const bool far_finite = far_w > 0 && std::isfinite(far_w) && far_w < double(FLT_MAX);
+  if (far_finite && !(far_w > near_w)) {
+    throw Error(ErrorCode::invalid_argument, concat("ObjectCullFrame::proj: the far plane (w = ", far_w,
+                                                    ") is not beyond the near plane (w = ", near_w, ")"));
+  }
+  push.near_w = static_cast<float>(near_w);
+  push.far_w = far_finite ? static_cast<float>(far_w) : FLT_MAX;
+  // A view-space radius bound: an affine view maps a ball of radius r into a ball of radius
+  // r * sigma_max of its 3x3 part V. sigma_max^2 = lambda_max(V^T V) is at most the largest row sum
+  // of |V^T V| (Gershgorin), which is exact for rotations and uniform scales, and at most the
+  // squared Frobenius norm; the smaller bound is used, rounded up.
+  double frob = 0;
+  for (int c = 0; c < 3; ++c)
+    for (int r = 0; r < 3; ++r) frob += double(v[c * 4 + r]) * v[c * 4 + r];
+  double g = 0;
+  for (int i = 0; i < 3; ++i) {
+    double row = 0;
+    for (int j = 0; j < 3; ++j) {
+      double d = 0;
+      for (int k = 0; k < 3; ++k) d += double(v[i * 4 + k]) * v[j * 4 + k];
+      row += std::abs(d);
+    }
+    g = std::max(g, row);
+  }
+  const double spectral_bound = std::min(std::sqrt(frob), std::sqrt(g));
+  push.radius_scale = round_up(spectral_bound * (1.0 + 1e-12));
+}
+
+}  // namespace
+
+void ObjectCullConfig::validate() const {
+  check_uint("ObjectCullConfig::max_objects", max_objects, 1, kMaxObjects);
+  check_uint("ObjectCullConfig::capacity", capacity, 1, kMaxObjects);
+  check_uint("ObjectCullConfig::payload_words", payload_words, 0, 64);
+  check_uint("ObjectCullConfig::objects_per_group", objects_per_group, 1, 1024);
+}
+
+struct ObjectCuller::Impl {
+  const Context* context = nullptr;
+  ObjectCullConfig config;
+  uint32_t max_groups_x = 65535;
+  uint32_t scan_threads = 1;
+  uint64_t max_range = 1u << 27;  // the device's maxStorageBufferRange
+  detail::ComputePipeline cull, phase1, scan, scatter;
+  detail::OwnedBuffer groups, dummy;
+  Buffer groups_state, dummy_state;
+  bool counters_cleared = false;
+  struct Sets {
+    VkDescriptorSet cull = VK_NULL_HANDLE, scan = VK_NULL_HANDLE, scatter = VK_NULL_HANDLE;
+  };
+  std::map<std::vector<uint64_t>, Sets> sets;
+  detail::DescriptorArena arena;
+
+  static void key_add(std::vector<uint64_t>& key, const Buffer& b) {
+    key.push_back(reinterpret_cast<uint64_t>(b.buffer));
+    key.push_back(b.offset);
+    key.push_back(b.size);
+  }
+
+  // Workgroups of the test and the scatter, as a 2D grid of at most max_groups_x per row.
+  void grid(uint32_t count, uint32_t& gx, uint32_t& gy) const {
+    const uint32_t g = std::max(1u, (count + kGroup - 1) / kGroup);
+    gx = std::min(g, max_groups_x);
+    gy = (g + gx - 1) / gx;
+  }
+
+  void check_common(const char* where, const ObjectCullFrame& frame, ObjectCullBuffers& in, ObjectCullOutputs& out,
+                    GlintObjectCullPush& push) const {
+    check_uint(concat(where, ": ObjectCullFrame::count").c_str(), frame.count, 0, config.max_objects);
+    camera_push(frame, config.reversed_z, push);
+    const VkBufferUsageFlags st = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+    const VkDeviceSize n = std::max<VkDeviceSize>(1, frame.count);
+    check_buffer(where, "objects", in.objects, n * sizeof(GlintCullObject), st);
+    if (config.payload_words > 0) check_buffer(where, "payloads", in.payloads, n * config.payload_words * 4, st);
+    check_buffer(where, "visibility", in.visibility, n * 4, st);
+    check_buffer(where, "list", out.list, VkDeviceSize(config.capacity) * std::max(1u, config.payload_words) * 4, st);
+    check_buffer(where, "indirect", out.indirect, sizeof(GlintObjectCullIndirect),
+                 st | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT);
+    check_buffer(where, "stats", out.stats, sizeof(GlintObjectCullStats), st);
+    // Storage descriptors bind each buffer's whole range, which the device limits.
+    const std::pair<const char*, const Buffer*> bound[] = {{"objects", &in.objects},
+                                                           {"payloads", &in.payloads},
+                                                           {"visibility", &in.visibility},
+                                                           {"list", &out.list},
+                                                           {"indirect", &out.indirect},
+                                                           {"stats", &out.stats}};
+    for (const auto& [role, b] : bound) {
+      if (b == &in.payloads && config.payload_words == 0) continue;
+      if (b->size > max_range) {
+        throw Error(ErrorCode::invalid_argument, concat(where, ": ", role, " buffer size = ", b->size,
+                                                        " bytes is above the device's maxStorageBufferRange = ",
+                                                        max_range, "; pass a smaller range"));
+      }
+    }
+  }
+
+  void check_images(const char* where, HiZPyramid& hiz, Image& depth) const {
+    const HiZConfig& hc = hiz.config();
+    if (hc.reversed_z != config.reversed_z) {
+      throw Error(ErrorCode::invalid_argument,
+                  concat(where, ": HiZConfig::reversed_z = ", hc.reversed_z, " differs from ObjectCullConfig::reversed_z = ",
+                         config.reversed_z));
+    }
+    if (!depth.image || !depth.view) throw Error(ErrorCode::invalid_argument, concat(where, ": depth image or view is null"));
+    if (depth.format != hc.format || depth.extent.width != hc.extent.width || depth.extent.height != hc.extent.height) {
+      throw Error(ErrorCode::invalid_argument,
+                  concat(where, ": depth (", detail::format_name(depth.format), " ", depth.extent.width, "x",
+                         depth.extent.height, ") does not match the Hi-Z pyramid (", detail::format_name(hc.format), " ",
+                         hc.extent.width, "x", hc.extent.height, ")"));
+    }
+    if (!(depth.usage & VK_IMAGE_USAGE_SAMPLED_BIT))
+      throw Error(ErrorCode::missing_usage, concat(where, ": depth image lacks VK_IMAGE_USAGE_SAMPLED_BIT usage"));
+  }
+
+  void run(VkCommandBuffer cmd, HiZPyramid* hiz, Image* depth, uint32_t mode, GlintObjectCullPush push,
+           uint32_t count, ObjectCullBuffers& in, ObjectCullOutputs& out, Profiler* profiler);
+};
+
+ObjectCuller::ObjectCuller(const Context& context, const ObjectCullConfig& config) : impl_(std::make_unique<Impl>()) {
+  config.validate();
+  Impl& m = *impl_;
+  m.context = &context;
+  m.config = config;
+  m.arena = detail::DescriptorArena(context, 16, 8);
+  VkPhysicalDeviceProperties props;
+  vkGetPhysicalDeviceProperties(context.physical_device(), &props);
+  m.max_groups_x = props.limits.maxComputeWorkGroupCount[0];
+  m.max_range = props.limits.maxStorageBufferRange;
+  // The objects, payload and list buffers are each one storage descriptor (limits come from the
+  // device): their largest sizes must fit maxStorageBufferRange (2^27 bytes guaranteed, 4 M objects).
+  const uint64_t object_bytes = uint64_t(config.max_objects) * sizeof(GlintCullObject);
+  const uint64_t payload_bytes = uint64_t(config.max_objects) * config.payload_words * 4;
+  const uint64_t list_bytes = uint64_t(config.capacity) * std::max(1u, config.payload_words) * 4;
+  if (object_bytes > m.max_range || payload_bytes > m.max_range) {
+    throw Error(ErrorCode::unsupported_size,
+                concat("ObjectCullConfig::max_objects = ", config.max_objects, " needs ",
+                       std::max(object_bytes, payload_bytes), "-byte object/payload buffers; the device's ",
+                       "maxStorageBufferRange = ", m.max_range, " allows at most ",
+                       m.max_range / std::max<uint64_t>(sizeof(GlintCullObject), uint64_t(config.payload_words) * 4),
+                       " objects"));
+  }
+  if (list_bytes > m.max_range) {
+    throw Error(ErrorCode::unsupported_size,
+                concat("ObjectCullConfig::capacity = ", config.capacity, " x max(1, payload_words) x 4 = ", list_bytes,
+                       " bytes exceeds the device's maxStorageBufferRange = ", m.max_range));
+  }
+  const uint64_t groups = (uint64_t(config.max_objects) + kGroup - 1) / kGroup;
+  if ((groups + m.max_groups_x - 1) / m.max_groups_x > props.limits.maxComputeWorkGroupCount[1]) {
+    throw Error(ErrorCode::invalid_argument,
+                concat("ObjectCullConfig::max_objects = ", config.max_objects,
+                       " needs more workgroups than the device's maxComputeWorkGroupCount allows"));
+  }
+  // As LightCuller: a CPU device runs a workgroup's invocations a few at a time.
+  const uint32_t scan_cap = context.info().type == VK_PHYSICAL_DEVICE_TYPE_CPU ? 64u : GLINT_OBJECT_SCAN_MAX_THREADS;
+  m.scan_threads =
+      std::min({scan_cap, props.limits.maxComputeWorkGroupInvocations, props.limits.maxComputeWorkGroupSize[0]});
+  const auto S = VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE;
+  const auto B = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+  detail::PipelineDesc d;
+  d.kernel_id = "object_cull_main";
+  d.bindings = {S, S, B, B, B};
+  d.push_constant_bytes = sizeof(GlintObjectCullPush);
+  d.workgroup = {kGroup, 1};
+  m.cull = detail::ComputePipeline(context, d);
+  d.kernel_id = "object_cull_phase1";
+  d.bindings = {B, B, B};
+  m.phase1 = detail::ComputePipeline(context, d);
+  detail::PipelineDesc sc;
+  sc.kernel_id = "object_cull_scan_main";
+  sc.bindings = {B, B, B};
+  sc.push_constant_bytes = sizeof(GlintObjectCompactPush);
+  sc.workgroup = {m.scan_threads, 1};
+  m.scan = detail::ComputePipeline(context, sc);
+  sc.kernel_id = "object_cull_scatter_main";
+  sc.workgroup = {kGroup, 1};
+  m.scatter = detail::ComputePipeline(context, sc);
+  const VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+  m.groups = detail::OwnedBuffer(context, GLINT_OBJECT_HEADER_WORDS * 4 + groups * 16, usage, false);
+  m.groups_state = view_of(m.groups, usage);
+  m.dummy = detail::OwnedBuffer(context, 16, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, false);
+  m.dummy_state = view_of(m.dummy, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+}
+
+ObjectCuller::ObjectCuller(ObjectCuller&&) noexcept = default;
+ObjectCuller& ObjectCuller::operator=(ObjectCuller&&) noexcept = default;
+ObjectCuller::~ObjectCuller() = default;
+
+const ObjectCullConfig& ObjectCuller::config() const { return impl_->config; }
+
+uint64_t ObjectCuller::min_bytes_moved(uint32_t count, uint32_t written) const {
+  const uint64_t groups = (uint64_t(count) + kGroup - 1) / kGroup;
+  const uint64_t words = std::max(1u, impl_->config.payload_words);
+  return uint64_t(count) * (sizeof(GlintCullObject) + 8) + groups * 16 * 3 + uint64_t(written) * words * 4 * 2;
+}
+
+void ObjectCuller::Impl::run(VkCommandBuffer cmd, HiZPyramid* hiz, Image* depth, uint32_t mode,
+                             GlintObjectCullPush push, uint32_t count, ObjectCullBuffers& in, ObjectCullOutputs& out,
+                             Profiler* profiler) {
+  Buffer& payloads = config.payload_words > 0 ? in.payloads : dummy_state;
+  const bool images = mode != GLINT_OBJECT_MODE_PHASE1;
+  std::vector<uint64_t> key{mode == GLINT_OBJECT_MODE_PHASE1 ? 1u : 0u};
+  if (images) {
+    key.push_back(reinterpret_cast<uint64_t>(depth->view));
+    key.push_back(reinterpret_cast<uint64_t>(hiz->image().view));
+  }
+  key_add(key, in.objects);
+  key_add(key, payloads);
+  key_add(key, in.visibility);
+  key_add(key, out.list);
+  key_add(key, out.indirect);
+  key_add(key, out.stats);
+  auto it = sets.find(key);
+  if (it == sets.end()) {
+    Sets s;
+    std::vector<detail::DescriptorArena::AnyBinding> c;
+    if (images) {
+      c.resize(2);
+      c[0].image = {depth->view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+      c[1].image = {hiz->image().view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+    }
+    for (Buffer* b : {&in.objects, &in.visibility, &groups_state}) {
+      detail::DescriptorArena::AnyBinding a;
+      a.buffer = *b;
+      c.push_back(a);
+    }
+    s.cull = arena.make_mixed_set(images ? cull : phase1, c);
+    std::vector<detail::DescriptorArena::AnyBinding> n(3);
+    n[0].buffer = groups_state;
+    n[1].buffer = out.indirect;
+    n[2].buffer = out.stats;
+    s.scan = arena.make_mixed_set(scan, n);
+    std::vector<detail::DescriptorArena::AnyBinding> p(3);
+    p[0].buffer = groups_state;
+    p[1].buffer = payloads;
+    p[2].buffer = out.list;
+    s.scatter = arena.make_mixed_set(scatter, p);
+    it = sets.emplace(key, s).first;
+  }
+  const Sets s = it->second;
+
+  detail::Barriers b;
+  if (!counters_cleared) {  // once per object: the scan resets them after every cull
+    b.use(groups_state, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);
+    b.flush(cmd);
+    vkCmdFillBuffer(cmd, groups.buffer(), 0, GLINT_OBJECT_HEADER_WORDS * 4, 0);
+    detail::count_recorded_command();
+    counters_cleared = true;
+  }
+  uint32_t gx, gy;
+  grid(count, gx, gy);
+  // 1. Test: masks, counters, states.
+  if (images) {
+    b.use(*depth, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, kCompute, kSampled);
+    b.use(hiz->image(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, kCompute, kSampled, std::max(1u, hiz->levels()));
+  }
+  b.use(in.objects, kCompute, kRead);
+  b.use(in.visibility, kCompute, images ? (kRead | kWrite) : kRead);
+  b.use(groups_state, kCompute, kRead | kWrite);
+  b.flush(cmd);
+  if (count > 0) {
+    push.count = count;
+    push.flags = mode | (config.reversed_z ? GLINT_OBJECT_REVERSED_Z : 0u);
+    push.groups_x = gx;
+    if (images) {
+      push.width = static_cast<int32_t>(hiz->config().extent.width);
+      push.height = static_cast<int32_t>(hiz->config().extent.height);
+      push.levels = hiz->levels();
+    }
+    (images ? cull : phase1).dispatch(cmd, s.cull, push, gx * kGroup, gy);
+  }
+  if (profiler) profiler->mark(cmd, "object cull");
+  // 2. Scan: slots, arguments, statistics; counters reset.
+  GlintObjectCompactPush cp{};
+  cp.count = count;
+  cp.capacity = config.capacity;
+  cp.payload_words = config.payload_words;
+  cp.objects_per_group = config.objects_per_group;
+  cp.groups_x = gx;
+  b.use(groups_state, kCompute, kRead | kWrite);
+  b.use(out.indirect, kCompute, kWrite);
+  b.use(out.stats, kCompute, kWrite);
+  b.flush(cmd);
+  scan.dispatch(cmd, s.scan, cp, scan_threads, 1);
+  if (profiler) profiler->mark(cmd, "object cull scan");
+  // 3. Scatter: payloads in object order.
+  if (count > 0) {
+    b.use(groups_state, kCompute, kRead);
+    b.use(payloads, kCompute, kRead);
+    b.use(out.list, kCompute, kWrite);
+    b.flush(cmd);
+    scatter.dispatch(cmd, s.scatter, cp, gx * kGroup, gy);
+  }
+  if (profiler) profiler->mark(cmd, "object cull scatter");
+}
+
+void ObjectCuller::record(VkCommandBuffer cmd, HiZPyramid& hiz, Image& depth, const ObjectCullFrame& frame,
+                          ObjectCullBuffers& buffers, ObjectCullOutputs& outputs, Profiler* profiler) {
+  Impl& m = *impl_;
+  GlintObjectCullPush push{};
+  m.check_common("ObjectCuller::record", frame, buffers, outputs, push);
+  m.check_images("ObjectCuller::record", hiz, depth);
+  m.run(cmd, &hiz, &depth, GLINT_OBJECT_MODE_SINGLE, push, frame.count, buffers, outputs, profiler);
+}
+
+void ObjectCuller::record_phase1(VkCommandBuffer cmd, const ObjectCullFrame& frame, ObjectCullBuffers& buffers,
+                                 ObjectCullOutputs& outputs, Profiler* profiler) {
+  Impl& m = *impl_;
+  GlintObjectCullPush push{};
+  m.check_common("ObjectCuller::record_phase1", frame, buffers, outputs, push);
+  m.run(cmd, nullptr, nullptr, GLINT_OBJECT_MODE_PHASE1, push, frame.count, buffers, outputs, profiler);
+}
+
+void ObjectCuller::record_phase2(VkCommandBuffer cmd, HiZPyramid& hiz, Image& depth, const ObjectCullFrame& frame,
+                                 ObjectCullBuffers& buffers, ObjectCullOutputs& outputs, Profiler* profiler) {
+  Impl& m = *impl_;
+  GlintObjectCullPush push{};
+  m.check_common("ObjectCuller::record_phase2", frame, buffers, outputs, push);
+  m.check_images("ObjectCuller::record_phase2", hiz, depth);
+  m.run(cmd, &hiz, &depth, GLINT_OBJECT_MODE_PHASE2, push, frame.count, buffers, outputs, profiler);
+}
+
+void ObjectCuller::record_clear_history(VkCommandBuffer cmd, Buffer& visibility, uint32_t count) {
+  const char* where = "ObjectCuller::record_clear_history";
+  check_uint(concat(where, ": count").c_str(), count, 0, impl_->config.max_objects);
+  check_buffer(where, "visibility", visibility, std::max<VkDeviceSize>(4, VkDeviceSize(count) * 4),
+               VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+  if (count == 0) return;
+  detail::Barriers b;
+  b.use(visibility, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);
+  b.flush(cmd);
+  vkCmdFillBuffer(cmd, visibility.buffer, visibility.offset, VkDeviceSize(count) * 4, 0);
+  detail::count_recorded_command();
+}
+
+void ObjectCuller::forget_caller_resources() {
+  impl_->sets.clear();
+  impl_->arena.reset();
+}
+
+}  // namespace glint
