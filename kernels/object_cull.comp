@@ -25,7 +25,7 @@
 // render target while phase 1 runs).
 layout(local_size_x_id = 0, local_size_y_id = 1) in;
 
-#include "object_cull.h"
+#include "object_cull_params.h"
 
 #ifdef GLINT_OBJECT_PHASE1
 #define BINDING_OBJECTS 0

@@ -9,7 +9,7 @@
 // atomics, so no reset races them).
 layout(local_size_x_id = 0, local_size_y_id = 1) in;
 
-#include "object_cull.h"
+#include "object_cull_params.h"
 
 layout(std430, binding = 0) buffer Groups {
   uint counters[GLINT_OBJECT_HEADER_WORDS];

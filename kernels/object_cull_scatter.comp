@@ -8,7 +8,7 @@
 // object's payload words (payload_words > 0) or its index.
 layout(local_size_x_id = 0, local_size_y_id = 1) in;
 
-#include "object_cull.h"
+#include "object_cull_params.h"
 
 layout(std430, binding = 0) readonly buffer Groups {
   uint counters[GLINT_OBJECT_HEADER_WORDS];

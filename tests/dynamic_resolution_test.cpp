@@ -487,6 +487,7 @@ TEST_F(DynamicResolutionTest, FramesInFlightIsChecked) {
     }
     AdoptInfo adopt;
     adopt.instance = context().instance();
+    adopt.api_version = VK_API_VERSION_1_3;
     adopt.physical_device = context().physical_device();
     adopt.device = context().device();
     adopt.queue_family_index = context().queue_family_index();
@@ -500,6 +501,7 @@ TEST_F(DynamicResolutionTest, FramesInFlightIsChecked) {
   }
   AdoptInfo adopt;
   adopt.instance = context().instance();
+  adopt.api_version = VK_API_VERSION_1_3;
   adopt.physical_device = context().physical_device();
   adopt.device = context().device();
   adopt.queue_family_index = context().queue_family_index();

@@ -27,7 +27,7 @@
 #include "core/barriers.h"
 #include "core/resources.h"
 #include "core/transfer.h"
-#include "object_cull.h"
+#include "glint/gpu/object_cull.h"
 
 namespace glint::cli {
 namespace {

@@ -13,7 +13,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "object_cull.h"
+#include "glint/gpu/object_cull.h"
 #include "reference/occlusion_reference.h"
 
 namespace glint::reference {

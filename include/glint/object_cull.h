@@ -28,6 +28,7 @@
 
 #include <glint/glint.h>
 #include <glint/occlusion.h>
+#include <glint/gpu/object_cull.h>
 
 #include <cstdint>
 #include <memory>
