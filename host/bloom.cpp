@@ -11,6 +11,7 @@
 #include "core/barriers.h"
 #include "core/check.h"
 #include "core/context_state.h"
+#include "core/formats.h"
 #include "core/pipeline.h"
 #include "core/resources.h"
 #include "core/size_cache.h"
@@ -159,13 +160,17 @@ struct Bloom::Impl {
 
   // Pipelines for the current shape (filter, precision); composite and copy per output format.
   detail::ComputePipeline prefilter_down, down, blur, up;
-  detail::ComputePipeline composite[2], copy[2];  // [0] rgba16f, [1] rgba32f
+  // Composite and copy per output variant (core/formats.h, check_color_write()): rgba16f and
+  // rgba32f are made with the others, r11f_g11f_b10f and noformat on first use.
+  std::map<std::string, detail::ComputePipeline> composite, copy;
 
   // Descriptor sets that name caller images, made once per (input view, output view).
   struct CallerSets {
     VkDescriptorSet prefilter = VK_NULL_HANDLE;
     VkDescriptorSet composite = VK_NULL_HANDLE;
     VkDescriptorSet copy = VK_NULL_HANDLE;
+    const detail::ComputePipeline* composite_pipeline = nullptr;  // for the output's format
+    const detail::ComputePipeline* copy_pipeline = nullptr;
   };
 
   // The pyramid of one input extent (and config generation). Kept per size in `cache` until no
@@ -213,12 +218,22 @@ struct Bloom::Impl {
     blur = config.filter == BloomFilter::gauss9 ? detail::ComputePipeline(*context, desc("bloom_blur_" + lv, {S, W}))
                                                 : detail::ComputePipeline();
     up = detail::ComputePipeline(*context, desc("bloom_up_" + lv, {S, W}));
-    const char* out_variants[2] = {"rgba16f", "rgba32f"};
-    for (int i = 0; i < 2; ++i) {
-      composite[i] =
-          detail::ComputePipeline(*context, desc(std::string("bloom_composite_") + out_variants[i], {S, S, W}));
-      copy[i] = detail::ComputePipeline(*context, desc(std::string("image_copy_") + out_variants[i], {S, W}));
+    composite.clear();
+    copy.clear();
+    for (const char* v : {"rgba16f", "rgba32f"}) output_pipelines(v);
+  }
+
+  // The composite and copy pipelines that write an output of kernel variant `v`.
+  std::pair<detail::ComputePipeline*, detail::ComputePipeline*> output_pipelines(const std::string& v) {
+    const auto S = VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE;
+    const auto W = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
+    auto c = composite.find(v);
+    if (c == composite.end()) {
+      c = composite.emplace(v, detail::ComputePipeline(*context, desc("bloom_composite_" + v, {S, S, W}))).first;
     }
+    auto k = copy.find(v);
+    if (k == copy.end()) k = copy.emplace(v, detail::ComputePipeline(*context, desc("image_copy_" + v, {S, W}))).first;
+    return {&c->second, &k->second};
   }
 
   // The pyramid for `size`, from the cache or made now; it becomes `cur`. Throws (before anything
@@ -270,22 +285,24 @@ struct Bloom::Impl {
     return made;
   }
 
-  const CallerSets& sets_for(Pyramid& P, const Image& in, const Image& out) {
+  const CallerSets& sets_for(Pyramid& P, const Image& in, const Image& out, const std::string& out_variant) {
     auto key = std::make_pair(in.view, out.view);
     auto it = P.caller_sets.find(key);
     if (it != P.caller_sets.end()) return it->second;
     auto& arena = P.caller_arena;
     const auto& pre_levels = P.pre_levels;
     const auto& levels = P.levels;
-    const bool in_place = in.image == out.image;
+    const bool in_place = same_subresource(in, out);
     const VkImageLayout in_layout = in_place ? VK_IMAGE_LAYOUT_GENERAL : VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
     const VkImageLayout G = VK_IMAGE_LAYOUT_GENERAL;
-    const int o = out.format == VK_FORMAT_R32G32B32A32_SFLOAT ? 1 : 0;
+    const auto [composite_pipeline, copy_pipeline] = output_pipelines(out_variant);
     CallerSets s;
     const VkImageView first = pre_levels.empty() ? levels[0].state.view : pre_levels[0].state.view;
     s.prefilter = arena.make_set(prefilter_down, {{in.view, in_layout}, {first, G}});
-    s.composite = arena.make_set(composite[o], {{in.view, in_layout}, {levels[0].state.view, G}, {out.view, G}});
-    s.copy = arena.make_set(copy[o], {{in.view, in_layout}, {out.view, G}});
+    s.composite = arena.make_set(*composite_pipeline, {{in.view, in_layout}, {levels[0].state.view, G}, {out.view, G}});
+    s.copy = arena.make_set(*copy_pipeline, {{in.view, in_layout}, {out.view, G}});
+    s.composite_pipeline = composite_pipeline;
+    s.copy_pipeline = copy_pipeline;
     return P.caller_sets.emplace(key, s).first->second;
   }
 
@@ -304,17 +321,19 @@ struct Bloom::Impl {
     return p;
   }
 
-  void check_images(const Image& in, const Image& out) const {
+  // Whether two caller images are the same layer of the same image (bloom in place).
+  static bool same_subresource(const Image& a, const Image& b) {
+    return a.image == b.image && a.base_array_layer == b.base_array_layer;
+  }
+
+  // Checks both images; returns the kernel variant that writes the output.
+  std::string check_images(const Image& in, const Image& out) const {
     const uint32_t max_dim = context->info().max_image_dimension_2d;
     auto check_one = [&](const Image& img, const char* role, VkImageUsageFlags need, const char* need_name) {
       if (!img.image || !img.view) {
         throw Error(ErrorCode::invalid_argument, concat("Bloom::record: ", role, " image and view must be non-null"));
       }
-      if (!detail::is_float_rgba(img.format)) {
-        throw Error(ErrorCode::unsupported_format,
-                    concat("Bloom::record: ", role, " format is ", detail::format_name(img.format),
-                           "; accepted VK_FORMAT_R16G16B16A16_SFLOAT or VK_FORMAT_R32G32B32A32_SFLOAT"));
-      }
+      detail::check_layers(img, "Bloom::record", role);
       if (img.extent.width == 0 || img.extent.height == 0 || img.extent.width > max_dim ||
           img.extent.height > max_dim) {
         throw Error(ErrorCode::unsupported_size,
@@ -325,43 +344,47 @@ struct Bloom::Impl {
         throw Error(ErrorCode::missing_usage, concat("Bloom::record: ", role, " image lacks ", need_name, " usage"));
       }
     };
-    const bool in_place = in.image == out.image;
+    const bool in_place = same_subresource(in, out);
     check_one(in, "input", VK_IMAGE_USAGE_SAMPLED_BIT, "VK_IMAGE_USAGE_SAMPLED_BIT");
     check_one(out, "output", VK_IMAGE_USAGE_STORAGE_BIT, "VK_IMAGE_USAGE_STORAGE_BIT");
+    detail::check_color_read(*context, in.format, "Bloom::record", "input");
+    std::string variant = detail::check_color_write(*context, out.format, "Bloom::record", "output");
     if (in.extent.width != out.extent.width || in.extent.height != out.extent.height) {
       throw Error(ErrorCode::invalid_argument,
                   concat("Bloom::record: output extent ", out.extent.width, "x", out.extent.height,
                          " differs from input extent ", in.extent.width, "x", in.extent.height));
     }
     if (in_place && in.format != out.format) {
-      throw Error(ErrorCode::invalid_argument, "Bloom::record: in-place input and output must have the same format");
+      throw Error(ErrorCode::invalid_argument,
+                  concat("Bloom::record: in-place input and output must have the same format; input is ",
+                         detail::format_name(in.format), ", output ", detail::format_name(out.format)));
     }
+    return variant;
   }
 
   void record(VkCommandBuffer cmd, Image& input, Image& output, Profiler* profiler);
 };
 
 void Bloom::Impl::record(VkCommandBuffer cmd, Image& input, Image& output, Profiler* profiler) {
-  check_images(input, output);
-  const bool in_place = input.image == output.image;
+  const std::string out_variant = check_images(input, output);
+  const bool in_place = same_subresource(input, output);
   if (config.intensity == 0.0f) {
     // Nothing to add: the output is the input. In place that is no work at all.
     if (in_place) return;
     Pyramid& P = pyramid_for(input.extent, "Bloom::record");
-    const CallerSets& s = sets_for(P, input, output);
+    const CallerSets& s = sets_for(P, input, output, out_variant);
     cache.recorded(&P, cmd);
     detail::Barriers b;
     b.use(input, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, kSampled);
     b.use(output, VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, kStorageWrite);
     b.flush(cmd);
     const LevelSize full{input.extent.width, input.extent.height};
-    copy[output.format == VK_FORMAT_R32G32B32A32_SFLOAT].dispatch(cmd, s.copy, push(P, full, full), full.width,
-                                                                  full.height);
+    s.copy_pipeline->dispatch(cmd, s.copy, push(P, full, full), full.width, full.height);
     if (profiler) profiler->mark(cmd, "bloom copy (intensity 0)");
     return;
   }
   Pyramid& P = pyramid_for(input.extent, "Bloom::record");
-  const CallerSets& sets = sets_for(P, input, output);
+  const CallerSets& sets = sets_for(P, input, output, out_variant);
   cache.recorded(&P, cmd);
   const std::vector<LevelSize>& chain = P.chain;
   const std::vector<LevelSize>& pre_chain = P.pre_chain;
@@ -434,8 +457,7 @@ void Bloom::Impl::record(VkCommandBuffer cmd, Image& input, Image& output, Profi
   b.use(scene, scene_layout, kCompute, kSampled);
   b.use(output, G, kCompute, in_place ? (kSampled | kStorageWrite) : kStorageWrite);
   b.flush(cmd);
-  composite[output.format == VK_FORMAT_R32G32B32A32_SFLOAT].dispatch(cmd, sets.composite, push(P, chain[0], full),
-                                                                     full.width, full.height);
+  sets.composite_pipeline->dispatch(cmd, sets.composite, push(P, chain[0], full), full.width, full.height);
   if (profiler) profiler->mark(cmd, "bloom composite");
   if (in_place) input = output;
 }
@@ -506,8 +528,8 @@ uint64_t Bloom::min_bytes_moved(VkFormat input_format, VkFormat output_format) c
   if (!impl_->cur) return 0;
   const Impl::Pyramid& p = *impl_->cur;
   const uint64_t pixels = uint64_t(p.extent.width) * p.extent.height;
-  const uint64_t in_bytes = input_format == VK_FORMAT_R32G32B32A32_SFLOAT ? 16 : 8;
-  const uint64_t out_bytes = output_format == VK_FORMAT_R32G32B32A32_SFLOAT ? 16 : 8;
+  const uint64_t in_bytes = detail::texel_bytes(input_format);
+  const uint64_t out_bytes = detail::texel_bytes(output_format);
   const uint64_t level_bytes = impl_->config.precision == Precision::fp32 ? 16 : 8;
   uint64_t total = pixels * (in_bytes + out_bytes);
   for (const LevelSize& l : p.chain) total += 2 * uint64_t(l.width) * l.height * level_bytes;

@@ -15,6 +15,7 @@
 #include "blur_plan.h"
 #include "core/barriers.h"
 #include "core/check.h"
+#include "core/formats.h"
 #include "core/context_state.h"
 #include "core/pipeline.h"
 #include "core/resources.h"
@@ -127,7 +128,14 @@ FusedShape fused_shape(const DeviceInfo& info, uint32_t radius, bool half_shared
 // Largest value a texel may hold so that every image of the chain stays finite (docs/BLUR.md):
 // fp32 keeps headroom for the 4-texel sums the kernels form before scaling.
 float max_value_for(VkFormat a, VkFormat b) {
-  return (a == VK_FORMAT_R16G16B16A16_SFLOAT || b == VK_FORMAT_R16G16B16A16_SFLOAT) ? 65504.0f : 1.0e37f;
+  return std::min({detail::format_max(a), detail::format_max(b), 1.0e37f});
+}
+
+// The kernel variant that stores `format`: its GLSL qualifier's, else "noformat" (which
+// detail::check_color_write() accepted for the caller's output before any pipeline is made).
+std::string store_variant(VkFormat format) {
+  const char* q = detail::qualified_variant(format);
+  return q ? q : "noformat";
 }
 
 // Throws Error(unsupported_size) "<where>: <role> extent WxH is out of range: accepted 1 to N on
@@ -147,10 +155,11 @@ void check_image(const Context& context, const Image& img, const char* where, co
                  const char* need_name) {
   if (!img.image || !img.view)
     throw Error(ErrorCode::invalid_argument, concat(where, ": ", role, " image and view must be non-null"));
-  if (!detail::is_float_rgba(img.format)) {
-    throw Error(ErrorCode::unsupported_format,
-                concat(where, ": ", role, " format is ", detail::format_name(img.format),
-                       "; accepted VK_FORMAT_R16G16B16A16_SFLOAT or VK_FORMAT_R32G32B32A32_SFLOAT"));
+  detail::check_layers(img, where, role);
+  if (need & VK_IMAGE_USAGE_STORAGE_BIT) {
+    detail::check_color_write(context, img.format, where, role);
+  } else {
+    detail::check_color_read(context, img.format, where, role);
   }
   check_extent_named(context, img.extent, where, role);
   if ((img.usage & need) != need)
@@ -197,12 +206,12 @@ struct StepProgram {
 
   const detail::ComputePipeline& pipeline(const std::string& kernel, VkFormat dst_format, detail::Workgroup2D wg,
                                           std::vector<uint32_t> spec, std::vector<VkDescriptorType> bindings) {
-    std::string key = concat(kernel, "_", detail::format_variant(dst_format), "/", wg.x, "x", wg.y);
+    std::string key = concat(kernel, "_", store_variant(dst_format), "/", wg.x, "x", wg.y);
     for (uint32_t v : spec) key += concat("/", v);
     auto it = pipelines->find(key);
     if (it != pipelines->end()) return it->second;
     detail::PipelineDesc d;
-    d.kernel_id = concat(kernel, "_", detail::format_variant(dst_format));
+    d.kernel_id = concat(kernel, "_", store_variant(dst_format));
     d.bindings = std::move(bindings);
     d.push_constant_bytes = sizeof(BlurPush);
     d.workgroup = wg;
@@ -683,8 +692,10 @@ void GaussianBlur::record(VkCommandBuffer cmd, Image& input, Image& output, Prof
   const Context& ctx = *impl_->context;
   check_image(ctx, input, "GaussianBlur::record", "input", VK_IMAGE_USAGE_SAMPLED_BIT, "VK_IMAGE_USAGE_SAMPLED_BIT");
   check_image(ctx, output, "GaussianBlur::record", "output", VK_IMAGE_USAGE_STORAGE_BIT, "VK_IMAGE_USAGE_STORAGE_BIT");
-  if (input.image == output.image) {
-    throw Error(ErrorCode::invalid_argument, "GaussianBlur::record: input and output must be different images");
+  if (input.image == output.image && input.base_array_layer == output.base_array_layer) {
+    throw Error(ErrorCode::invalid_argument,
+                concat("GaussianBlur::record: input and output are layer ", input.base_array_layer,
+                       " of the same image; they must be different images or layers"));
   }
   if (input.extent.width != output.extent.width || input.extent.height != output.extent.height) {
     throw Error(ErrorCode::invalid_argument,
@@ -692,6 +703,8 @@ void GaussianBlur::record(VkCommandBuffer cmd, Image& input, Image& output, Prof
                        " differs from input extent ", input.extent.width, "x", input.extent.height));
   }
   Impl::Size& size = impl_->size_for(input.extent, output.format, "GaussianBlur::record");
+  // The paired-tap method reads the input through a bilinear sampler (docs/BLUR.md).
+  if (size.choice.linear_sampling) detail::check_color_read(ctx, input.format, "GaussianBlur::record", "input", true);
   impl_->cache.recorded(&size, cmd);
   size.prog.record(cmd, input, &output, profiler);
 }

@@ -14,6 +14,7 @@
 
 #include "core/barriers.h"
 #include "core/check.h"
+#include "core/formats.h"
 #include "core/context_state.h"
 #include "core/pipeline.h"
 #include "core/resources.h"
@@ -77,13 +78,18 @@ void check_uint(const char* name, uint64_t value, uint64_t lo, uint64_t hi) {
 // ---------------------------------------------------------------------------------------------
 // HiZPyramid
 
+namespace {
+constexpr const char* kHiZFormats =
+    "VK_FORMAT_D16_UNORM, VK_FORMAT_X8_D24_UNORM_PACK32, VK_FORMAT_D24_UNORM_S8_UINT, VK_FORMAT_D32_SFLOAT, "
+    "VK_FORMAT_D32_SFLOAT_S8_UINT or VK_FORMAT_R32_SFLOAT";
+}  // namespace
+
 void HiZConfig::validate() const {
   check_uint("HiZConfig::extent.width", extent.width, 1, 16384);
   check_uint("HiZConfig::extent.height", extent.height, 1, 16384);
-  if (format != VK_FORMAT_D32_SFLOAT && format != VK_FORMAT_R32_SFLOAT) {
+  if (!detail::is_depth_format(format) && format != VK_FORMAT_R32_SFLOAT) {
     throw Error(ErrorCode::unsupported_format,
-                concat("HiZConfig::format = ", detail::format_name(format),
-                       " is not accepted: VK_FORMAT_D32_SFLOAT or VK_FORMAT_R32_SFLOAT"));
+                concat("HiZConfig::format = ", detail::format_name(format), " is not accepted: ", kHiZFormats));
   }
   if (max_cell_px != 0) check_uint("HiZConfig::max_cell_px", max_cell_px, 1, 16384);
 }
@@ -202,6 +208,13 @@ HiZPyramid::HiZPyramid(const Context& context, const HiZConfig& config) : impl_(
                 concat("HiZConfig::extent = ", config.extent.width, "x", config.extent.height,
                        " is above the device's maxImageDimension2D = ", limit));
   }
+  // The kernel gathers the depth through a sampler: the format needs SAMPLED_IMAGE, which Vulkan
+  // guarantees for D16_UNORM and D32_SFLOAT only (X8_D24, D24S8 and D32S8 vary by device).
+  if (!(detail::format_features(context, config.format) & VK_FORMAT_FEATURE_2_SAMPLED_IMAGE_BIT)) {
+    throw Error(ErrorCode::unsupported_format,
+                concat("HiZConfig::format = ", detail::format_name(config.format), " cannot be sampled on device '",
+                       context.info().name, "' (no VK_FORMAT_FEATURE_2_SAMPLED_IMAGE_BIT with optimal tiling)"));
+  }
   Impl& m = *impl_;
   m.context = &context;
   m.config = config;
@@ -254,6 +267,7 @@ void HiZPyramid::record(VkCommandBuffer cmd, Image& depth, Profiler* profiler) {
   const char* where = "HiZPyramid::record";
   if (!depth.image || !depth.view)
     throw Error(ErrorCode::invalid_argument, concat(where, ": depth image or view is null"));
+  detail::check_layers(depth, where, "depth");
   if (depth.format != m.config.format) {
     throw Error(ErrorCode::unsupported_format,
                 concat(where, ": depth format ", detail::format_name(depth.format),
@@ -436,6 +450,7 @@ void LightCuller::record(VkCommandBuffer cmd, HiZPyramid& hiz, Image& depth, Buf
   }
   if (!depth.image || !depth.view)
     throw Error(ErrorCode::invalid_argument, concat(where, ": depth image or view is null"));
+  detail::check_layers(depth, where, "depth");
   if (depth.format != hc.format || depth.extent.width != hc.extent.width || depth.extent.height != hc.extent.height) {
     throw Error(ErrorCode::invalid_argument,
                 concat(where, ": depth (", detail::format_name(depth.format), " ", depth.extent.width, "x",

@@ -9,7 +9,8 @@ layout(local_size_x_id = 0, local_size_y_id = 1) in;
 
 layout(binding = 0) uniform texture2D scene;
 layout(binding = 1) uniform texture2D level0;
-layout(binding = 2, DST_FORMAT) uniform writeonly image2D result;
+#include "dst_image.glsl"
+DST_LAYOUT(2) uniform writeonly image2D result;
 
 #include "bloom_params.h"
 layout(push_constant) uniform Push { BloomPush p; };

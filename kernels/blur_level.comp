@@ -20,7 +20,8 @@ layout(constant_id = 4) const int MODE = 0;         // source read: 0 same size,
 layout(constant_id = 5) const bool HALF_SHARED = false;
 
 layout(binding = 0) uniform texture2D src;
-layout(binding = 1, DST_FORMAT) uniform writeonly image2D dst;
+#include "dst_image.glsl"
+DST_LAYOUT(1) uniform writeonly image2D dst;
 
 #include "blur_params.h"
 layout(push_constant) uniform Push { BlurPush p; };

@@ -8,7 +8,8 @@ layout(local_size_x_id = 0, local_size_y_id = 1) in;  // run as (SEGMENT, 1)
 layout(constant_id = 2) const int MAX_RADIUS = 192;
 
 layout(binding = 0) uniform texture2D src;
-layout(binding = 1, DST_FORMAT) uniform writeonly image2D dst;
+#include "dst_image.glsl"
+DST_LAYOUT(1) uniform writeonly image2D dst;
 layout(binding = 2, std430) readonly buffer Taps { float taps[]; };  // w[0..R]
 
 #include "blur_params.h"

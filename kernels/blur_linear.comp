@@ -8,7 +8,8 @@
 layout(local_size_x_id = 0, local_size_y_id = 1) in;
 
 layout(binding = 0) uniform sampler2D src;  // linear filter, clamp to edge, normalized coordinates
-layout(binding = 1, DST_FORMAT) uniform writeonly image2D dst;
+#include "dst_image.glsl"
+DST_LAYOUT(1) uniform writeonly image2D dst;
 layout(binding = 2, std430) readonly buffer Taps { vec2 taps[]; };  // (offset, weight); taps[0] = (0, w0)
 
 #include "blur_params.h"

@@ -8,7 +8,8 @@
 layout(local_size_x_id = 0, local_size_y_id = 1) in;
 
 layout(binding = 0) uniform texture2D src;
-layout(binding = 1, DST_FORMAT) uniform writeonly image2D dst;
+#include "dst_image.glsl"
+DST_LAYOUT(1) uniform writeonly image2D dst;
 
 #include "blur_params.h"
 layout(push_constant) uniform Push { BlurPush p; };

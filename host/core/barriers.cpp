@@ -2,6 +2,8 @@
 
 #include <atomic>
 
+#include "core/formats.h"
+
 namespace glint::detail {
 
 void Barriers::use(Image& image, VkImageLayout layout, VkPipelineStageFlags2 stage, VkAccessFlags2 access,
@@ -27,12 +29,11 @@ void Barriers::use(Image& image, VkImageLayout layout, VkPipelineStageFlags2 sta
   b.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
   b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
   b.image = image.image;
-  const VkImageAspectFlags aspect =
-      image.format == VK_FORMAT_D32_SFLOAT ? VK_IMAGE_ASPECT_DEPTH_BIT : VK_IMAGE_ASPECT_COLOR_BIT;
-  b.subresourceRange = {aspect, 0, level_count, 0, 1};
-  // The same image twice in one batch (in-place use) merges into one barrier.
+  b.subresourceRange = {image_aspects(image.format), 0, level_count, image.base_array_layer, 1};
+  // The same layer of an image twice in one batch (in-place use) merges into one barrier; two
+  // layers of one image are two subresources with barriers of their own.
   for (auto& p : pending_) {
-    if (p.image == image.image) {
+    if (p.image == image.image && p.subresourceRange.baseArrayLayer == image.base_array_layer) {
       p.dstStageMask |= stage;
       p.dstAccessMask |= access;
       p.newLayout = layout;
@@ -85,7 +86,7 @@ void Barriers::queue_read_chain(VkPipelineStageFlags2 readers, VkPipelineStageFl
     b.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
     b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
     b.image = image->image;
-    b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, VK_REMAINING_MIP_LEVELS, 0, 1};
+    b.subresourceRange = {image_aspects(image->format), 0, VK_REMAINING_MIP_LEVELS, image->base_array_layer, 1};
     pending_.push_back(b);
   } else {
     VkBufferMemoryBarrier2 b{VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER_2};

@@ -45,8 +45,9 @@ class Barriers {
   /// Declares that `image` is next used with (layout, stage, access). Read-after-read in the same
   /// layout needs no barrier and only widens the tracked use; anything else queues one.
   /// `level_count` mip levels from level 0 are covered (glint-owned mip chains such as the Hi-Z
-  /// pyramid; caller images are views of level 0). The aspect follows the format (depth for
-  /// VK_FORMAT_D32_SFLOAT, colour otherwise).
+  /// pyramid; caller images are views of level 0), in the one layer Image::base_array_layer. The
+  /// aspect follows the format (core/formats.h, image_aspects(): depth and stencil for a combined
+  /// depth/stencil format, depth for a depth format, colour otherwise).
   void use(Image& image, VkImageLayout layout, VkPipelineStageFlags2 stage, VkAccessFlags2 access,
            uint32_t level_count = 1);
   /// The same for a buffer range (no layouts).

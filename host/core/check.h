@@ -34,7 +34,9 @@ inline void check_range(const char* name, double value, double lo, double hi) {
   }
 }
 
-const char* format_name(VkFormat format);
+/// "VK_FORMAT_B10G11R11_UFLOAT_PACK32", ...: every VkFormat by its enumerant name (a value unknown to
+/// the headers as "VkFormat <number>"), so that every refusal names the format it refused.
+std::string format_name(VkFormat format);
 
 /// The checks every effect makes on a caller's buffer before recording, in one place so that
 /// effects (and composites such as LensFlarePass) declare what they need instead of repeating

@@ -30,18 +30,6 @@ const char* vk_result_name(VkResult r) {
   }
 }
 
-const char* format_name(VkFormat f) {
-  switch (f) {
-    case VK_FORMAT_R16G16B16A16_SFLOAT: return "VK_FORMAT_R16G16B16A16_SFLOAT";
-    case VK_FORMAT_R32G32B32A32_SFLOAT: return "VK_FORMAT_R32G32B32A32_SFLOAT";
-    case VK_FORMAT_R8G8B8A8_UNORM: return "VK_FORMAT_R8G8B8A8_UNORM";
-    case VK_FORMAT_D32_SFLOAT: return "VK_FORMAT_D32_SFLOAT";
-    case VK_FORMAT_R32_SFLOAT: return "VK_FORMAT_R32_SFLOAT";
-    case VK_FORMAT_UNDEFINED: return "VK_FORMAT_UNDEFINED";
-    default: return "an unsupported VkFormat";
-  }
-}
-
 uint32_t ContextState::memory_type(uint32_t type_bits, VkMemoryPropertyFlags flags) const {
   for (uint32_t i = 0; i < memory.memoryTypeCount; ++i) {
     if ((type_bits & (1u << i)) && (memory.memoryTypes[i].propertyFlags & flags) == flags) return i;

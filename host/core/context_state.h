@@ -98,6 +98,11 @@ struct ContextState {
   /// (core/resources.h, clamp_sampler()); destroyed with the context.
   std::mutex sampler_mutex;
   std::map<std::tuple<int, int, float>, VkSampler> samplers;
+
+  /// optimalTilingFeatures of each format asked about (core/formats.h, format_features()): queried
+  /// once per format, since effects check them on every record().
+  std::mutex format_mutex;
+  std::map<VkFormat, VkFormatFeatureFlags2> format_features;
 };
 
 /// Validation messages seen by every context of the process, including those that arrive while a

@@ -5,6 +5,7 @@
 
 #include "core/check.h"
 #include "core/context_state.h"
+#include "core/formats.h"
 
 namespace glint::detail {
 
@@ -38,14 +39,23 @@ uint32_t texel_bytes(VkFormat format) {
     case VK_FORMAT_R32_UINT:
       return 4;
     case VK_FORMAT_R16_SFLOAT:
+    case VK_FORMAT_D16_UNORM:
       return 2;
+    case VK_FORMAT_B10G11R11_UFLOAT_PACK32:
+    case VK_FORMAT_E5B9G9R9_UFLOAT_PACK32:
+    case VK_FORMAT_X8_D24_UNORM_PACK32:
+      return 4;
+    case VK_FORMAT_R16G16B16_SFLOAT:
+      return 6;
+    case VK_FORMAT_R32G32B32_SFLOAT:
+      return 12;
     default:
       throw Error(ErrorCode::unsupported_format, concat("texel size of ", format_name(format), " is unknown"));
   }
 }
 
 OwnedImage::OwnedImage(const Context& context, VkExtent2D extent, VkFormat format, VkImageUsageFlags usage,
-                       uint32_t levels) {
+                       uint32_t levels, uint32_t layers) {
   device_ = context.device();
   auto& s = context.state();
   VkImageCreateInfo info{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
@@ -53,7 +63,7 @@ OwnedImage::OwnedImage(const Context& context, VkExtent2D extent, VkFormat forma
   info.format = format;
   info.extent = {extent.width, extent.height, 1};
   info.mipLevels = levels;
-  info.arrayLayers = 1;
+  info.arrayLayers = layers;
   info.samples = VK_SAMPLE_COUNT_1_BIT;
   info.tiling = VK_IMAGE_TILING_OPTIMAL;
   info.usage = usage;
@@ -64,6 +74,7 @@ OwnedImage::OwnedImage(const Context& context, VkExtent2D extent, VkFormat forma
   state.extent = extent;
   state.usage = usage;
   levels_ = levels;
+  layers_ = layers;
   try {
     VkMemoryRequirements req;
     vkGetImageMemoryRequirements(device_, state.image, &req);
@@ -74,11 +85,19 @@ OwnedImage::OwnedImage(const Context& context, VkExtent2D extent, VkFormat forma
     view.image = state.image;
     view.viewType = VK_IMAGE_VIEW_TYPE_2D;
     view.format = format;
-    const bool depth = format == VK_FORMAT_D32_SFLOAT;
-    const auto aspect = static_cast<VkImageAspectFlags>(depth ? VK_IMAGE_ASPECT_DEPTH_BIT : VK_IMAGE_ASPECT_COLOR_BIT);
+    // Views of a depth/stencil image show the depth aspect alone (a sampled view has one aspect).
+    const VkImageAspectFlags aspect = image_aspects(format) & ~VkImageAspectFlags(VK_IMAGE_ASPECT_STENCIL_BIT);
     view.subresourceRange = {aspect, 0, levels, 0, 1};
     vk_check(vkCreateImageView(device_, &view, nullptr, &state.view), "vkCreateImageView");
     s.count_object();
+    for (uint32_t l = 1; l < layers; ++l) {
+      view.subresourceRange = {aspect, 0, levels, l, 1};
+      VkImageView v = VK_NULL_HANDLE;
+      vk_check(vkCreateImageView(device_, &view, nullptr, &v), "vkCreateImageView (layer)");
+      s.count_object();
+      layer_views_.push_back(v);
+    }
+    view.subresourceRange = {aspect, 0, levels, 0, 1};
     for (uint32_t k = 0; levels > 1 && k < levels; ++k) {
       view.subresourceRange = {aspect, k, 1, 0, 1};
       VkImageView v = VK_NULL_HANDLE;
@@ -99,7 +118,9 @@ OwnedImage& OwnedImage::operator=(OwnedImage&& other) noexcept {
     memory_ = std::exchange(other.memory_, VK_NULL_HANDLE);
     state = std::exchange(other.state, Image{});
     levels_ = std::exchange(other.levels_, 0);
+    layers_ = std::exchange(other.layers_, 0);
     level_views_ = std::exchange(other.level_views_, {});
+    layer_views_ = std::exchange(other.layer_views_, {});
   }
   return *this;
 }
@@ -107,6 +128,7 @@ OwnedImage& OwnedImage::operator=(OwnedImage&& other) noexcept {
 void OwnedImage::reset() {
   if (device_) {
     for (VkImageView v : level_views_) vkDestroyImageView(device_, v, nullptr);
+    for (VkImageView v : layer_views_) vkDestroyImageView(device_, v, nullptr);
     if (state.view) vkDestroyImageView(device_, state.view, nullptr);
     if (state.image) vkDestroyImage(device_, state.image, nullptr);
     if (memory_) vkFreeMemory(device_, memory_, nullptr);
@@ -115,7 +137,9 @@ void OwnedImage::reset() {
   memory_ = VK_NULL_HANDLE;
   state = Image{};
   levels_ = 0;
+  layers_ = 0;
   level_views_.clear();
+  layer_views_.clear();
 }
 
 OwnedBuffer::OwnedBuffer(const Context& context, VkDeviceSize size, VkBufferUsageFlags usage, bool host_visible) {

@@ -14,7 +14,10 @@ namespace glint::detail {
 class OwnedImage {
  public:
   OwnedImage() = default;
-  OwnedImage(const Context& context, VkExtent2D extent, VkFormat format, VkImageUsageFlags usage, uint32_t levels = 1);
+  /// With layers > 1 an array image: `state` shows layer 0 through a 2D view; layer_view(l) shows
+  /// layer l (tests of caller array images).
+  OwnedImage(const Context& context, VkExtent2D extent, VkFormat format, VkImageUsageFlags usage, uint32_t levels = 1,
+             uint32_t layers = 1);
   OwnedImage(OwnedImage&& other) noexcept { *this = std::move(other); }
   OwnedImage& operator=(OwnedImage&& other) noexcept;
   OwnedImage(const OwnedImage&) = delete;
@@ -26,6 +29,9 @@ class OwnedImage {
   uint32_t levels() const { return levels_; }
   /// A view of mip `k` alone (levels > 1), or the view of the whole image (levels == 1).
   VkImageView level_view(uint32_t k) const { return level_views_.empty() ? state.view : level_views_.at(k); }
+  uint32_t layers() const { return layers_; }
+  /// A 2D view of layer `l` (all mips).
+  VkImageView layer_view(uint32_t l) const { return l == 0 ? state.view : layer_views_.at(l - 1); }
   /// The image as effects see it; the state fields are shared with this object by reference.
   Image& image() { return state; }
   const Image& image() const { return state; }
@@ -36,7 +42,9 @@ class OwnedImage {
   VkDevice device_ = VK_NULL_HANDLE;
   VkDeviceMemory memory_ = VK_NULL_HANDLE;
   uint32_t levels_ = 0;
+  uint32_t layers_ = 0;
   std::vector<VkImageView> level_views_;
+  std::vector<VkImageView> layer_views_;  // layers 1, 2, ...
 };
 
 /// A buffer with its memory, optionally host-visible and mapped.
@@ -71,13 +79,16 @@ class OwnedBuffer {
 /// Bytes per texel of the formats glint handles.
 uint32_t texel_bytes(VkFormat format);
 
-/// Whether `format` is one of the colour formats the image effects take: RGBA16F or RGBA32F.
+/// Whether `format` is RGBA16F or RGBA32F: the formats of glint's own intermediate images (and of
+/// the flare gather's target, which it reads and writes). Caller images of bloom and blur take
+/// more (core/formats.h).
 inline bool is_float_rgba(VkFormat format) {
   return format == VK_FORMAT_R16G16B16A16_SFLOAT || format == VK_FORMAT_R32G32B32A32_SFLOAT;
 }
 
-/// The kernel-variant suffix of a storage format ("rgba32f" or "rgba16f"; kernels/CMakeLists.txt
-/// compiles each image-writing kernel once per storage format).
+/// The kernel-variant suffix of an intermediate storage format ("rgba32f" or "rgba16f";
+/// kernels/CMakeLists.txt compiles each image-writing kernel once per storage format). Caller
+/// outputs pick theirs with check_color_write() (core/formats.h).
 inline const char* format_variant(VkFormat format) {
   return format == VK_FORMAT_R32G32B32A32_SFLOAT ? "rgba32f" : "rgba16f";
 }

@@ -15,15 +15,18 @@ namespace glint::detail {
 inline constexpr VkImageUsageFlags kToolImageUsage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_STORAGE_BIT |
                                                      VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
 
-/// Copies `pixels` (RGBA float; converted to half for RGBA16F) into `image` and leaves it in
-/// TRANSFER_DST_OPTIMAL, last written by a transfer. Sizes must match.
+/// Copies `pixels` (RGBA float, converted to the image's format: RGBA16F, RGBA32F,
+/// B10G11R11_UFLOAT (core/packed_float.h), RGB16F or RGB32F) into layer Image::base_array_layer of
+/// `image` and leaves it in TRANSFER_DST_OPTIMAL, last written by a transfer. Sizes must match.
 void upload(const Context& context, Image& image, const CpuImage& pixels);
 
-/// Reads `image` back as RGBA float (from any state; the state is updated).
+/// Reads `image` (that layer) back as RGBA float (from any state; the state is updated). Formats
+/// without alpha read as alpha 1.
 CpuImage download(const Context& context, Image& image);
 
-/// Copies one float per texel into a D32_SFLOAT or R32_SFLOAT `image` (depth buffers, Hi-Z
-/// inputs), leaving it in TRANSFER_DST_OPTIMAL, last written by a transfer.
+/// Copies one float per texel into R32_SFLOAT or the depth aspect of a depth `image` (depth
+/// buffers, Hi-Z inputs; UNORM depth gets round(clamp(v, 0, 1) * (2^bits - 1))), leaving it in
+/// TRANSFER_DST_OPTIMAL, last written by a transfer.
 void upload_r32(const Context& context, Image& image, const std::vector<float>& values);
 
 /// Reads mip `level` (of size `extent`) of an R32_SFLOAT or D32_SFLOAT image back, from any state
@@ -36,9 +39,9 @@ std::vector<float> download_r32(const Context& context, Image& image, uint32_t l
 // record_readback() record the barrier and the copy (readback adds the barrier to host reads),
 // read_staged() converts what a completed readback left in its staging buffer.
 
-/// A staging buffer holding `pixels` in `image`'s format (RGBA16F or RGBA32F; sizes must match).
+/// A staging buffer holding `pixels` in `image`'s format (as upload(); sizes must match).
 OwnedBuffer make_upload_staging(const Context& context, const Image& image, const CpuImage& pixels);
-/// A staging buffer holding one float per texel of a D32_SFLOAT or R32_SFLOAT `image`.
+/// A staging buffer holding one value per texel of `image` (as upload_r32()).
 OwnedBuffer make_upload_staging_r32(const Context& context, const Image& image, const std::vector<float>& values);
 /// Records the copy of a whole staging buffer into mip 0 of `image` (depth aspect for D32), leaving
 /// it in TRANSFER_DST_OPTIMAL, last written by a transfer.
@@ -50,7 +53,7 @@ void record_readback(VkCommandBuffer cmd, Image& image, const OwnedBuffer& stagi
 /// Makes every earlier transfer write visible to host reads after the submission completes
 /// (COPY/TRANSFER_WRITE -> HOST/HOST_READ), the barrier every readback ends with.
 void record_host_read_barrier(VkCommandBuffer cmd);
-/// `image`'s texels (RGBA16F or RGBA32F) from a staging buffer a completed readback filled.
+/// `image`'s texels (as download()) from a staging buffer a completed readback filled.
 CpuImage read_staged(const OwnedBuffer& staging, const Image& image);
 
 /// Fills `image` with `value` in every channel (NaN poisons: an unwritten texel stays NaN).

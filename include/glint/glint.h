@@ -236,15 +236,22 @@ struct LevelSize {
 /// `layout`, `stage` and `access` describe the caller's last use of the image, so the effect can
 /// write the right barrier; after record() they describe the effect's last use, which the caller's
 /// next barrier starts from.
+///
+/// Array images: `view` is a 2D view (VK_IMAGE_VIEW_TYPE_2D) of the one layer `base_array_layer`;
+/// effects transition that layer alone and leave every other layer as it was. `layer_count` must be
+/// 1 (effects refuse others by name); the state fields describe that layer.
 struct Image {
   VkImage image = VK_NULL_HANDLE;
-  VkImageView view = VK_NULL_HANDLE;  //!< a 2D view of mip 0, layer 0, colour aspect
+  VkImageView view = VK_NULL_HANDLE;  //!< a 2D view of mip 0 of layer base_array_layer; colour aspect, or
+                                      //!< depth aspect alone for a depth image (HiZPyramid, LightCuller)
   VkFormat format = VK_FORMAT_UNDEFINED;
   VkExtent2D extent{0, 0};
   VkImageUsageFlags usage = 0;  //!< the usage the image was created with
   VkImageLayout layout = VK_IMAGE_LAYOUT_UNDEFINED;
   VkPipelineStageFlags2 stage = VK_PIPELINE_STAGE_2_NONE;
   VkAccessFlags2 access = VK_ACCESS_2_NONE;
+  uint32_t base_array_layer = 0;  //!< the layer `view` shows (0 for a non-array image)
+  uint32_t layer_count = 1;       //!< layers `view` shows: effects accept 1
 };
 
 /// A view of a caller's buffer (or a range of it), with the caller's last use, like Image.

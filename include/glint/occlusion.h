@@ -29,7 +29,11 @@ namespace glint {
 struct HiZConfig {
   VkExtent2D extent{0, 0};                 //!< depth image size in pixels (1 to 16384 on a side, and at most the
                                            //!< device's maxImageDimension2D)
-  VkFormat format = VK_FORMAT_D32_SFLOAT;  //!< VK_FORMAT_D32_SFLOAT or VK_FORMAT_R32_SFLOAT
+  /// The depth image's format: VK_FORMAT_D16_UNORM, X8_D24_UNORM_PACK32, D24_UNORM_S8_UINT, D32_SFLOAT,
+  /// D32_SFLOAT_S8_UINT (read through a depth-aspect view; UNORM depth reads as d / (2^bits - 1)) or
+  /// R32_SFLOAT. The constructor also refuses, by name, a format the device cannot sample (Vulkan
+  /// guarantees only D16_UNORM and D32_SFLOAT; D24S8 is absent on some GPUs).
+  VkFormat format = VK_FORMAT_D32_SFLOAT;
   bool reversed_z = false;                 //!< true: depth 1 is near, the pyramid keeps the minimum (farthest);
                                            //!< false: 0 is near, it keeps the maximum
   /// The largest grid cell (light size_px / grid) that needs one texel per cell, in pixels
@@ -66,7 +70,8 @@ class HiZPyramid {
   ~HiZPyramid();
 
   /// Records the build of every level from `depth` (one dispatch up to 4096 on a side, two above).
-  /// `depth`: config.format and config.extent, SAMPLED usage, `view` a depth-aspect (D32) or
+  /// `depth`: config.format and config.extent, SAMPLED usage, `view` a 2D view with the depth aspect
+  /// alone (a depth format; barriers cover depth and stencil of a combined format) or a
   /// colour (R32) view of mip 0. Afterwards `depth` is in SHADER_READ_ONLY_OPTIMAL, last read by
   /// the compute shader stage, and the pyramid was last written by it. The first record() also
   /// clears the pyramid's internal counter (once per object); later frames need no clearing.
