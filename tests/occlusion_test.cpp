@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <map>
 #include <random>
@@ -353,6 +354,35 @@ TEST_F(OcclusionTest, CullMatchesReferenceOnRandomScenes) {
         }
       }
     }
+  }
+}
+
+// The cull on the other depth formats (depth-aspect views; barriers cover stencil where the format
+// has it). UNORM depth is quantized to round(d * (2^bits - 1)) / (2^bits - 1) for the reference,
+// as the GPU reads it. A format the device cannot sample is skipped by name (HiZPyramid refuses it).
+TEST_F(OcclusionTest, CullReadsEveryDepthFormat) {
+  uint32_t seed = 91;
+  for (VkFormat format : {VK_FORMAT_D16_UNORM, VK_FORMAT_X8_D24_UNORM_PACK32, VK_FORMAT_D24_UNORM_S8_UINT,
+                          VK_FORMAT_D32_SFLOAT_S8_UINT}) {
+    VkFormatProperties props;
+    vkGetPhysicalDeviceFormatProperties(context().physical_device(), format, &props);
+    if (!(props.optimalTilingFeatures & VK_FORMAT_FEATURE_SAMPLED_IMAGE_BIT)) {
+      std::printf("skipped %d: device cannot sample it\n", int(format));
+      continue;
+    }
+    const int bits = format == VK_FORMAT_D16_UNORM ? 16 : format == VK_FORMAT_D32_SFLOAT_S8_UINT ? 0 : 24;
+    auto scene = reference::random_scene(161, 97, 300, seed++, false, 60);
+    if (bits) {
+      const double q = std::ldexp(1.0, bits) - 1.0;
+      for (float& v : scene.depth.depth) v = static_cast<float>(std::nearbyint(double(v) * q) / q);
+    }
+    LightCullConfig config;
+    config.capacity = 300;
+    float vp[16];
+    for (int i = 0; i < 16; ++i) vp[i] = static_cast<float>(scene.view_proj[i]);
+    const auto run = run_cull(scene.depth, format, false, scene.lights, vp, config);
+    expect_cull_matches(run, scene, config, false, 7, "161x97 format " + std::to_string(int(format)));
+    EXPECT_GT(run.stats.occluded, 0u);
   }
 }
 
@@ -760,7 +790,7 @@ TEST_F(OcclusionTest, BadConfigAndArgumentsThrow) {
     LightCullOutputs bad = out;
     bad.indirect = no_indirect;
     expect_error([&] { culler.record(cmd, hiz, img.state, lights.view, 10, frame, bad); }, ErrorCode::missing_usage,
-                 "indirect buffer lacks usage");
+                 "indirect buffer lacks usage VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT");
     bad = out;
     bad.instances = small.view;
     expect_error([&] { culler.record(cmd, hiz, img.state, lights.view, 10, frame, bad); }, ErrorCode::invalid_argument,
