@@ -68,8 +68,11 @@ std::vector<LevelSize> bloom_pre_levels(VkExtent2D input, uint32_t level0_height
 
 /// One bloom effect. Make it once; call record() every frame.
 ///
-/// Inputs: any RGBA16F or RGBA32F image with SAMPLED usage. Output: RGBA16F or RGBA32F with STORAGE
-/// usage, same extent. After record(), the input is in SHADER_READ_ONLY_OPTIMAL (GENERAL if it is
+/// Input: a float colour image with SAMPLED usage whose format the device can sample; output: one
+/// with STORAGE usage whose format it can store (docs/FORMATS.md: RGBA16F, RGBA32F and
+/// B10G11R11_UFLOAT on every device that stores them; RGB16F, RGB32F and E5B9G9R9 where the device
+/// stores them without a format), same extent. Formats are chosen from the device's format
+/// features; any other is refused with an Error naming it. After record(), the input is in SHADER_READ_ONLY_OPTIMAL (GENERAL if it is
 /// also the output) and the output in GENERAL, both last used by the compute shader stage.
 /// Input and output may be the same image (in place).
 ///

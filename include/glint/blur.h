@@ -34,7 +34,8 @@ struct EffectiveSigma {
 /// area-downsampled to half size (floor, at least 1) and blurred by one separable Gaussian, in
 /// one dispatch per level (docs/BLUR.md, "Blur pyramid").
 ///
-/// Input: RGBA16F or RGBA32F with SAMPLED usage; after record() it is in SHADER_READ_ONLY_OPTIMAL,
+/// Input: a float colour format the device samples (docs/FORMATS.md: RGBA16F, RGBA32F,
+/// B10G11R11_UFLOAT, ...) with SAMPLED usage; after record() it is in SHADER_READ_ONLY_OPTIMAL,
 /// last read by the compute stage. The levels are images the pyramid owns, with SAMPLED, STORAGE
 /// and TRANSFER_SRC usage; after record() they are in GENERAL, last written by the compute stage (so the
 /// caller's next barrier starts from level(k).stage/access). A shader samples all three with the
@@ -149,10 +150,12 @@ struct BlurChoice {
 
 /// A same-size Gaussian blur of input into output.
 ///
-/// Input: RGBA16F or RGBA32F with SAMPLED usage, left in SHADER_READ_ONLY_OPTIMAL. Output:
-/// RGBA16F or RGBA32F with STORAGE usage, same extent, a different image, left in GENERAL; both
-/// last used by the compute stage. Per size and output format, everything is made once; record()
-/// at a prepared size with seen image views creates no Vulkan object.
+/// Input: a float colour format the device samples (and filters linearly with linear_sampling),
+/// with SAMPLED usage, left in SHADER_READ_ONLY_OPTIMAL. Output: a float colour format it stores
+/// (docs/FORMATS.md: RGBA16F, RGBA32F, B10G11R11_UFLOAT, ...) with STORAGE usage, same extent, a
+/// different image (or another layer of the same one), left in GENERAL; both last used by the
+/// compute stage. Per size and output format, everything is made once; record() at a prepared
+/// size with seen image views creates no Vulkan object.
 ///
 /// Several sizes: one blur may be recorded at different extents and output formats, in one
 /// command buffer or in consecutive frames; each (size, output format) keeps its own plan, images
