@@ -285,7 +285,7 @@ struct Bloom::Impl {
     return made;
   }
 
-  const CallerSets& sets_for(Pyramid& P, const Image& in, const Image& out, const std::string& out_variant) {
+  const CallerSets& sets_for(Pyramid& P, const Image& in, const Image& out, const char* out_variant) {
     auto key = std::make_pair(in.view, out.view);
     auto it = P.caller_sets.find(key);
     if (it != P.caller_sets.end()) return it->second;
@@ -327,7 +327,7 @@ struct Bloom::Impl {
   }
 
   // Checks both images; returns the kernel variant that writes the output.
-  std::string check_images(const Image& in, const Image& out) const {
+  const char* check_images(const Image& in, const Image& out) const {
     const uint32_t max_dim = context->info().max_image_dimension_2d;
     auto check_one = [&](const Image& img, const char* role, VkImageUsageFlags need, const char* need_name) {
       if (!img.image || !img.view) {
@@ -348,7 +348,7 @@ struct Bloom::Impl {
     check_one(in, "input", VK_IMAGE_USAGE_SAMPLED_BIT, "VK_IMAGE_USAGE_SAMPLED_BIT");
     check_one(out, "output", VK_IMAGE_USAGE_STORAGE_BIT, "VK_IMAGE_USAGE_STORAGE_BIT");
     detail::check_color_read(*context, in.format, "Bloom::record", "input");
-    std::string variant = detail::check_color_write(*context, out.format, "Bloom::record", "output");
+    const char* variant = detail::check_color_write(*context, out.format, "Bloom::record", "output");
     if (in.extent.width != out.extent.width || in.extent.height != out.extent.height) {
       throw Error(ErrorCode::invalid_argument,
                   concat("Bloom::record: output extent ", out.extent.width, "x", out.extent.height,
@@ -366,7 +366,7 @@ struct Bloom::Impl {
 };
 
 void Bloom::Impl::record(VkCommandBuffer cmd, Image& input, Image& output, Profiler* profiler) {
-  const std::string out_variant = check_images(input, output);
+  const char* out_variant = check_images(input, output);
   const bool in_place = same_subresource(input, output);
   if (config.intensity == 0.0f) {
     // Nothing to add: the output is the input. In place that is no work at all.

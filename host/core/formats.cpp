@@ -50,7 +50,7 @@ const char* qualified_variant(VkFormat format) {
   }
 }
 
-void check_color_read(const Context& context, VkFormat format, const std::string& where, const char* role,
+void check_color_read(const Context& context, VkFormat format, const char* where, const char* role,
                       bool linear) {
   if (!is_float_color(format)) {
     throw Error(ErrorCode::unsupported_format, concat(where, ": ", role, " format is ", format_name(format),
@@ -70,7 +70,7 @@ void check_color_read(const Context& context, VkFormat format, const std::string
   }
 }
 
-const char* check_color_write(const Context& context, VkFormat format, const std::string& where, const char* role) {
+const char* check_color_write(const Context& context, VkFormat format, const char* where, const char* role) {
   if (!is_float_color(format)) {
     throw Error(ErrorCode::unsupported_format, concat(where, ": ", role, " format is ", format_name(format),
                                                       "; accepted ", float_color_formats()));
@@ -133,7 +133,7 @@ VkImageAspectFlags image_aspects(VkFormat format) {
   return VK_IMAGE_ASPECT_COLOR_BIT;
 }
 
-void check_layers(const Image& image, const std::string& where, const char* role) {
+void check_layers(const Image& image, const char* where, const char* role) {
   if (image.layer_count != 1) {
     throw Error(ErrorCode::invalid_argument,
                 concat(where, ": ", role, " Image::layer_count = ", image.layer_count,

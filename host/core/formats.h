@@ -30,14 +30,14 @@ const char* qualified_variant(VkFormat format);
 /// Throws Error(unsupported_format) "<where>: <role> format is F; ..." unless `format` is a float
 /// colour format the device can sample (SAMPLED_IMAGE, and SAMPLED_IMAGE_FILTER_LINEAR when
 /// `linear` is set: the kernel reads it through a bilinear sampler).
-void check_color_read(const Context& context, VkFormat format, const std::string& where, const char* role,
+void check_color_read(const Context& context, VkFormat format, const char* where, const char* role,
                       bool linear = false);
 
 /// The variant of the image-writing kernels that stores `format`: its qualifier's variant when the
 /// format has STORAGE_IMAGE, else "noformat" when it has STORAGE_WRITE_WITHOUT_FORMAT (the
 /// per-format form of shaderStorageImageWriteWithoutFormat in Vulkan 1.3). Throws
 /// Error(unsupported_format) naming the format and what it lacks otherwise.
-const char* check_color_write(const Context& context, VkFormat format, const std::string& where, const char* role);
+const char* check_color_write(const Context& context, VkFormat format, const char* where, const char* role);
 
 /// The largest finite value a texel of `format` holds (65504 for 16-bit floats, 65024 for
 /// B10G11R11, 65408 for E5B9G9R9, FLT_MAX for 32-bit floats): what effects clamp outputs to.
@@ -56,6 +56,6 @@ VkImageAspectFlags image_aspects(VkFormat format);
 
 /// Throws Error(invalid_argument) "<where>: <role> Image::layer_count = N ..." unless the image
 /// names one layer (layer_count 1); effects read and write 2D views of one layer.
-void check_layers(const Image& image, const std::string& where, const char* role);
+void check_layers(const Image& image, const char* where, const char* role);
 
 }  // namespace glint::detail
