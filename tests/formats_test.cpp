@@ -2,6 +2,7 @@
 // float colour formats the device supports, Hi-Z on every depth format, one layer of an array
 // image, and refusals that name the format, the layer count or the feature they refused.
 // Validation with synchronization validation is on (support/gpu_test.h).
+#include <cstdio>
 #include <glint/bloom.h>
 #include <glint/blur.h>
 #include <glint/occlusion.h>
@@ -198,6 +199,10 @@ TEST_F(FormatsTest, OtherFloatFormatsFollowTheDeviceFeatures) {
     // As output.
     const bool writable = (features & VK_FORMAT_FEATURE_2_STORAGE_IMAGE_BIT) &&
                           (features & VK_FORMAT_FEATURE_2_STORAGE_WRITE_WITHOUT_FORMAT_BIT);
+    std::printf("%s on %s: input %s, output %s\n", name.c_str(), context().info().name.c_str(),
+                (features & VK_FORMAT_FEATURE_2_SAMPLED_IMAGE_BIT) ? (transferable ? "compared" : "untested")
+                                                                   : "refused by name",
+                writable ? (transferable ? "compared (noformat kernel)" : "untested") : "refused by name");
     if (writable && transferable) {
       const CpuImage gpu = run_bloom(config, input, kF32, f);
       EXPECT_LT(reference::relative_l2(gpu, reference::bloom(input, config)), 1e-3) << name;
