@@ -24,6 +24,10 @@
 #include "support/flare_scene.h"
 #include "support/gpu_test.h"
 
+// The replacements below pair operator new with malloc and operator delete with free, which is
+// correct; GCC's -Wmismatched-new-delete sees a free() of what `new` returned once they inline.
+#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
+
 namespace {
 thread_local bool g_counting = false;
 thread_local uint64_t g_allocations = 0;
