@@ -23,6 +23,7 @@
 
 #include "core/cpu_image.h"
 #include "io/exr_io.h"
+#include "tooling/host_memory.h"
 #include "io/png_io.h"
 
 namespace glint {
@@ -373,3 +374,25 @@ TEST_F(IoTest, PngHoldsTheTonemappedSrgbPixels) {
 
 }  // namespace
 }  // namespace glint
+
+namespace glint::test {
+namespace {
+
+// The tools refuse work the host cannot hold up front (the demo at 16384x16384 was killed by the
+// kernel after minutes), naming the bytes; work that fits passes.
+TEST(HostMemory, WorkBeyondTheAvailableMemoryIsRefusedByName) {
+  const uint64_t available = tools::available_host_memory();
+  ASSERT_GT(available, 0u) << "this system reports no available memory";
+  EXPECT_NO_THROW(tools::check_host_memory("a small job", 1 << 20));
+  try {
+    tools::check_host_memory("a huge job", available + (uint64_t(1) << 30));
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::unsupported_size);
+    EXPECT_NE(std::string(e.what()).find("a huge job needs about"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("MiB are available"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace glint::test

@@ -24,6 +24,7 @@
 #include "io/exr_io.h"
 #include "io/lights_json.h"
 #include "io/png_io.h"
+#include "tooling/host_memory.h"
 
 namespace glint::cli {
 namespace {
@@ -58,6 +59,10 @@ void write_text(const std::string& path, const std::string& text) {
 void run_demo(const DemoOptions& o) {
   const auto wall_start = std::chrono::steady_clock::now();
   const VkExtent2D extent = parse_size("--size", o.size);
+  // What the demo holds on the host at once, per pixel: the depth (4 bytes) and its EXR, three
+  // read-back RGBA16F images staged (8 bytes each) and converted to float (16 bytes each), the
+  // fill of the largest upload (16), the PNG (4) and the EXR writer's copy of one image (8).
+  tools::check_host_memory("glint demo at " + o.size, uint64_t(extent.width) * extent.height * (4 + 4 + 3 * (8 + 16) + 16 + 4 + 8));
   check_exposure(o.exposure);
   const FlareConfig look = demo_preset(o.preset);
   demo::StarfieldParams scene_params;
