@@ -114,6 +114,18 @@ void BM_ObjectCull(benchmark::State& state) {
     all.push_back(ms);
     state.SetIterationTime(ms * 1e-3);
   }
+  // Per-stage times of one more frame (the medians above are of whole frames).
+  Profiler stages(ctx, 8);
+  ctx.run_once([&](VkCommandBuffer cmd) {
+    stages.reset(cmd);
+    stages.mark(cmd, "start");
+    culler.record(cmd, hiz, depth.state, frame, buffers, outputs, &stages);
+  });
+  for (const auto& st : stages.results()) {
+    std::string key = st.label + "_us";
+    std::replace(key.begin(), key.end(), ' ', '_');
+    state.counters[key] = st.ms * 1e3;
+  }
   ctx.run_once([&](VkCommandBuffer cmd) {
     detail::Barriers b;
     b.use(outputs.stats, VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);

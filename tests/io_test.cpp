@@ -23,8 +23,8 @@
 
 #include "core/cpu_image.h"
 #include "io/exr_io.h"
-#include "tooling/host_memory.h"
 #include "io/png_io.h"
+#include "tooling/host_memory.h"
 
 namespace glint {
 namespace {
