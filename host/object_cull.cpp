@@ -185,12 +185,13 @@ struct ObjectCuller::Impl {
   uint32_t max_groups_x = 65535;
   uint32_t scan_threads = 1;
   uint64_t max_range = 1u << 27;  // the device's maxStorageBufferRange
-  detail::ComputePipeline cull, phase1, scan, scatter;
+  detail::ComputePipeline cull, phase1, scan_tiles, scan, scatter;
   detail::OwnedBuffer groups, dummy;
   Buffer groups_state, dummy_state;
   bool counters_cleared = false;
   struct Sets {
-    VkDescriptorSet cull = VK_NULL_HANDLE, scan = VK_NULL_HANDLE, scatter = VK_NULL_HANDLE;
+    VkDescriptorSet cull = VK_NULL_HANDLE, scan_tiles = VK_NULL_HANDLE, scan = VK_NULL_HANDLE,
+                    scatter = VK_NULL_HANDLE;
   };
   std::map<std::vector<uint64_t>, Sets> sets;
   detail::DescriptorArena arena;
@@ -315,6 +316,10 @@ ObjectCuller::ObjectCuller(const Context& context, const ObjectCullConfig& confi
   sc.push_constant_bytes = sizeof(GlintObjectCompactPush);
   sc.workgroup = {m.scan_threads, 1};
   m.scan = detail::ComputePipeline(context, sc);
+  detail::PipelineDesc st = sc;
+  st.kernel_id = "object_cull_scan_tiles_main";
+  st.bindings = {B};
+  m.scan_tiles = detail::ComputePipeline(context, st);
   sc.kernel_id = "object_cull_scatter_main";
   sc.workgroup = {kGroup, 1};
   m.scatter = detail::ComputePipeline(context, sc);
@@ -373,6 +378,7 @@ void ObjectCuller::Impl::run(VkCommandBuffer cmd, HiZPyramid* hiz, Image* depth,
     n[1].buffer = out.indirect;
     n[2].buffer = out.stats;
     s.scan = arena.make_mixed_set(scan, n);
+    s.scan_tiles = arena.make_mixed_set(scan_tiles, {n[0]});
     std::vector<detail::DescriptorArena::AnyBinding> p(3);
     p[0].buffer = groups_state;
     p[1].buffer = payloads;
@@ -420,6 +426,15 @@ void ObjectCuller::Impl::run(VkCommandBuffer cmd, HiZPyramid* hiz, Image* depth,
   cp.payload_words = config.payload_words;
   cp.objects_per_group = config.objects_per_group;
   cp.groups_x = gx;
+  cp.tile_groups = scan_threads;
+  // 2a. Tiles of scan_threads groups in parallel: slots within each tile, tile totals.
+  const uint32_t group_count = (count + kGroup - 1) / kGroup;
+  if (group_count > 0) {
+    b.use(groups_state, kCompute, kRead | kWrite);
+    b.flush(cmd);
+    scan_tiles.dispatch(cmd, s.scan_tiles, cp, (group_count + scan_threads - 1) / scan_threads * scan_threads, 1);
+  }
+  // 2b. One workgroup: the tiles' first slots, arguments, statistics.
   b.use(groups_state, kCompute, kRead | kWrite);
   b.use(out.indirect, kCompute, kWrite);
   b.use(out.stats, kCompute, kWrite);

@@ -482,6 +482,50 @@ TEST_F(ObjectCullTest, PayloadsAndOverflow) {
   }
 }
 
+// The two-level scan over many tiles (a tile is up to 1024 groups of 64 objects, 64 groups on CPU
+// devices): the list holds exactly the objects the cull left VISIBLE, in increasing index, with
+// the count and statistics to match, for counts that end inside a group, on a tile boundary and
+// one past it. The objects repeat a random scene's, so every tile has visible and hidden ones.
+TEST_F(ObjectCullTest, ManyTilesCompactInObjectOrder) {
+  SceneSpec s;
+  s.objects = 4096;
+  std::mt19937 rng(21);
+  const TestCamera cam = make_camera(rng, s);
+  const auto depth = make_depth_image(rng, cam, s);
+  const auto base = make_objects(rng, cam, s);
+  const uint32_t most = 3 * 65536 + 64 + 1;  // more than two tiles of 1024 groups
+  std::vector<GlintCullObject> objs(most);
+  for (uint32_t i = 0; i < most; ++i) objs[i] = base[(i * 2654435761u) % base.size()];
+  GpuScene g(depth, false, objs);
+  for (uint32_t count : {most, 131072u, 131073u, 4109u}) {
+    ObjectCullConfig cc;
+    cc.max_objects = most;
+    cc.capacity = most;
+    ObjectCuller culler(context(), cc);
+    Outputs out(most, 0);
+    const ObjectCullFrame frame = frame_of(cam.cam, count);
+    g.visibility.poison();
+    context().run_once([&](VkCommandBuffer cmd) {
+      g.hiz.record(cmd, g.depth_image.state);
+      culler.record(cmd, g.hiz, g.depth_image.state, frame, g.buffers, out.out);
+      out.host(cmd);
+      to_host(cmd, g.buffers.visibility);
+    });
+    const auto states = g.states(count);
+    std::vector<uint32_t> expected;
+    for (uint32_t i = 0; i < count; ++i) {
+      if (states[i] == GLINT_OBJECT_STATE_VISIBLE) expected.push_back(i);
+    }
+    ASSERT_GT(expected.size(), count / 100) << count;
+    ASSERT_LT(expected.size(), count) << count;
+    EXPECT_EQ(out.args().draw_count, expected.size()) << count;
+    EXPECT_EQ(out.st().emitted, expected.size()) << count;
+    EXPECT_EQ(out.st().total, count);
+    const auto list = out.words(expected.size());
+    EXPECT_TRUE(list == expected) << count << ": the list is not the visible objects in order";
+  }
+}
+
 // Bad input throws glint::Error naming the problem, before anything is recorded.
 TEST_F(ObjectCullTest, ErrorsBeforeRecording) {
   SceneSpec s;

@@ -11,7 +11,8 @@
 #define GLINT_OBJECT_GROUP 64u
 // The internal group buffer: GLINT_OBJECT_HEADER_WORDS counter words (zero between dispatches: the
 // scan resets them), then one uvec4 per workgroup: emitted mask of objects 0..31 (x), 32..63 (y),
-// first slot (z, written by the scan), 0.
+// slot within the tile (z) and, on a tile's first group, the tile's total and then its first slot (w),
+// written by the two scans.
 #define GLINT_OBJECT_COUNTER_FRUSTUM 1u
 #define GLINT_OBJECT_COUNTER_OCCLUDED 2u
 #define GLINT_OBJECT_COUNTER_VISIBLE 3u
@@ -67,7 +68,8 @@ struct GlintObjectCompactPush {
   GLINT_UINT payload_words;      // 0: the list holds object indices (one uint); else words copied per object
   GLINT_UINT objects_per_group;  // scan: dispatch group_count_x = ceil(written / this)
   GLINT_UINT groups_x;           // scatter: workgroups per row of its 2D dispatch
-  GLINT_UINT reserved[3];
+  GLINT_UINT tile_groups;        // scans and scatter: 64-object groups per tile of the two-level scan
+  GLINT_UINT reserved[2];
 };
 
 #endif
