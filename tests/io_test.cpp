@@ -10,10 +10,14 @@
 #include <ImfOutputFile.h>
 #include <ImfRgbaFile.h>
 #include <png.h>
+#include <signal.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -22,6 +26,7 @@
 #include <vector>
 
 #include "core/cpu_image.h"
+#include "io/atomic_outputs.h"
 #include "io/exr_io.h"
 #include "io/png_io.h"
 #include "tooling/host_memory.h"
@@ -157,6 +162,22 @@ TEST_F(IoTest, SingleChannelFileGoesToGrey) {
         EXPECT_EQ(img.at(x, y)[2], v) << name;
         EXPECT_EQ(img.at(x, y)[3], 1.0f) << name;
       }
+    }
+  }
+}
+
+// A file whose only channel is A: R = G = B = A = the channel (the single-channel rule). Before, the
+// alpha slice replaced the grey one in OpenEXR's FrameBuffer (one slice per name): the image was black.
+TEST_F(IoTest, SingleAlphaChannelGoesToGreyAndAlpha) {
+  const std::string path = file("alpha.exr");
+  write_float_channels(path, 5, 3, {"A"}, [](size_t, int x, int y) { return 0.25f + float(x) + 10.0f * y; });
+  const CpuImage img = io::read_exr(path);
+  ASSERT_EQ(img.width, 5u);
+  ASSERT_EQ(img.height, 3u);
+  for (uint32_t y = 0; y < 3; ++y) {
+    for (uint32_t x = 0; x < 5; ++x) {
+      const float v = 0.25f + float(x) + 10.0f * y;
+      for (int c = 0; c < 4; ++c) EXPECT_EQ(img.at(x, y)[c], v) << "channel " << c << " at " << x << "," << y;
     }
   }
 }
@@ -370,6 +391,163 @@ TEST_F(IoTest, PngHoldsTheTonemappedSrgbPixels) {
   EXPECT_EQ(rgb[0], 0);      // NaN
   EXPECT_EQ(rgb[3 + 1], 255);  // +Inf
   EXPECT_EQ(rgb[6 + 2], 0);  // negative
+}
+
+// ---- AtomicOutputs ----
+
+// Every file in `dir` whose name ends with the temporaries' suffix.
+std::vector<std::string> temporaries_in(const fs::path& dir) {
+  std::vector<std::string> found;
+  for (const auto& e : fs::directory_iterator(dir)) {
+    const std::string name = e.path().filename().string();
+    if (name.size() >= std::strlen(io::kTemporarySuffix) &&
+        name.compare(name.size() - std::strlen(io::kTemporarySuffix), std::string::npos, io::kTemporarySuffix) == 0) {
+      found.push_back(name);
+    }
+  }
+  return found;
+}
+
+std::string read_text(const std::string& path) {
+  const std::vector<char> b = read_bytes(path);
+  return std::string(b.begin(), b.end());
+}
+
+TEST_F(IoTest, AtomicOutputsReplaceAllFilesOnCommit) {
+  io::write_text_file(file("a.txt"), "old a");
+  io::write_text_file(file("b.txt"), "old b");
+  const CpuImage img = random_image(9, 7, 3);
+  {
+    io::AtomicOutputs out;
+    out.write(file("a.txt"), [](const std::string& tmp) { io::write_text_file(tmp, "new a"); });
+    out.write(file("b.txt"), [](const std::string& tmp) { io::write_text_file(tmp, "new b"); });
+    out.write(file("c.exr"), [&](const std::string& tmp) { io::write_exr_half(tmp, img); });
+    // Nothing is replaced before commit(): the temporaries sit next to the targets.
+    EXPECT_EQ(read_text(file("a.txt")), "old a");
+    EXPECT_EQ(read_text(file("b.txt")), "old b");
+    EXPECT_FALSE(fs::exists(file("c.exr")));
+    EXPECT_EQ(temporaries_in(dir_).size(), 3u);
+    out.commit();
+  }
+  EXPECT_EQ(read_text(file("a.txt")), "new a");
+  EXPECT_EQ(read_text(file("b.txt")), "new b");
+  EXPECT_EQ(io::read_exr(file("c.exr")).width, 9u);
+  EXPECT_TRUE(temporaries_in(dir_).empty());
+}
+
+// A writer that fails (as a full disk or a file-size limit does) after another file was written:
+// no file is replaced, no temporary is left, and the error names the target, not the temporary.
+TEST_F(IoTest, AtomicOutputsLeaveEverythingOnAFailingWrite) {
+  io::write_text_file(file("a.txt"), "old a");
+  io::write_text_file(file("b.txt"), "old b");
+  expect_io_failure(file("b.txt"), [&] {
+    io::AtomicOutputs out;
+    out.write(file("a.txt"), [](const std::string& tmp) { io::write_text_file(tmp, "new a"); });
+    out.write(file("b.txt"), [](const std::string& tmp) {
+      io::write_text_file(tmp, "half of b");  // partly written, then the device is full
+      throw Error(ErrorCode::io_failure, tmp + ": No space left on device");
+    });
+    out.commit();
+  }, "No space left on device");
+  EXPECT_EQ(read_text(file("a.txt")), "old a");
+  EXPECT_EQ(read_text(file("b.txt")), "old b");
+  EXPECT_TRUE(temporaries_in(dir_).empty());
+  // An exception of another type is reported as io_failure naming the target too.
+  expect_io_failure(file("a.txt"), [&] {
+    io::AtomicOutputs out;
+    out.write(file("a.txt"), [](const std::string&) { throw std::runtime_error("disk on fire"); });
+  }, "disk on fire");
+  EXPECT_EQ(read_text(file("a.txt")), "old a");
+  EXPECT_TRUE(temporaries_in(dir_).empty());
+  // A missing directory fails before any writer runs.
+  bool ran = false;
+  expect_io_failure(file("no/such/x.txt"), [&] {
+    io::AtomicOutputs out;
+    out.write(file("no/such/x.txt"), [&](const std::string&) { ran = true; });
+  }, "does not exist");
+  EXPECT_FALSE(ran);
+}
+
+// A real file-size limit (RLIMIT_FSIZE, what `ulimit -f` sets): the EXR writer fails with EFBIG
+// (SIGXFSZ is ignored by AtomicOutputs, else it would kill the process), the previous file stays.
+// Run in a child process so that the limit does not touch the rest of the suite.
+TEST_F(IoTest, AtomicOutputsUnderAFileSizeLimitKeepThePreviousFile) {
+  const CpuImage big = random_image(256, 256, 5);  // ~500 kB of half RGBA, noise does not compress
+  const CpuImage small = random_image(4, 4, 6);
+  io::write_exr_half(file("out.exr"), small);
+  const std::vector<char> before = read_bytes(file("out.exr"));
+  const std::string target = file("out.exr");
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    const rlimit limit{64 << 10, 64 << 10};
+    ::setrlimit(RLIMIT_FSIZE, &limit);
+    int code = 3;
+    try {
+      io::AtomicOutputs out;
+      out.write(target, [&](const std::string& tmp) { io::write_exr_half(tmp, big); });
+      out.commit();
+      code = 0;
+    } catch (const Error& e) {
+      code = (e.code() == ErrorCode::io_failure && std::string(e.what()).rfind(target, 0) == 0) ? 2 : 4;
+    }
+    ::_exit(code);
+  }
+  int status = 0;
+  ASSERT_EQ(::waitpid(child, &status, 0), child);
+  ASSERT_TRUE(WIFEXITED(status)) << "the child died of signal " << (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
+  EXPECT_EQ(WEXITSTATUS(status), 2) << "0: the write did not fail; 4: wrong error";
+  EXPECT_EQ(read_bytes(file("out.exr")), before);
+  EXPECT_TRUE(temporaries_in(dir_).empty());
+}
+
+// SIGTERM (and SIGINT) while a file is being written: the handler removes the temporaries and the
+// process dies of the signal; the previous files are intact.
+TEST_F(IoTest, AtomicOutputsRemoveTemporariesOnSigterm) {
+  for (const int sig : {SIGTERM, SIGINT}) {
+    io::write_text_file(file("a.txt"), "old a");
+    io::write_text_file(file("b.txt"), "old b");
+    int ready[2];
+    ASSERT_EQ(::pipe(ready), 0);
+    const pid_t child = ::fork();
+    ASSERT_GE(child, 0);
+    if (child == 0) {
+      ::close(ready[0]);
+      io::AtomicOutputs out;
+      out.write(file("a.txt"), [](const std::string& tmp) { io::write_text_file(tmp, "new a"); });
+      out.write(file("b.txt"), [&](const std::string& tmp) {
+        io::write_text_file(tmp, "half of b");
+        const char byte = 1;
+        (void)!::write(ready[1], &byte, 1);  // "killing me now finds two temporaries"
+        for (;;) ::pause();
+      });
+      ::_exit(0);
+    }
+    ::close(ready[1]);
+    char byte = 0;
+    ASSERT_EQ(::read(ready[0], &byte, 1), 1);
+    ::close(ready[0]);
+    EXPECT_EQ(temporaries_in(dir_).size(), 2u);
+    ASSERT_EQ(::kill(child, sig), 0);
+    int status = 0;
+    ASSERT_EQ(::waitpid(child, &status, 0), child);
+    ASSERT_TRUE(WIFSIGNALED(status));
+    EXPECT_EQ(WTERMSIG(status), sig);
+    EXPECT_EQ(read_text(file("a.txt")), "old a");
+    EXPECT_EQ(read_text(file("b.txt")), "old b");
+    EXPECT_TRUE(temporaries_in(dir_).empty()) << "signal " << sig;
+  }
+}
+
+TEST_F(IoTest, AtomicOutputsKeepThePermissionsOfTheReplacedFile) {
+  io::write_text_file(file("p.txt"), "old");
+  fs::permissions(file("p.txt"), fs::perms::owner_read | fs::perms::owner_write | fs::perms::group_read);
+  io::AtomicOutputs out;
+  out.write(file("p.txt"), [](const std::string& tmp) { io::write_text_file(tmp, "new"); });
+  out.commit();
+  EXPECT_EQ(fs::status(file("p.txt")).permissions() & fs::perms::all,
+            fs::perms::owner_read | fs::perms::owner_write | fs::perms::group_read);
+  EXPECT_EQ(read_text(file("p.txt")), "new");
 }
 
 }  // namespace

@@ -199,6 +199,10 @@ TEST(LightsJson, MalformedText) {
   expect_error(doc("") + doc(""), {"invalid JSON"});
   expect_error("{'view_proj': []}", {"invalid JSON"});
   expect_error(std::string("{\"view_proj\"\0: []}", 17), {"invalid JSON"});
+  // A whole valid document followed by NUL and garbage: nlohmann's lexer stops at the NUL, so this
+  // parsed as the document alone before NUL bytes were rejected.
+  expect_error(doc("") + std::string("\0garbage", 8), {"invalid JSON", "NUL byte at offset"});
+  expect_error(doc("") + std::string(1, '\0'), {"invalid JSON", "NUL"});
 }
 
 // Every prefix of a valid file is an error (never a crash or an accepted half file).

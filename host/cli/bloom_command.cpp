@@ -9,6 +9,7 @@
 #include "cli/commands.h"
 #include "core/resources.h"
 #include "core/transfer.h"
+#include "io/atomic_outputs.h"
 #include "io/exr_io.h"
 #include "io/png_io.h"
 
@@ -69,12 +70,13 @@ void run_bloom(BloomOptions& o) {
   }
   print_stages(profiler);
 
-  io::write_exr_half(o.output, output);
-  std::printf("wrote %s\n", o.output.c_str());
+  io::AtomicOutputs files;  // OUT and --png are replaced together, only once both are written
+  files.write(o.output, [&](const std::string& tmp) { io::write_exr_half(tmp, output); });
   if (!o.png.empty()) {
-    io::write_png_tonemapped(o.png, output, o.exposure);
-    std::printf("wrote %s\n", o.png.c_str());
+    files.write(o.png, [&](const std::string& tmp) { io::write_png_tonemapped(tmp, output, o.exposure); });
   }
+  files.commit();
+  for (const std::string& f : files.targets()) std::printf("wrote %s\n", f.c_str());
 }
 
 }  // namespace

@@ -11,6 +11,7 @@
 #include "cli/commands.h"
 #include "core/resources.h"
 #include "core/transfer.h"
+#include "io/atomic_outputs.h"
 #include "io/exr_io.h"
 
 namespace glint::cli {
@@ -54,12 +55,19 @@ void run_blur(const BlurOptions& o) {
                [&](VkCommandBuffer cmd, Image& source, Profiler* p) { pyramid.record(cmd, source, p); });
   print_device(context, o.input, input);
   print_stages(profiler);
+  io::AtomicOutputs files;  // the three levels are replaced together, only once all are written
+  VkExtent2D sizes[3];
+  EffectiveSigma sigmas[3];
   for (uint32_t k = 1; k <= 3; ++k) {
     const CpuImage level = detail::download(context, pyramid.level(k));
-    const EffectiveSigma s = pyramid.effective_sigma_px(k);
-    io::write_exr_half(names[k - 1], level);
-    std::printf("wrote %s (%ux%u, sigma %.3g texels, effective sigma %.3f x %.3f input pixels)\n", names[k - 1].c_str(),
-                level.width, level.height, config.sigma_texels[k - 1], s.x_px, s.y_px);
+    sizes[k - 1] = {level.width, level.height};
+    sigmas[k - 1] = pyramid.effective_sigma_px(k);
+    files.write(names[k - 1], [&](const std::string& tmp) { io::write_exr_half(tmp, level); });
+  }
+  files.commit();
+  for (uint32_t k = 0; k < 3; ++k) {
+    std::printf("wrote %s (%ux%u, sigma %.3g texels, effective sigma %.3f x %.3f input pixels)\n", names[k].c_str(),
+                sizes[k].width, sizes[k].height, config.sigma_texels[k], sigmas[k].x_px, sigmas[k].y_px);
   }
 }
 
@@ -109,7 +117,9 @@ void run_gauss(GaussOptions& o) {
   std::printf("sigma: %.3f px asked, %.3f px effective; expected relative L2 error %.2e (bound %.2e)\n",
               o.config.sigma_px, c.effective_sigma_px, c.expected_relative_error, o.config.max_relative_error);
   print_stages(profiler);
-  io::write_exr_half(o.output, output);
+  io::AtomicOutputs files;
+  files.write(o.output, [&](const std::string& tmp) { io::write_exr_half(tmp, output); });
+  files.commit();
   std::printf("wrote %s\n", o.output.c_str());
 }
 

@@ -3,6 +3,7 @@
 // Adding an effect adds one <effect>_command.cpp and one line in main.cpp.
 #pragma once
 
+#include <glint/flare.h>
 #include <glint/glint.h>
 
 #include <CLI/CLI.hpp>
@@ -50,6 +51,15 @@ void check_exposure(float exposure);
 /// Throws Error(io_failure) when `path` cannot be an output file: its directory is missing or it
 /// is a directory. Checked before GPU work so that a typo does not cost a run.
 void check_output_path(const std::string& path);
+
+/// The lens-flare looks by name, any case: retro_subtle, retro_intense, cinematic, disabled, or
+/// default (FlareConfig{}: ratio 2, intensity 1). The one parser of --preset for `demo` and `flare`.
+/// Throws Error(invalid_argument) naming --preset and the accepted names.
+FlareConfig flare_preset_from_name(const std::string& name);
+
+/// --help text of --preset.
+inline constexpr const char* kFlarePresetHelp =
+    "Lens-flare look: retro_subtle, retro_intense, cinematic, disabled, or default (ratio 2, intensity 1); any case";
 
 /// Adds --device to a subcommand (an index or a name substring, as ContextOptions::device).
 void add_device_option(CLI::App& sub, std::string& device);

@@ -1,3 +1,5 @@
+#include <algorithm>
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -53,6 +55,19 @@ void check_output_path(const std::string& path) {
   std::error_code ec;
   if (!fs::is_directory(dir, ec)) throw Error(ErrorCode::io_failure, path + ": directory " + dir.string() + " does not exist");
   if (fs::is_directory(p, ec)) throw Error(ErrorCode::io_failure, path + ": is a directory");
+}
+
+FlareConfig flare_preset_from_name(const std::string& name) {
+  std::string n = name;
+  std::transform(n.begin(), n.end(), n.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  if (n == "retro_subtle") return FlareConfig::preset(FlarePreset::retro_subtle);
+  if (n == "retro_intense") return FlareConfig::preset(FlarePreset::retro_intense);
+  if (n == "cinematic") return FlareConfig::preset(FlarePreset::cinematic);
+  if (n == "disabled") return FlareConfig::preset(FlarePreset::disabled);
+  if (n == "default") return FlareConfig{};
+  throw Error(ErrorCode::invalid_argument, "--preset: '" + name +
+                                               "' is not a preset; accepted retro_subtle, retro_intense, cinematic, "
+                                               "disabled or default (any case)");
 }
 
 void add_device_option(CLI::App& sub, std::string& device) {

@@ -12,7 +12,6 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <memory>
 
 #include "cli/commands.h"
@@ -21,6 +20,7 @@
 #include "core/resources.h"
 #include "core/transfer.h"
 #include "demo_scene.h"
+#include "io/atomic_outputs.h"
 #include "io/exr_io.h"
 #include "io/lights_json.h"
 #include "io/png_io.h"
@@ -38,24 +38,6 @@ struct DemoOptions {
   uint32_t seed = 1;
 };
 
-FlareConfig demo_preset(const std::string& name) {
-  std::string n = name;
-  std::transform(n.begin(), n.end(), n.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  if (n == "retro_subtle") return FlareConfig::preset(FlarePreset::retro_subtle);
-  if (n == "retro_intense") return FlareConfig::preset(FlarePreset::retro_intense);
-  if (n == "cinematic") return FlareConfig::preset(FlarePreset::cinematic);
-  if (n == "disabled") return FlareConfig::preset(FlarePreset::disabled);
-  throw Error(ErrorCode::invalid_argument,
-              "--preset: '" + name + "' is not a preset; accepted retro_subtle, retro_intense, cinematic or disabled");
-}
-
-void write_text(const std::string& path, const std::string& text) {
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  out << text;
-  out.close();
-  if (!out) throw Error(ErrorCode::io_failure, path + ": cannot write");
-}
-
 void run_demo(const DemoOptions& o) {
   const auto wall_start = std::chrono::steady_clock::now();
   const VkExtent2D extent = parse_size("--size", o.size);
@@ -64,7 +46,7 @@ void run_demo(const DemoOptions& o) {
   // fill of the largest upload (16), the PNG (4) and the EXR writer's copy of one image (8).
   tools::check_host_memory("glint demo at " + o.size, uint64_t(extent.width) * extent.height * (4 + 4 + 3 * (8 + 16) + 16 + 4 + 8));
   check_exposure(o.exposure);
-  const FlareConfig look = demo_preset(o.preset);
+  const FlareConfig look = flare_preset_from_name(o.preset);
   demo::StarfieldParams scene_params;
   scene_params.seed = o.seed;
 
@@ -196,15 +178,22 @@ void run_demo(const DemoOptions& o) {
               bloom.clamped() ? " (clamped at this size)" : "");
   print_stages(profiler);
 
-  io::write_exr_half(out_path("scene.exr"), scene_pixels);
-  io::write_exr_channel(out_path("depth.exr"), "Z", extent.width, extent.height, flare_scene.depth);
+  // The six files are replaced together, only once all are written.
+  io::AtomicOutputs files;
+  files.write(out_path("scene.exr"), [&](const std::string& tmp) { io::write_exr_half(tmp, scene_pixels); });
+  files.write(out_path("depth.exr"), [&](const std::string& tmp) {
+    io::write_exr_channel(tmp, "Z", extent.width, extent.height, flare_scene.depth);
+  });
   io::LightsFile lights_file;
   lights_file.view_proj = flare_scene.view_proj;
   lights_file.lights = flare_scene.lights;
-  write_text(out_path("lights.json"), io::to_lights_json(lights_file));
-  io::write_exr_half(out_path("flares.exr"), flared_pixels);
-  io::write_exr_half(out_path("bloom.exr"), result_pixels);
-  io::write_png_tonemapped(out_path("bloom.png"), result_pixels, o.exposure);
+  files.write(out_path("lights.json"),
+              [&](const std::string& tmp) { io::write_text_file(tmp, io::to_lights_json(lights_file)); });
+  files.write(out_path("flares.exr"), [&](const std::string& tmp) { io::write_exr_half(tmp, flared_pixels); });
+  files.write(out_path("bloom.exr"), [&](const std::string& tmp) { io::write_exr_half(tmp, result_pixels); });
+  files.write(out_path("bloom.png"),
+              [&](const std::string& tmp) { io::write_png_tonemapped(tmp, result_pixels, o.exposure); });
+  files.commit();
   const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   std::printf("wrote scene.exr, depth.exr, lights.json, flares.exr, bloom.exr, bloom.png in %s\n", o.out_dir.c_str());
   std::printf("wall time (device setup, pipelines, GPU, readback, files): %.2f s\n", wall_s);
@@ -220,7 +209,7 @@ Command add_demo_command(CLI::App& app) {
   sub->add_option("--out", o->out_dir,
                   "Directory for scene.exr, depth.exr, lights.json, flares.exr, bloom.exr and bloom.png (created if "
                   "missing)");
-  sub->add_option("--preset", o->preset, "Lens-flare look: retro_subtle, retro_intense, cinematic or disabled");
+  sub->add_option("--preset", o->preset, kFlarePresetHelp);
   sub->add_option("--exposure", o->exposure, "Linear exposure applied before the PNG tonemap (> 0)");
   sub->add_option("--seed", o->seed, "Seed of the starfield");
   add_device_option(*sub, o->device);

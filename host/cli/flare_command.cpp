@@ -11,17 +11,17 @@
 #include <glint/flare_pass.h>
 
 #include <algorithm>
-#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <fstream>
 #include <memory>
+#include <sstream>
 
 #include "cli/commands.h"
 #include "core/barriers.h"
 #include "core/resources.h"
 #include "core/transfer.h"
+#include "io/atomic_outputs.h"
 #include "io/exr_io.h"
 #include "io/lights_json.h"
 
@@ -36,20 +36,6 @@ struct FlareOptions {
   bool reverse_z = false;
   bool fp32 = false;
 };
-
-// Presets by name, any case. "default" is FlareConfig{} (the seed's LensFlareConfig defaults).
-FlareConfig preset_from_name(const std::string& name) {
-  std::string n = name;
-  std::transform(n.begin(), n.end(), n.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  if (n == "retro_subtle") return FlareConfig::preset(FlarePreset::retro_subtle);
-  if (n == "retro_intense") return FlareConfig::preset(FlarePreset::retro_intense);
-  if (n == "cinematic") return FlareConfig::preset(FlarePreset::cinematic);
-  if (n == "disabled") return FlareConfig::preset(FlarePreset::disabled);
-  if (n == "default") return FlareConfig{};
-  throw Error(ErrorCode::invalid_argument, "--preset: '" + name +
-                                               "' is not a preset; accepted retro_subtle, retro_intense, cinematic, "
-                                               "disabled or default (any case)");
-}
 
 const char* culled_name(uint32_t culled) {
   switch (culled) {
@@ -66,9 +52,9 @@ const char* culled_name(uint32_t culled) {
   }
 }
 
-void write_stats(const std::string& path, const GlintFlareStats& s, const GlintFlareLightResult* results, size_t n) {
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  if (!out) throw Error(ErrorCode::io_failure, path + ": cannot open for writing");
+// The text of STATS.json (format at the top of this file).
+std::string stats_json(const GlintFlareStats& s, const GlintFlareLightResult* results, size_t n) {
+  std::ostringstream out;
   out << "{\"total\": " << s.total << ", \"frustum_culled\": " << s.frustum_culled << ", \"occluded\": " << s.occluded
       << ", \"visible\": " << s.visible << ", \"overflow\": " << s.overflow << ", \"disabled\": " << s.disabled
       << ",\n \"lights\": [";
@@ -80,13 +66,12 @@ void write_stats(const std::string& path, const GlintFlareStats& s, const GlintF
         << ", \"culled\": " << culled_name(results[i].culled) << "}";
   }
   out << (n ? "\n ]}\n" : "]}\n");
-  out.close();
-  if (!out) throw Error(ErrorCode::io_failure, path + ": write failed");
+  return out.str();
 }
 
 void run_flare(const FlareOptions& o) {
   // Flags and output paths first: a typo costs no file reading and no device.
-  const FlareConfig look = preset_from_name(o.preset);
+  const FlareConfig look = flare_preset_from_name(o.preset);
   if (o.grid < 1 || o.grid > 16) {
     throw Error(ErrorCode::invalid_argument,
                 "--grid = " + std::to_string(o.grid) + " is out of range: accepted 1 to 16 (N x N cells per light)");
@@ -191,12 +176,14 @@ void run_flare(const FlareOptions& o) {
               st.frustum_culled, st.occluded, st.visible, st.overflow, st.disabled);
   print_stages(profiler);
 
-  io::write_exr_half(o.output, result);
-  std::printf("wrote %s\n", o.output.c_str());
+  io::AtomicOutputs files;  // OUT and --stats are replaced together, only once both are written
+  files.write(o.output, [&](const std::string& tmp) { io::write_exr_half(tmp, result); });
   if (!o.stats.empty()) {
-    write_stats(o.stats, st, results, pc.per_light_results ? n : 0);
-    std::printf("wrote %s\n", o.stats.c_str());
+    const std::string text = stats_json(st, results, pc.per_light_results ? n : 0);
+    files.write(o.stats, [&](const std::string& tmp) { io::write_text_file(tmp, text); });
   }
+  files.commit();
+  for (const std::string& f : files.targets()) std::printf("wrote %s\n", f.c_str());
 }
 
 }  // namespace
@@ -214,9 +201,7 @@ Command add_flare_command(CLI::App& app) {
                   "\"color\": [r,g,b], \"intensity\": f, \"size\": px, \"element\": \"glow\", \"enabled\": true}]}")
       ->required();
   sub->add_option("output", o->output, "Output OpenEXR file (RGBA half)")->required();
-  sub->add_option(
-      "--preset", o->preset,
-      "Look: retro_subtle, retro_intense, cinematic, disabled, or default (ratio 2, intensity 1); any case");
+  sub->add_option("--preset", o->preset, kFlarePresetHelp);
   sub->add_option("--grid", o->grid, "Occlusion grid: N x N samples per light (1 to 16)");
   sub->add_flag("--reverse-z", o->reverse_z, "Depth 1 is near and 0 far (reversed Z)");
   sub->add_option("--draw", o->draw, "Drawing path")->check(CLI::IsMember({"raster", "compute"}));

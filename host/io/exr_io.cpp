@@ -245,11 +245,20 @@ CpuImage read_exr(const std::string& path) {
                      channel_names(channels) + ")");
     }
     require_full_resolution(path, grey.c_str(), *channels.findChannel(grey));
+    // A FrameBuffer holds one slice per channel name: when the grey channel is A itself (a file with
+    // the single channel A), inserting the alpha slice would replace the grey one and leave R = G =
+    // B = 0. Then A is read once, into R, and copied to G, B and A.
+    const bool grey_is_alpha = grey == "A";
     fb.insert(grey, Imf::Slice::Make(Imf::FLOAT, image.rgba.data(), w.box, x_stride, y_stride));
-    fb.insert("A", Imf::Slice::Make(Imf::FLOAT, image.rgba.data() + 3, w.box, x_stride, y_stride, 1, 1, 1.0));
+    if (!grey_is_alpha) {
+      fb.insert("A", Imf::Slice::Make(Imf::FLOAT, image.rgba.data() + 3, w.box, x_stride, y_stride, 1, 1, 1.0));
+    }
     file.setFrameBuffer(fb);
     file.readPixels(w.box.min.y, w.box.max.y);
-    for (size_t i = 0; i < image.rgba.size(); i += 4) image.rgba[i + 1] = image.rgba[i + 2] = image.rgba[i];
+    for (size_t i = 0; i < image.rgba.size(); i += 4) {
+      image.rgba[i + 1] = image.rgba[i + 2] = image.rgba[i];
+      if (grey_is_alpha) image.rgba[i + 3] = image.rgba[i];
+    }
     return image;
   });
 }

@@ -335,6 +335,13 @@ const char* flare_element_name(uint32_t element) {
 }
 
 LightsFile parse_lights_json(std::string_view text) {
+  // nlohmann's lexer takes a NUL byte for the end of the input (for C strings), so "{...}\0garbage"
+  // would parse as the object alone. JSON text has no NUL anywhere (RFC 8259: control characters
+  // are not allowed unescaped, even in strings), so any NUL is an error.
+  if (const size_t nul = text.find('\0'); nul != std::string_view::npos) {
+    throw Error(ErrorCode::invalid_argument,
+                "invalid JSON: NUL byte at offset " + std::to_string(nul) + " (JSON text cannot contain NUL)");
+  }
   Handler handler;
   bool ok = false;
   try {
