@@ -93,6 +93,9 @@ bad demo --size 10 --out "$tmp/d"
 bad demo --size 20000x10 --out "$tmp/d"
 bad demo --exposure -1 --out "$tmp/d"
 bad demo --out "$scene"  # a file, not a directory
+bad demo --size 8x8 --out "$tmp/d" --preset sparkly
+ok demo --size 8x8 --out "$tmp/dp" --preset DEFAULT  # the presets of `flare`, parsed by the same code
+grep -q '^flares: preset DEFAULT' "$tmp/out" || fail "demo --preset default: $(grep '^flares' "$tmp/out")"
 
 # Bad files.
 bad bloom "$tmp/missing.exr" "$tmp/x.exr"
@@ -192,6 +195,37 @@ printf '1,2,3\n' >"$tmp/short.csv"
 bad lod --levels 13 "$tmp/short.csv" "$tmp/x.csv"
 printf '0.1,0,0,0.1,nan?,4,0,0\n' >"$tmp/junk.csv"
 bad lod --levels 13 "$tmp/junk.csv" "$tmp/x.csv"
+# bad_csv 'TEXT' 'EXPECTED PART OF THE MESSAGE': every data row is evaluated or rejected by line.
+bad_csv() {
+  printf '%s' "$1" >"$tmp/bad.csv"
+  bad lod --levels 13 "$tmp/bad.csv" "$tmp/x.csv"
+  grep -qF -- "$2" "$tmp/err" || fail "bad CSV '$1': message lacks '$2': $(cat "$tmp/err")"
+}
+bad_csv $'0.1,0,0,0.1,256,256,0,0\n0.1,0,0,0.1,nan,256,0,0\n' 'line 2: field 5 (tex_w)'
+bad_csv $'0.1,0,0,0.1,256,inf,0,0\n' 'line 1: field 6 (tex_h)'
+bad_csv $'0.1,0,0,0.1,0,256,0,0\n' 'field 5 (tex_w) = 0 is out of range; accepted 1 to 4096'
+bad_csv $'0.1,0,0,0.1,256,-2,0,0\n' 'field 6 (tex_h) = -2'
+bad_csv $'0.1,0,0,0.1,256,256,3841,0\n' 'field 7 (off_x) = 3841'
+bad_csv $'h1,h2,h3,h4,h5,h6,h7,h8\nh1,h2,h3,h4,h5,h6,h7,h8\n' 'line 2: field 1 (dudx)'
+# A first row whose numbers underflow a float is data, not a header: one query in, one out.
+printf '1e-45,0,0,1e-45,256,256,0,0\n' >"$tmp/tiny.csv"
+ok lod --levels 13 "$tmp/tiny.csv" "$tmp/tiny_out.csv"
+[[ "$(wc -l <"$tmp/tiny_out.csv")" == 1 && "$(cut -d, -f1 "$tmp/tiny_out.csv")" == 1e-45 ]] ||
+  fail "lod dropped or changed the underflowing first row: $(cat "$tmp/tiny_out.csv")"
+# Endless and huge inputs stop at the caps at once (exit 2, the cap named), not after gigabytes.
+start=$(date +%s)
+timeout 60 "$GLINT" lod --levels 13 /dev/zero "$tmp/x.csv" >"$tmp/out" 2>"$tmp/err"
+rc=$?
+((rc == 2)) && grep -q 'line 1: longer than 1024 bytes' "$tmp/err" || fail "lod /dev/zero -> exit $rc: $(cat "$tmp/err")"
+(($(date +%s) - start < 30)) || fail "lod /dev/zero took $(($(date +%s) - start)) s"
+truncate -s 50G "$tmp/sparse.csv" 2>/dev/null && {
+  bad lod --levels 13 "$tmp/sparse.csv" "$tmp/x.csv"
+  grep -q 'longer than 1024 bytes' "$tmp/err" || fail "lod on a sparse 50 GB file: $(cat "$tmp/err")"
+  rm -f "$tmp/sparse.csv"
+}
+# --aniso 0 is isotropic, as --help says: the same levels as no --aniso at all.
+ok lod --levels 13 --aniso 0 "$tmp/q.csv" "$tmp/lod_iso.csv"
+cmp -s "$tmp/lod.csv" "$tmp/lod_iso.csv" || fail "lod --aniso 0 differs from isotropic"
 
 # glint flare: the demo's scene, depth and light list replayed. The statistics must be the demo's,
 # with one entry per light in input order, for every preset and both drawing paths.
@@ -363,6 +397,61 @@ bad_cull '[1' 'not JSON'
 bad cull --depth "$tmp/missing.exr" --objects "$tmp/objects.json" "$tmp/x.json"
 bad cull --depth "$d/depth.exr" --objects "$tmp/missing.json" "$tmp/x.json"
 bad cull --depth "$d/depth.exr" --objects "$tmp/objects.json" "$tmp/no/such/dir/x.json"
+
+# Outputs are replaced atomically: a failing write (a file-size limit, as a full disk) and SIGTERM
+# while writing both leave the previous files intact and no temporaries.
+no_temporaries() {  # no_temporaries DIR WHAT
+  local left
+  left="$(find "$1" -name '*.glint-tmp')"
+  [[ -z "$left" ]] || fail "$2 left temporaries: $left"
+}
+ok bloom "$scene" "$tmp/atomic.exr" --png "$tmp/atomic.png"
+cp "$tmp/atomic.exr" "$tmp/atomic.exr.before"
+cp "$tmp/atomic.png" "$tmp/atomic.png.before"
+# 8 KiB: less than the EXR; the PNG is not written. SIGXFSZ is ignored, so the write fails cleanly.
+(ulimit -f 8 && "$GLINT" bloom "$scene" "$tmp/atomic.exr" --png "$tmp/atomic.png" --intensity 2 >"$tmp/out" 2>"$tmp/err")
+rc=$?
+((rc == 2)) && grep -q '^glint: error: .*atomic.exr: .*File too large' "$tmp/err" ||
+  fail "bloom under ulimit -f 8 -> exit $rc: $(cat "$tmp/err")"
+cmp -s "$tmp/atomic.exr" "$tmp/atomic.exr.before" || fail "a failed bloom write changed the previous EXR"
+cmp -s "$tmp/atomic.png" "$tmp/atomic.png.before" || fail "a failed bloom write changed the previous PNG"
+no_temporaries "$tmp" "a failed bloom write"
+# The demo's six files: the first three (scene.exr, depth.exr, lights.json) fit under the limit,
+# flares.exr (the scene plus flares) does not; none of the six is replaced.
+ok demo --size 96x64 --seed 7 --out "$tmp/atomic_demo"
+(cd "$tmp/atomic_demo" && md5sum * >"$tmp/atomic_demo.md5")
+ok demo --size 128x128 --out "$tmp/atomic_sizes"
+first=$(stat -c %s "$tmp/atomic_sizes/scene.exr" "$tmp/atomic_sizes/depth.exr" "$tmp/atomic_sizes/lights.json" | sort -n | tail -1)
+limit=$((first / 1024 + 1))
+if (($(stat -c %s "$tmp/atomic_sizes/flares.exr") > limit * 1024)); then
+  (ulimit -f "$limit" && "$GLINT" demo --size 128x128 --out "$tmp/atomic_demo" >"$tmp/out" 2>"$tmp/err")
+  rc=$?
+  ((rc == 2)) && grep -q 'flares.exr: .*File too large' "$tmp/err" ||
+    fail "demo under ulimit -f $limit -> exit $rc: $(cat "$tmp/err")"
+else
+  echo "cli_test: note: flares.exr is no larger than scene.exr on this device; partial-write case skipped"
+fi
+(cd "$tmp/atomic_demo" && md5sum -c --quiet "$tmp/atomic_demo.md5") || fail "a failed demo write changed earlier files"
+no_temporaries "$tmp/atomic_demo" "a failed demo write"
+# SIGTERM as soon as the first temporary appears (the demo writes six 1024x1024 files after it).
+"$GLINT" demo --size 1024x1024 --out "$tmp/atomic_demo" >"$tmp/out" 2>"$tmp/err" &
+pid=$!
+seen=0
+for ((i = 0; i < 12000; ++i)); do  # up to 120 s at 10 ms (a cold shader cache on a busy machine)
+  if [[ -n "$(find "$tmp/atomic_demo" -name '*.glint-tmp' 2>/dev/null)" ]]; then
+    kill -TERM "$pid"
+    seen=1
+    break
+  fi
+  kill -0 "$pid" 2>/dev/null || break
+  sleep 0.01
+done
+wait "$pid"
+rc=$?
+((seen)) || fail "never saw the demo's temporaries (exit $rc)"
+((rc == 143)) || fail "demo killed by SIGTERM -> exit $rc (expected 143): $(cat "$tmp/err")"
+(cd "$tmp/atomic_demo" && md5sum -c --quiet "$tmp/atomic_demo.md5") || fail "SIGTERM during the demo's write changed earlier files"
+no_temporaries "$tmp/atomic_demo" "SIGTERM during the demo's write"
 
 if ((failures)); then
   printf 'cli_test: %d failure(s)\n' "$failures" >&2
