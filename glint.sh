@@ -79,7 +79,8 @@ build() { cmake --build "$BUILD_DIR" -j"$(nproc)" "$@"; }
 # because the uninstrumented loader, driver and layer keep caches until exit that LSan reports,
 # and the frames that name them are lost by the fast unwinder (the slow one makes the run take over
 # ten minutes). glint's own leaks there are caught by the validation layer's object tracker and the
-# RSS checks of tests/api_errors_test.cpp (ApiMemory.*), which run in both builds.
+# memory bounds of tests/api_errors_test.cpp (ApiMemory.*), asserted in both builds: on RSS in
+# Release, on the live heap of ASan's allocator here (RSS grows with ASan's quarantine by design).
 asan_test() {
   local dir=build-asan
   # -O1 with line tables only (-g1): symbolized sanitizer reports at a fraction of the compile time

@@ -5,7 +5,6 @@
 
 #include <gtest/gtest.h>
 
-#include <chrono>
 #include <cmath>
 #include <vector>
 
@@ -177,17 +176,6 @@ TEST(BlurPlan, AutoTakesTheCheapestPlanWithinTheBound) {
   EXPECT_EQ(plan_auto(1.2, 3840, 2160, 1e-2).method, Method::separable);
   EXPECT_THROW(plan_auto(0.0, 64, 64, 1e-2), std::invalid_argument);
   EXPECT_THROW(plan_auto(2.0, 0, 64, 1e-2), std::invalid_argument);
-}
-
-TEST(BlurPlan, PlanningIsFast) {
-  // auto runs at effect creation; docs ask for well under 50 ms up to sigma 64 (generous here,
-  // the CI machine is shared).
-  for (double sigma : {0.5, 5.0, 24.0, 48.0, 64.0}) {
-    const auto t0 = std::chrono::steady_clock::now();
-    (void)plan_auto(sigma, 3840, 2160, 1e-2);
-    const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-    EXPECT_LT(ms, 150.0) << "sigma " << sigma;
-  }
 }
 
 }  // namespace
