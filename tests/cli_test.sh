@@ -144,6 +144,8 @@ bad bloom "$tmp/negattr.exr" "$tmp/x.exr"
 bad bloom "$scene" "$tmp/no/such/dir/x.exr"
 bad bloom "$scene" "$tmp"
 bad bloom "$scene" "$tmp/x.exr" --png "$tmp/no/such/dir/x.png"
+bad bloom "$scene" "$tmp/x.exr" --png "$tmp/./x.exr"
+grep -q 'OUT and --png are the same file' "$tmp/err" || fail "bloom OUT = --png: $(cat "$tmp/err")"
 
 # glint blur / gauss: level files at 1/2, 1/4, 1/8 of the 96x64 scene; the method is reported.
 ok blur "$scene" "$tmp/bp" --sigmas 0.8,1.2,2
@@ -314,6 +316,7 @@ bad flare "${flare_args[@]}" "$tmp/x.exr" --draw splat
 bad flare "${flare_args[@]}" "$tmp/x.exr" --no-such-flag
 bad flare "${flare_args[@]}" "$tmp/x.exr" --stats "$tmp/no/such/dir/s.json"
 bad flare "${flare_args[@]}" "$tmp/no/such/dir/x.exr"
+bad flare "${flare_args[@]}" "$tmp/x.exr" --stats "$tmp/x.exr"
 bad flare "${flare_args[@]}" "$tmp/x.exr" --device no-such-gpu
 bad flare --color "$tmp/missing.exr" --depth "$d/depth.exr" --lights "$d/lights.json" "$tmp/x.exr"
 bad flare --color "$d/scene.exr" --depth "$tmp/missing.exr" --lights "$d/lights.json" "$tmp/x.exr"

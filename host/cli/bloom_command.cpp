@@ -47,7 +47,10 @@ void run_bloom(BloomOptions& o) {
   o.config.validate();  // bad flags fail before any file or device is touched
   check_exposure(o.exposure);
   check_output_path(o.output);
-  if (!o.png.empty()) check_output_path(o.png);
+  if (!o.png.empty()) {
+    check_output_path(o.png);
+    check_distinct_outputs({"OUT", "--png"}, {o.output, o.png});
+  }
 
   const CpuImage input = io::read_exr(o.input);
   const VkExtent2D extent{input.width, input.height};

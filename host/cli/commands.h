@@ -13,6 +13,7 @@
 
 #include <functional>
 #include <string>
+#include <vector>
 
 namespace glint::cli {
 
@@ -51,6 +52,11 @@ void check_exposure(float exposure);
 /// Throws Error(io_failure) when `path` cannot be an output file: its directory is missing or it
 /// is a directory. Checked before GPU work so that a typo does not cost a run.
 void check_output_path(const std::string& path);
+
+/// Throws Error(invalid_argument) when two of the named output paths are the same file (after
+/// resolving "." and ".." and symbolic links of the existing part), e.g. `flare OUT --stats OUT`.
+/// options[i] names paths[i] in the message.
+void check_distinct_outputs(const std::vector<std::string>& options, const std::vector<std::string>& paths);
 
 /// The lens-flare looks by name, any case: retro_subtle, retro_intense, cinematic, disabled, or
 /// default (FlareConfig{}: ratio 2, intensity 1). The one parser of --preset for `demo` and `flare`.

@@ -57,6 +57,24 @@ void check_output_path(const std::string& path) {
   if (fs::is_directory(p, ec)) throw Error(ErrorCode::io_failure, path + ": is a directory");
 }
 
+void check_distinct_outputs(const std::vector<std::string>& options, const std::vector<std::string>& paths) {
+  namespace fs = std::filesystem;
+  std::vector<fs::path> resolved;
+  for (const std::string& p : paths) {
+    std::error_code ec;
+    fs::path r = fs::weakly_canonical(fs::absolute(p, ec), ec);
+    resolved.push_back(ec ? fs::path(p) : r);
+  }
+  for (size_t i = 0; i < paths.size(); ++i) {
+    for (size_t j = 0; j < i; ++j) {
+      if (resolved[i] == resolved[j]) {
+        throw Error(ErrorCode::invalid_argument, options[j] + " and " + options[i] + " are the same file (" + paths[i] +
+                                                     "); each output needs its own path");
+      }
+    }
+  }
+}
+
 FlareConfig flare_preset_from_name(const std::string& name) {
   std::string n = name;
   std::transform(n.begin(), n.end(), n.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });

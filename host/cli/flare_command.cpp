@@ -77,7 +77,10 @@ void run_flare(const FlareOptions& o) {
                 "--grid = " + std::to_string(o.grid) + " is out of range: accepted 1 to 16 (N x N cells per light)");
   }
   check_output_path(o.output);
-  if (!o.stats.empty()) check_output_path(o.stats);
+  if (!o.stats.empty()) {
+    check_output_path(o.stats);
+    check_distinct_outputs({"OUT", "--stats"}, {o.output, o.stats});
+  }
 
   const CpuImage color_in = io::read_exr(o.color);
   const io::ExrChannel depth_in = read_depth_exr(o.depth);
