@@ -385,7 +385,7 @@ bad_cull() {  # bad_cull JSON NEEDLE
   rm -f "$tmp/bad_out.json"
   bad cull --depth "$d/depth.exr" --objects "$tmp/bad_objects.json" "$tmp/bad_out.json"
   grep -q -- "$2" "$tmp/err" || fail "glint cull error for $1 does not name '$2': $(cat "$tmp/err")"
-  if [[ -e "$tmp/bad_out.json" || -e "$tmp/bad_out.json.tmp" ]]; then fail "glint cull left an output after an error"; fi
+  if [[ -e "$tmp/bad_out.json" || -n "$(find "$tmp" -maxdepth 1 -name "*.glint-tmp")" ]]; then fail "glint cull left an output after an error"; fi
 }
 bad_cull '{"view": '"$ident"', "proj": '"$proj"', "objects": [{"sphere": [0,0,-5,1]}, {"sphere": [0,0,-5,-1]}]}' 'objects\[1\].sphere\[3\]'
 bad_cull '{"view": '"$ident"', "proj": '"$proj"', "objects": [{"box": [0,0,0,1,1]}]}' 'objects\[0\].box'

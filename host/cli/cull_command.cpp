@@ -7,7 +7,7 @@
 // Numbers must be finite and within float range; r >= 0; min <= max. OUT.json:
 //   {"total": N, "frustum_culled": a, "occluded": b, "visible": c,
 //    "objects": ["visible" | "occluded" | "frustum", ...]}
-// written to OUT.json.tmp and renamed, so a failed run leaves no half-written file.
+// replaced atomically (io::AtomicOutputs), so a failed or killed run leaves no half-written file.
 #include <glint/object_cull.h>
 #include <glint/occlusion.h>
 
@@ -28,6 +28,7 @@
 #include "core/resources.h"
 #include "core/transfer.h"
 #include "glint/gpu/object_cull.h"
+#include "io/atomic_outputs.h"
 
 namespace glint::cli {
 namespace {
@@ -195,22 +196,9 @@ void run(const CullOptions& o) {
     out += std::string("\"") + state_name(states[i]) + "\"";
   }
   out += "]}\n";
-  const std::string tmp = o.output + ".tmp";
-  {
-    std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
-    f << out;
-    f.close();
-    if (!f) {
-      std::filesystem::remove(tmp);
-      throw Error(ErrorCode::io_failure, tmp + ": cannot write");
-    }
-  }
-  std::error_code ec;
-  std::filesystem::rename(tmp, o.output, ec);
-  if (ec) {
-    std::filesystem::remove(tmp);
-    throw Error(ErrorCode::io_failure, o.output + ": cannot write: " + ec.message());
-  }
+  io::AtomicOutputs files;  // temporary, fsync, rename (README: every CLI output is replaced atomically)
+  files.write(o.output, [&](const std::string& tmp) { io::write_text_file(tmp, out); });
+  files.commit();
   std::printf("device: %s (%s)\n", context.info().name.c_str(), device_type_name(context.info().type));
   std::printf("input: %s, %ux%u; %u object%s from %s\n", o.depth.c_str(), extent.width, extent.height, n,
               n == 1 ? "" : "s", o.objects.c_str());
