@@ -131,6 +131,17 @@ float max_value_for(VkFormat a, VkFormat b) {
   return std::min({detail::format_max(a), detail::format_max(b), 1.0e37f});
 }
 
+// blur_plan::Storage's unit of a store into `format`: one ulp of its mantissa, relative.
+double store_unit(VkFormat format) {
+  switch (format) {
+    case VK_FORMAT_R32G32B32A32_SFLOAT:
+    case VK_FORMAT_R32G32B32_SFLOAT: return blur_plan::store_unit(23);
+    case VK_FORMAT_B10G11R11_UFLOAT_PACK32: return blur_plan::store_unit(5);  // 6 bits (R, G), 5 (B)
+    case VK_FORMAT_E5B9G9R9_UFLOAT_PACK32: return blur_plan::store_unit(8);   // relative to the largest channel
+    default: return blur_plan::store_unit(10);                                // fp16
+  }
+}
+
 // The kernel variant that stores `format`: its GLSL qualifier's, else "noformat" (which
 // detail::check_color_write() accepted for the caller's output before any pipeline is made).
 std::string store_variant(VkFormat format) {
@@ -517,23 +528,36 @@ struct GaussianBlur::Impl {
     return *cur;
   }
 
-  BlurChoice plan(VkExtent2D size) const {
+  // The rounding of every store on the path (docs/BLUR.md "Error model"): intermediates at the
+  // configured precision, the output in its own format.
+  blur_plan::Storage storage(VkFormat out_format) const {
+    blur_plan::Storage st;
+    st.level_unit = store_unit(level_format());
+    st.output_unit = store_unit(out_format);
+    st.level_half = level_format() == VK_FORMAT_R16G16B16A16_SFLOAT;
+    st.output_half = out_format == VK_FORMAT_R16G16B16A16_SFLOAT;
+    st.sub_texel_bits = context->info().sub_texel_precision_bits;
+    return st;
+  }
+
+  BlurChoice plan(VkExtent2D size, VkFormat out_format) const {
     const double bound = config.max_relative_error;
+    const blur_plan::Storage st = storage(out_format);
     blur_plan::Plan p;
     switch (config.method) {
       case BlurMethod::automatic:
-        p = blur_plan::plan_auto(config.sigma_px, size.width, size.height, bound);
+        p = blur_plan::plan_auto(config.sigma_px, size.width, size.height, bound, st);
         break;
       case BlurMethod::separable:
         p = blur_plan::plan_method(
             config.linear_sampling ? blur_plan::Method::separable_linear : blur_plan::Method::separable,
-            config.sigma_px, size.width, size.height, bound);
+            config.sigma_px, size.width, size.height, bound, st);
         break;
       case BlurMethod::pyramid:
-        p = blur_plan::plan_method(blur_plan::Method::pyramid, config.sigma_px, size.width, size.height, bound);
+        p = blur_plan::plan_method(blur_plan::Method::pyramid, config.sigma_px, size.width, size.height, bound, st);
         break;
       case BlurMethod::dual:
-        p = blur_plan::plan_method(blur_plan::Method::dual, config.sigma_px, size.width, size.height, bound);
+        p = blur_plan::plan_method(blur_plan::Method::dual, config.sigma_px, size.width, size.height, bound, st);
         break;
     }
     BlurChoice choice;
@@ -557,7 +581,7 @@ struct GaussianBlur::Impl {
     prog.pipelines = &pipelines;
     made->extent = size;
     made->output_format = out_format;
-    made->choice = plan(size);
+    made->choice = plan(size, out_format);
     BlurChoice& choice = made->choice;
     std::vector<std::pair<VkExtent2D, VkFormat>>& intermediates = made->intermediates;
     const DeviceInfo& info = context->info();

@@ -518,7 +518,7 @@ Plan plan_separable(Method method, double sigma_px, uint32_t width, uint32_t hei
 // 0.5 <= sigma_k <= 3. Without any, the smallest error among the k with sigma_k in range; with no
 // k in range (tiny sigma, or an image too small for a large one), the k whose sigma_k is nearest
 // the range, sigma_k clamped into it (the error model then shows what that costs).
-Plan plan_pyramid(double sigma_px, uint32_t width, uint32_t height, double max_relative_l2) {
+Plan plan_pyramid(double sigma_px, uint32_t width, uint32_t height, double max_relative_l2, const Storage* storage) {
   Plan best;
   bool have = false, best_meets = false, best_in_range = false;
   double best_distance = std::numeric_limits<double>::infinity();
@@ -552,8 +552,10 @@ Plan plan_pyramid(double sigma_px, uint32_t width, uint32_t height, double max_r
     p.effective_sigma_px =
         std::sqrt(0.5 * (pyramid_axis_variance(width, k, level_var) + pyramid_axis_variance(height, k, level_var)));
     p.expected_relative_l2 = error;
+    if (storage) p.expected_relative_l2 += rounding_bound(p, *storage);
+    const double error_total = p.expected_relative_l2;
     p.cost = pyramid_cost(k, p.radius, width, height);
-    const bool meets = in_range && error <= max_relative_l2;
+    const bool meets = in_range && error_total <= max_relative_l2;
     if (!have || meets || (!best_meets && in_range && (!best_in_range || error < best.expected_relative_l2)) ||
         (!best_in_range && !in_range && distance < best_distance)) {
       best = p;
@@ -693,31 +695,87 @@ std::vector<double> pyramid_effective_sigma(uint32_t size, const std::vector<dou
   return out;
 }
 
-Plan plan_method(Method method, double sigma_px, uint32_t width, uint32_t height, double max_relative_l2) {
+namespace {
+
+Plan plan_with(Method method, double sigma_px, uint32_t width, uint32_t height, double max_relative_l2,
+               const Storage* storage) {
   check_request(sigma_px, width, height);
+  Plan p;
   switch (method) {
     case Method::separable:
     case Method::separable_linear:
-      return plan_separable(method, sigma_px, width, height);
+      p = plan_separable(method, sigma_px, width, height);
+      break;
     case Method::pyramid:
-      return plan_pyramid(sigma_px, width, height, max_relative_l2);
+      return plan_pyramid(sigma_px, width, height, max_relative_l2, storage);  // adds the rounding itself
     case Method::dual:
-      return plan_dual(sigma_px, width, height);
+      p = plan_dual(sigma_px, width, height);
+      break;
+    default:
+      throw std::invalid_argument("plan_method: unknown method");
   }
-  throw std::invalid_argument("plan_method: unknown method");
+  if (storage) p.expected_relative_l2 += rounding_bound(p, *storage);
+  return p;
 }
 
-// The cheapest of separable, pyramid and dual whose modelled error is <= max_relative_l2.
-// Separable always qualifies (the fallback): if even its truncation error misses a very small
-// bound, it is returned with that error in expected_relative_l2.
-Plan plan_auto(double sigma_px, uint32_t width, uint32_t height, double max_relative_l2) {
+// The cheapest of separable, pyramid and dual whose expected error is <= max_relative_l2.
+// Separable always qualifies (the fallback): if even its error misses a very small bound, it is
+// returned with that error in expected_relative_l2.
+Plan auto_with(double sigma_px, uint32_t width, uint32_t height, double max_relative_l2, const Storage* storage) {
   check_request(sigma_px, width, height);
-  Plan best = plan_separable(Method::separable, sigma_px, width, height);
+  Plan best = plan_with(Method::separable, sigma_px, width, height, max_relative_l2, storage);
   for (Method m : {Method::pyramid, Method::dual}) {
-    const Plan p = plan_method(m, sigma_px, width, height, max_relative_l2);
+    const Plan p = plan_with(m, sigma_px, width, height, max_relative_l2, storage);
     if (p.expected_relative_l2 <= max_relative_l2 && p.cost < best.cost) best = p;
   }
   return best;
+}
+
+}  // namespace
+
+double store_unit(uint32_t mantissa_bits) { return mantissa_bits >= 23 ? 0.0 : std::ldexp(1.0, -int(mantissa_bits)); }
+
+// docs/BLUR.md "Error model": the stores and multiply-adds on each method's path (host/blur.cpp
+// GaussianBlur::Impl::make() records the same steps).
+double rounding_bound(const Plan& plan, const Storage& st) {
+  const double half = store_unit(10);
+  const double arith = std::ldexp(1.0, -24);
+  const double line_taps = 2.0 * (2.0 * plan.radius + 1.0);  // both passes of a separable blur
+  double u = 0.0;
+  switch (plan.method) {
+    case Method::separable:
+      if (plan.radius <= kFusedMaxRadius)  // fused: shared copies in fp16 when the output is RGBA16F
+        u = st.output_unit + (st.output_half ? 2.0 * half : 0.0) + arith * line_taps;
+      else  // two line passes through a scratch image
+        u = st.level_unit + st.output_unit + arith * line_taps;
+      break;
+    case Method::separable_linear:
+      u = st.level_unit + st.output_unit + 2.0 * 2.0 * std::ldexp(1.0, -int(st.sub_texel_bits)) +
+          arith * 2.0 * (plan.radius + 2.0);
+      break;
+    case Method::pyramid:  // k levels, the fused kernel's copies at the last, the B-spline output
+      u = plan.levels * st.level_unit + (st.level_half ? 2.0 * half : 0.0) + st.output_unit +
+          arith * (16.0 * plan.levels + line_taps + 16.0);
+      break;
+    case Method::dual:  // k down, k - 1 up into levels, the last up into the output
+      u = (2.0 * plan.levels - 1.0) * st.level_unit + st.output_unit + arith * 52.0 * plan.levels;
+      break;
+  }
+  return u * (1.0 + plan.expected_relative_l2);
+}
+
+Plan plan_method(Method method, double sigma_px, uint32_t width, uint32_t height, double max_relative_l2) {
+  return plan_with(method, sigma_px, width, height, max_relative_l2, nullptr);
+}
+Plan plan_method(Method method, double sigma_px, uint32_t width, uint32_t height, double max_relative_l2,
+                 const Storage& storage) {
+  return plan_with(method, sigma_px, width, height, max_relative_l2, &storage);
+}
+Plan plan_auto(double sigma_px, uint32_t width, uint32_t height, double max_relative_l2) {
+  return auto_with(sigma_px, width, height, max_relative_l2, nullptr);
+}
+Plan plan_auto(double sigma_px, uint32_t width, uint32_t height, double max_relative_l2, const Storage& storage) {
+  return auto_with(sigma_px, width, height, max_relative_l2, &storage);
 }
 
 }  // namespace glint::blur_plan

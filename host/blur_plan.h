@@ -52,6 +52,32 @@ struct Plan {
   double cost = 0;              //!< relative cost estimate used by auto (full-resolution texel passes)
 };
 
+/// How the GPU stores and samples what a plan computes, for the rounding part of the expected
+/// error (docs/BLUR.md "Error model"). A unit is the largest relative error one store into that
+/// format may make: 2^-10 for fp16 (Vulkan lets a device round toward zero, one ulp, as well as
+/// to nearest), 2^-5 for B10G11R11's 5- and 6-bit mantissas, 2^-8 for E5B9G9R9, 0 for fp32 (a
+/// float result stored as float is exact).
+struct Storage {
+  double level_unit = 0;        //!< intermediate images (GaussianBlurConfig::precision)
+  double output_unit = 0;       //!< the caller's output format
+  bool level_half = false;      //!< intermediates are RGBA16F: the fused kernel's shared copies are fp16
+  bool output_half = false;     //!< the output is RGBA16F: so are the fused kernel's at full resolution
+  uint32_t sub_texel_bits = 4;  //!< VkPhysicalDeviceLimits::subTexelPrecisionBits (linear sampling)
+};
+
+/// The unit of `Storage` for a store into a format of `mantissa_bits` explicit mantissa bits
+/// (10 for fp16, 23 for fp32): 2^-mantissa_bits, one ulp relative, or 0 at 23 and above.
+double store_unit(uint32_t mantissa_bits);
+
+/// Bound on the relative L2 error that storage and fp32 arithmetic add to the plan's modelled
+/// error, for non-negative images (all weights are non-negative, so an error of u relative in a
+/// stored texel reaches each output at most as u times the output): the sum over the stores on
+/// the path (levels, the fused kernel's fp16 shared copies, the output) of their units, the
+/// linear sampler's weight quantization 2^-sub_texel_bits (twice per pass: it moves weight
+/// between the two texels of a pair), and 2^-24 per fp32 multiply-add; times (1 + modelled
+/// error), since the outputs are relative to the exact Gaussian.
+double rounding_bound(const Plan& plan, const Storage& storage);
+
 /// Plan of `method` for `sigma_px` on an image of `width x height`. For pyramid, the largest
 /// level count whose modelled error is <= max_relative_l2 (at least 1 level).
 Plan plan_method(Method method, double sigma_px, uint32_t width, uint32_t height, double max_relative_l2);
@@ -60,5 +86,12 @@ Plan plan_method(Method method, double sigma_px, uint32_t width, uint32_t height
 /// (separable always qualifies: it is the reference up to truncation at 4 sigma; if even it misses
 /// a very small bound it is returned with its error).
 Plan plan_auto(double sigma_px, uint32_t width, uint32_t height, double max_relative_l2);
+
+/// plan_method() and plan_auto() with the rounding of `storage` added to expected_relative_l2
+/// (rounding_bound()), which is then what the bound is compared with: the error of what the
+/// caller's output holds, not only of the algorithm.
+Plan plan_method(Method method, double sigma_px, uint32_t width, uint32_t height, double max_relative_l2,
+                 const Storage& storage);
+Plan plan_auto(double sigma_px, uint32_t width, uint32_t height, double max_relative_l2, const Storage& storage);
 
 }  // namespace glint::blur_plan

@@ -99,7 +99,7 @@ void main() {
   ivec2 dst_size = ivec2(p.dst_width, p.dst_height);
   g_src_size = ivec2(p.src_width, p.src_height);
   ivec2 group_origin = ivec2(gl_GlobalInvocationID.xy - gl_LocalInvocationID.xy);
-  g_window = ivec2(floor(map_position(group_origin, dst_size, g_src_size))) - 2;
+  g_window = ivec2(floor(level_map(group_origin, dst_size, g_src_size))) - 2;
   ivec2 raw_origin = g_window - kRadius;
 
   // Every fetch is issued before the first shared store, so their latencies overlap.

@@ -342,6 +342,40 @@ TEST_F(BloomTest, PointSourceGlowIsRadiallySymmetric) {
   }
 }
 
+// The glow of a single pixel is centred on it: the centroid of the added light is within 0.25 px
+// of the pixel for every filter, at the common sizes whose chains have odd levels (1080 -> 135 ->
+// 67, 720 -> 45 -> 22, 540 -> 135 -> 67) and at odd sizes, for pixels at several phases (near the
+// centre: at small sizes the glow reaches the borders, whose clamp moves any centroid). The dual
+// filter's same-UV map between n and floor(n / 2) texels moved it by up to 2 px (docs/BLOOM.md).
+TEST_F(BloomTest, GlowOfAPixelIsCentredOnItAtEverySize) {
+  const VkExtent2D sizes[] = {{1920, 1080}, {1280, 720}, {960, 540}, {961, 541}, {1333, 751}};
+  for (VkExtent2D size : sizes) {
+    for (BloomFilter filter : kFilters) {
+      BloomConfig config;
+      config.filter = filter;
+      config.intensity = 50.0f;
+      Bloom bloom(context(), config);
+      for (int offset : {-20, -11, 7}) {
+        const uint32_t px = size.width / 2 + offset, py = size.height / 2 + 3 + offset / 4;
+        CpuImage input = point_source(size.width, size.height, px, py, 100.0f, 0.0f);
+        const CpuImage gpu = run_bloom(bloom, input, kF32, kF32);
+        const std::vector<double> added = added_light(gpu, input);
+        double e = 0.0, sx = 0.0, sy = 0.0;
+        for (uint32_t y = 0; y < size.height; ++y)
+          for (uint32_t x = 0; x < size.width; ++x) {
+            const double a = added[size_t(y) * size.width + x];
+            e += a;
+            sx += a * x;
+            sy += a * y;
+          }
+        ASSERT_GT(e, 0.0);
+        EXPECT_NEAR(sx / e, px, 0.25) << bloom_filter_name(filter) << " " << size.width << "x" << size.height;
+        EXPECT_NEAR(sy / e, py, 0.25) << bloom_filter_name(filter) << " " << size.width << "x" << size.height;
+      }
+    }
+  }
+}
+
 TEST_F(BloomTest, BrighterSourceGivesMoreBloomEnergy) {
   double last = 0.0;
   for (float value : {2.0f, 10.0f, 100.0f, 900.0f}) {

@@ -330,6 +330,36 @@ TEST_F(BlurTest, ImpulseResponseIsSymmetricSumsToOneAndHasTheExpectedSigma) {
   }
 }
 
+// The printed error covers what the caller's output holds: with an RGBA16F output (and fp16
+// intermediates) the stores' rounding is part of expected_relative_error, measured over the
+// whole image against the exact float64 Gaussian of an RGBA32F input (what `glint gauss` does).
+// The separable blur clamps at full resolution like the exact Gaussian, so the borders count too.
+TEST_F(BlurTest, ExpectedErrorIncludesTheRoundingOfEveryStore) {
+  const CpuImage random = random_hdr(96, 80, 77);
+  for (float sigma : {1.0f, 3.0f, 20.0f}) {
+    double expected[2] = {};
+    for (Precision precision : {Precision::fp16, Precision::fp32}) {
+      SCOPED_TRACE(testing::Message() << "sigma " << sigma << (precision == Precision::fp16 ? " fp16" : " fp32"));
+      GaussianBlurConfig config;
+      config.sigma_px = sigma;
+      config.method = BlurMethod::separable;
+      config.precision = precision;
+      GaussianBlur blur(context(), config);
+      const VkFormat out_format = precision == Precision::fp16 ? kF16 : kF32;
+      auto in = make_image(random, kF32);
+      auto out = make_poisoned({random.width, random.height}, out_format);
+      context().run_once([&](VkCommandBuffer cmd) { blur.record(cmd, in.state, out.state); });
+      blur.forget_caller_resources();
+      const CpuImage result = detail::download(context(), out.state);
+      const double measured = reference::rgba_relative_l2(result, reference::exact_gaussian(random, sigma));
+      expected[precision == Precision::fp16 ? 0 : 1] = blur.choice().expected_relative_error;
+      EXPECT_LE(measured, blur.choice().expected_relative_error);
+    }
+    // fp16 stores add at least the output's rounding, 2^-10 relative, to the fp32 path's error.
+    EXPECT_GE(expected[0], expected[1] + std::ldexp(1.0, -10));
+  }
+}
+
 // auto meets its bound against the exact Gaussian across the sigma range, on an impulse (the
 // modelled worst case) and on random HDR input.
 TEST_F(BlurTest, AutoMeetsItsErrorBoundAcrossTheSigmaRange) {

@@ -158,6 +158,27 @@ for method in auto separable pyramid dual; do
   grep -q 'expected relative L2 error' "$tmp/out" || fail "glint gauss --method $method printed no error"
 done
 ok gauss "$scene" "$tmp/g_lin.exr" --sigma 1.5 --method separable --linear --fp32
+# --fp32 writes 32-bit float channels, the default half: the pixel type of each channel in the
+# header's chlist (OpenEXR file layout: name, NUL, int32 type with 1 = HALF, 2 = FLOAT).
+ok gauss "$scene" "$tmp/g_f32.exr" --sigma 3 --method separable --fp32
+exr_types() {
+  python3 - "$1" <<'PY'
+import struct, sys
+data = open(sys.argv[1], 'rb').read()
+i = data.index(b'channels\0chlist\0') + len(b'channels\0chlist\0')
+size = struct.unpack_from('<i', data, i)[0]
+body, types, j = data[i + 4:i + 4 + size], [], 0
+while body[j] != 0:
+    end = body.index(b'\0', j)
+    types.append(struct.unpack_from('<i', body, end + 1)[0])
+    j = end + 1 + 16
+print(' '.join(str(t) for t in types))
+PY
+}
+[ "$(exr_types "$tmp/g_f32.exr")" = "2 2 2 2" ] || fail "glint gauss --fp32 wrote channel types $(exr_types "$tmp/g_f32.exr")"
+[ "$(exr_types "$tmp/g_separable.exr")" = "1 1 1 1" ] || fail "glint gauss wrote channel types $(exr_types "$tmp/g_separable.exr")"
+ok bloom "$scene" "$tmp/b_f32.exr" --fp32
+[ "$(exr_types "$tmp/b_f32.exr")" = "2 2 2 2" ] || fail "glint bloom --fp32 wrote channel types $(exr_types "$tmp/b_f32.exr")"
 bad blur "$scene" "$tmp/bp" --sigmas 1,2
 bad blur "$scene" "$tmp/bp" --sigmas 1,2,9
 bad blur "$scene" "$tmp/bp" --sigmas a,b,c

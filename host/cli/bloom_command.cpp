@@ -62,7 +62,7 @@ void run_bloom(BloomOptions& o) {
   const CpuImage output =
       run_image_effect(context, input, profiler, [&](VkCommandBuffer cmd, Image& in, Image& out, Profiler* p) {
         bloom.record(cmd, in, out, p);
-      });
+      }, o.fp32 ? VK_FORMAT_R32G32B32A32_SFLOAT : VK_FORMAT_R16G16B16A16_SFLOAT);
   print_device(context, o.input, input);
   std::printf("bloom: filter %s, %s intermediates, %u level%s", bloom_filter_name(o.config.filter), o.fp32 ? "fp32" : "fp16",
               bloom.levels(), bloom.levels() == 1 ? "" : "s");
@@ -74,7 +74,7 @@ void run_bloom(BloomOptions& o) {
   print_stages(profiler);
 
   io::AtomicOutputs files;  // OUT and --png are replaced together, only once both are written
-  files.write(o.output, [&](const std::string& tmp) { io::write_exr_half(tmp, output); });
+  files.write(o.output, [&](const std::string& tmp) { write_result_exr(tmp, output, o.fp32); });
   if (!o.png.empty()) {
     files.write(o.png, [&](const std::string& tmp) { io::write_png_tonemapped(tmp, output, o.exposure); });
   }
@@ -86,9 +86,9 @@ void run_bloom(BloomOptions& o) {
 
 Command add_bloom_command(CLI::App& app) {
   auto o = std::make_shared<BloomOptions>();
-  CLI::App* sub = app.add_subcommand("bloom", "Apply bloom to an OpenEXR image; write RGBA half EXR");
+  CLI::App* sub = app.add_subcommand("bloom", "Apply bloom to an OpenEXR image; write RGBA half EXR (float with --fp32)");
   sub->add_option("input", o->input, "Input OpenEXR file (R,G,B[,A], or one grey channel)")->required();
-  sub->add_option("output", o->output, "Output OpenEXR file (RGBA half)")->required();
+  sub->add_option("output", o->output, "Output OpenEXR file (RGBA half; 32-bit float with --fp32)")->required();
   sub->add_option("--threshold", o->config.threshold, "Luminance where bloom starts (0 to 65504)");
   sub->add_option("--knee", o->config.soft_knee, "Soft knee width as a fraction of the threshold (0 to 1)");
   sub->add_option("--intensity", o->config.intensity, "Weight of the bloom added to the image (0 to 100)");
@@ -100,7 +100,7 @@ Command add_bloom_command(CLI::App& app) {
   sub->add_option("--max-brightness", o->config.max_brightness, "Per-channel clamp of level 0 (1e-3 to 8000)");
   sub->add_option("--level0-height", o->config.level0_height,
                   "Rows of pyramid level 0 (0 = half the input; 8 to 16384 makes the glow resolution independent)");
-  sub->add_flag("--fp32", o->fp32, "Keep the pyramid in RGBA32F instead of RGBA16F");
+  sub->add_flag("--fp32", o->fp32, "Keep the pyramid and the output in RGBA32F and write 32-bit float EXR (default: RGBA16F, half EXR)");
   sub->add_option("--png", o->png, "Also write a tonemapped (ACES fitted) 8-bit sRGB PNG here");
   sub->add_option("--exposure", o->exposure, "Linear exposure applied before the PNG tonemap (> 0)");
   add_device_option(*sub, o->device);

@@ -62,7 +62,7 @@ void run_blur(const BlurOptions& o) {
     const CpuImage level = detail::download(context, pyramid.level(k));
     sizes[k - 1] = {level.width, level.height};
     sigmas[k - 1] = pyramid.effective_sigma_px(k);
-    files.write(names[k - 1], [&](const std::string& tmp) { io::write_exr_half(tmp, level); });
+    files.write(names[k - 1], [&](const std::string& tmp) { write_result_exr(tmp, level, o.fp32); });
   }
   files.commit();
   for (uint32_t k = 0; k < 3; ++k) {
@@ -104,7 +104,7 @@ void run_gauss(GaussOptions& o) {
   const CpuImage output =
       run_image_effect(context, input, profiler, [&](VkCommandBuffer cmd, Image& in, Image& out, Profiler* p) {
         blur.record(cmd, in, out, p);
-      });
+      }, o.fp32 ? VK_FORMAT_R32G32B32A32_SFLOAT : VK_FORMAT_R16G16B16A16_SFLOAT);
   print_device(context, o.input, input);
   const BlurChoice& c = blur.choice();
   std::printf("method: %s%s (asked: %s)", to_string(c.method), c.linear_sampling ? " with linear sampling" : "",
@@ -118,7 +118,7 @@ void run_gauss(GaussOptions& o) {
               o.config.sigma_px, c.effective_sigma_px, c.expected_relative_error, o.config.max_relative_error);
   print_stages(profiler);
   io::AtomicOutputs files;
-  files.write(o.output, [&](const std::string& tmp) { io::write_exr_half(tmp, output); });
+  files.write(o.output, [&](const std::string& tmp) { write_result_exr(tmp, output, o.fp32); });
   files.commit();
   std::printf("wrote %s\n", o.output.c_str());
 }
@@ -132,23 +132,23 @@ Command add_blur_command(CLI::App& app) {
   sub->add_option("output_prefix", o->prefix, "Output prefix (PREFIX.blur1.exr ...)")->required();
   sub->add_option("--sigmas", o->sigmas,
                   "Sigma of each level in texels of that level, a,b,c (each 0.3 to 4; default 1.2,1.2,1.2)");
-  sub->add_flag("--fp32", o->fp32, "Keep the levels in RGBA32F instead of RGBA16F");
+  sub->add_flag("--fp32", o->fp32, "Keep the levels in RGBA32F and write 32-bit float EXR (default: RGBA16F, half EXR)");
   add_device_option(*sub, o->device);
   return {sub, [o] { run_blur(*o); }};
 }
 
 Command add_gauss_command(CLI::App& app) {
   auto o = std::make_shared<GaussOptions>();
-  CLI::App* sub = app.add_subcommand("gauss", "Gaussian blur of an OpenEXR image; write RGBA half EXR");
+  CLI::App* sub = app.add_subcommand("gauss", "Gaussian blur of an OpenEXR image; write RGBA half EXR (float with --fp32)");
   sub->add_option("input", o->input, "Input OpenEXR file")->required();
-  sub->add_option("output", o->output, "Output OpenEXR file (RGBA half)")->required();
+  sub->add_option("output", o->output, "Output OpenEXR file (RGBA half; 32-bit float with --fp32)")->required();
   sub->add_option("--sigma", o->config.sigma_px, "Standard deviation in pixels (0.5 to 64)")->required();
   sub->add_option("--method", o->method, "auto, separable, pyramid or dual")
       ->check(CLI::IsMember({"auto", "separable", "pyramid", "dual"}));
   sub->add_option("--max-error", o->config.max_relative_error,
                   "auto/pyramid: bound on the modelled relative L2 error (1e-4 to 1)");
   sub->add_flag("--linear", o->linear, "separable: pair taps into bilinear sampler fetches (9 taps in 5)");
-  sub->add_flag("--fp32", o->fp32, "RGBA32F intermediates instead of RGBA16F");
+  sub->add_flag("--fp32", o->fp32, "RGBA32F intermediates and output, written as 32-bit float EXR (default: RGBA16F, half EXR)");
   add_device_option(*sub, o->device);
   return {sub, [o] { run_gauss(*o); }};
 }

@@ -84,8 +84,14 @@ void print_device(const Context& context, const std::string& input_path, const C
 void run_on_input(const Context& context, const CpuImage& input, Profiler& profiler,
                   const std::function<void(VkCommandBuffer, Image& source, Profiler*)>& effect);
 
-/// run_on_input() with an RGBA16F output image of the same size, which is read back and returned.
+/// run_on_input() with an output image of the same size in `output_format` (RGBA16F, or RGBA32F
+/// for --fp32), which is read back and returned.
 CpuImage run_image_effect(const Context& context, const CpuImage& input, Profiler& profiler,
-                          const std::function<void(VkCommandBuffer, Image& source, Image& result, Profiler*)>& effect);
+                          const std::function<void(VkCommandBuffer, Image& source, Image& result, Profiler*)>& effect,
+                          VkFormat output_format = VK_FORMAT_R16G16B16A16_SFLOAT);
+
+/// Writes an effect's result at the precision it was computed in: RGBA32F as 32-bit float EXR
+/// channels (--fp32), anything else as half.
+void write_result_exr(const std::string& path, const CpuImage& image, bool fp32);
 
 }  // namespace glint::cli

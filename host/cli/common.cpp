@@ -129,12 +129,19 @@ void run_on_input(const Context& context, const CpuImage& input, Profiler& profi
 }
 
 CpuImage run_image_effect(const Context& context, const CpuImage& input, Profiler& profiler,
-                          const std::function<void(VkCommandBuffer, Image& source, Image& result, Profiler*)>& effect) {
-  detail::OwnedImage result(context, {input.width, input.height}, VK_FORMAT_R16G16B16A16_SFLOAT,
-                            detail::kToolImageUsage);
+                          const std::function<void(VkCommandBuffer, Image& source, Image& result, Profiler*)>& effect,
+                          VkFormat output_format) {
+  detail::OwnedImage result(context, {input.width, input.height}, output_format, detail::kToolImageUsage);
   run_on_input(context, input, profiler,
                [&](VkCommandBuffer cmd, Image& source, Profiler* p) { effect(cmd, source, result.image(), p); });
   return detail::download(context, result.image());
+}
+
+void write_result_exr(const std::string& path, const CpuImage& image, bool fp32) {
+  if (fp32)
+    io::write_exr_float(path, image);
+  else
+    io::write_exr_half(path, image);
 }
 
 // The depth channel: Z, else the first channel; every value finite and in [0, 1].

@@ -237,6 +237,7 @@ void fill_info(ContextState& s) {
   s.info.type = p.deviceType;
   s.info.subgroup_size = subgroup.subgroupSize;
   s.info.max_shared_memory_bytes = p.limits.maxComputeSharedMemorySize;
+  s.info.sub_texel_precision_bits = p.limits.subTexelPrecisionBits;
   s.info.max_workgroup_invocations = p.limits.maxComputeWorkGroupInvocations;
   s.info.max_image_dimension_2d = p.limits.maxImageDimension2D;
   s.info.timestamp_period_ns = p.limits.timestampPeriod;

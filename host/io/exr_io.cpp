@@ -330,4 +330,23 @@ void write_exr_channel(const std::string& path, const std::string& name, uint32_
   });
 }
 
+void write_exr_float(const std::string& path, const CpuImage& image) {
+  limit_openexr_sizes();
+  check_writable_image(path, image);
+  guarded(path, "write OpenEXR file", [&] {
+    Imf::Header header(int(image.width), int(image.height));  // ZIP compression by default
+    const char* names[4] = {"R", "G", "B", "A"};
+    for (const char* n : names) header.channels().insert(n, Imf::Channel(Imf::FLOAT));
+    Imf::OutputFile file(path.c_str(), header);
+    Imf::FrameBuffer fb;
+    // Interleaved RGBA floats; OpenEXR's Slice takes a non-const pointer but only reads when writing.
+    char* base = reinterpret_cast<char*>(const_cast<float*>(image.rgba.data()));
+    for (size_t c = 0; c < 4; ++c)
+      fb.insert(names[c], Imf::Slice(Imf::FLOAT, base + c * sizeof(float), 4 * sizeof(float),
+                                     4 * sizeof(float) * image.width));
+    file.setFrameBuffer(fb);
+    file.writePixels(int(image.height));
+  });
+}
+
 }  // namespace glint::io

@@ -52,6 +52,12 @@ ExrChannel read_exr_channel(const std::string& path, const std::string& preferre
 /// image: must be non-empty, with rgba.size() == width * height * 4 (else Error(invalid_argument)).
 void write_exr_half(const std::string& path, const CpuImage& image);
 
+/// Writes `image` as an RGBA 32-bit float OpenEXR file (ZIP compression), replacing `path`;
+/// read_exr() reads it back bit for bit (no rounding, unlike write_exr_half()).
+/// path: the file to write; its directory must exist.
+/// image: as for write_exr_half().
+void write_exr_float(const std::string& path, const CpuImage& image);
+
 /// Writes one float channel called `name` (e.g. "Z" for depth) as a 32-bit float OpenEXR file (ZIP
 /// compression), replacing `path`; read_exr_channel() reads it back bit for bit.
 /// path: the file to write; its directory must exist.

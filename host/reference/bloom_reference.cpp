@@ -60,6 +60,19 @@ void bilinear(const DoubleImage& img, double px, double py, double out[3]) {
 // normalized UV: p = (x + 0.5) * ws / wd - 0.5.
 double map_coord(uint32_t x, uint32_t dst, uint32_t src) { return (x + 0.5) * double(src) / double(dst) - 0.5; }
 
+// The dual filter's map (docs/BLOOM.md "Notation"): between n and floor(n / 2) texels the exact
+// ratio 2 (or 1/2), the grids aligned at texel 0; any other pair of sizes (level0_height's first
+// step) the same-UV map.
+double dual_map(uint32_t x, uint32_t dst, uint32_t src) {
+  if (src > 1 && dst == src / 2) return 2.0 * x + 0.5;
+  if (dst > 1 && src == dst / 2) return (x + 0.5) * 0.5 - 0.5;
+  return map_coord(x, dst, src);
+}
+
+double level_map(BloomFilter filter, uint32_t x, uint32_t dst, uint32_t src) {
+  return filter == BloomFilter::dual ? dual_map(x, dst, src) : map_coord(x, dst, src);
+}
+
 double luma3(const double c[3]) { return luma(c[0], c[1], c[2]); }
 
 // The RGBA16F store: round each colour channel to fp16 (the GPU computes in fp32 and then stores,
@@ -264,9 +277,9 @@ DoubleImage downsample(const DoubleImage& src, LevelSize size, BloomFilter filte
     return dst;
   }
   for (uint32_t y = 0; y < size.height; ++y) {
-    const double py = map_coord(y, size.height, src.height);
+    const double py = level_map(filter, y, size.height, src.height);
     for (uint32_t x = 0; x < size.width; ++x) {
-      const double px = map_coord(x, size.width, src.width);
+      const double px = level_map(filter, x, size.width, src.width);
       if (filter == BloomFilter::cod13)
         down_cod13(src, px, py, karis, dst.at(x, y));
       else
@@ -462,9 +475,9 @@ std::vector<DoubleImage> downsampled_levels(const CpuImage& input, const BloomCo
 DoubleImage upsample(const DoubleImage& small, uint32_t width, uint32_t height, BloomFilter filter, double radius) {
   DoubleImage dst = make_level(width, height);
   for (uint32_t y = 0; y < height; ++y) {
-    const double py = map_coord(y, height, small.height);
+    const double py = level_map(filter, y, height, small.height);
     for (uint32_t x = 0; x < width; ++x)
-      upsample_at(small, map_coord(x, width, small.width), py, filter, radius, dst.at(x, y));
+      upsample_at(small, level_map(filter, x, width, small.width), py, filter, radius, dst.at(x, y));
   }
   return dst;
 }
@@ -491,10 +504,10 @@ DoubleImage bloom(const CpuImage& input, const BloomConfig& config, bool round_i
     DoubleImage& level = levels[k];
     const DoubleImage& smaller = levels[k + 1];
     for (uint32_t y = 0; y < level.height; ++y) {
-      const double py = map_coord(y, level.height, smaller.height);
+      const double py = level_map(config.filter, y, level.height, smaller.height);
       for (uint32_t x = 0; x < level.width; ++x) {
         double up[3];
-        upsample_at(smaller, map_coord(x, level.width, smaller.width), py, config.filter, radius, up);
+        upsample_at(smaller, level_map(config.filter, x, level.width, smaller.width), py, config.filter, radius, up);
         double* own = level.at(x, y);
         for (int c = 0; c < 3; ++c) own[c] += up[c];
       }
@@ -511,10 +524,10 @@ DoubleImage bloom(const CpuImage& input, const BloomConfig& config, bool round_i
   const DoubleImage& a0 = levels[0];
   const double scale = double(config.intensity) / double(n);
   for (uint32_t y = 0; y < out.height; ++y) {
-    const double py = map_coord(y, out.height, a0.height);
+    const double py = level_map(config.filter, y, out.height, a0.height);
     for (uint32_t x = 0; x < out.width; ++x) {
       double up[3];
-      upsample_at(a0, map_coord(x, out.width, a0.width), py, config.filter, radius, up);
+      upsample_at(a0, level_map(config.filter, x, out.width, a0.width), py, config.filter, radius, up);
       double* o = out.at(x, y);
       for (int c = 0; c < 3; ++c) o[c] += scale * up[c];
       for (int c = 0; c < 4; ++c) o[c] = std::clamp(o[c], -kFloatMax, kFloatMax);

@@ -144,7 +144,7 @@ struct BlurChoice {
   double level_sigma = 0;              //!< pyramid: sigma in texels of the smallest level
   double dual_offset = 0;              //!< dual: tap offset o in texels
   double effective_sigma_px = 0;       //!< sigma of the method's impulse response, input pixels
-  double expected_relative_error = 0;  //!< modelled relative L2 against the exact Gaussian
+  double expected_relative_error = 0;  //!< modelled relative L2 against the exact Gaussian, storage rounding included
   uint32_t dispatches = 0;
 };
 

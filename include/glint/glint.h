@@ -138,6 +138,7 @@ struct DeviceInfo {
   uint32_t max_shared_memory_bytes = 0;
   uint32_t max_workgroup_invocations = 0;
   uint32_t max_image_dimension_2d = 0;
+  uint32_t sub_texel_precision_bits = 4;  //!< VkPhysicalDeviceLimits::subTexelPrecisionBits (at least 4)
   float timestamp_period_ns = 0.0f;  //!< nanoseconds per timestamp tick
   bool timestamps_supported = false;
 };

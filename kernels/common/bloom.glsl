@@ -28,6 +28,26 @@ vec3 soft_threshold(vec3 c, float threshold, float knee) {
 
 ivec2 g_src_size;
 
+// Position in the source of size `s` of texel x of the destination of size `d`, one axis
+// (docs/BLOOM.md "Notation", dual). Between n and floor(n / 2) texels the dual filter maps with the
+// exact ratio 2 (or 1/2), the grids aligned at texel 0 (at odd n the larger one's last texel lies
+// past the smaller grid's end and is read through the clamp). Every tap then sits on a corner
+// between texels, where each sub-sum of the 2-D taps carries the same mass whatever a point's
+// position; the same-UV map (ratio n / floor(n / 2), slightly above 2) lets the mass of the
+// diagonal taps, which couple the axes, depend on a point's row, and moved a point's glow along x
+// by up to 2 pixels at 960x540. At even n both maps are the same bit for bit.
+float dual_map_1d(int x, int d, int s) {
+  if (s > 1 && d == s / 2) return 2.0 * float(x) + 0.5;
+  if (d > 1 && s == d / 2) return (float(x) + 0.5) * 0.5 - 0.5;
+  return (float(x) + 0.5) * (float(s) / float(d)) - 0.5;
+}
+
+// map_position() for every filter but dual, dual_map_1d() per axis for dual.
+vec2 level_map(ivec2 xy, ivec2 dst, ivec2 src) {
+  if (FILTER != GLINT_BLOOM_DUAL) return map_position(xy, dst, src);
+  return vec2(dual_map_1d(xy.x, dst.x, src.x), dual_map_1d(xy.y, dst.y, src.y));
+}
+
 vec3 src_at(ivec2 ij) { return source_texel(clamp(ij, ivec2(0), g_src_size - 1)); }
 
 vec3 src_bilinear(vec2 pos) {
@@ -67,7 +87,7 @@ vec3 downsample(ivec2 xy, ivec2 dst_size, bool karis) {
     }
     return sum / wsum;
   }
-  vec2 c = map_position(xy, dst_size, g_src_size);
+  vec2 c = level_map(xy, dst_size, g_src_size);
   if (FILTER == GLINT_BLOOM_DUAL) {
     add_box(sum, wsum, src_bilinear(c), 0.5, karis);
     add_box(sum, wsum, src_bilinear(c + vec2(-1, -1)), 0.125, karis);

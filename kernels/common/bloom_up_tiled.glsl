@@ -37,8 +37,8 @@ vec3 upsample_tiled(texture2D small, ivec2 small_size, ivec2 dst_size, float rad
   ivec2 first = ivec2(gl_GlobalInvocationID.xy - gl_LocalInvocationID.xy);
   ivec2 last = min(ivec2(first.x + int(gl_WorkGroupSize.x) - 1, first.y + int(gl_WorkGroupSize.y) - 1), dst_size - 1);
   float reach = FILTER == GLINT_BLOOM_GAUSS9 ? 0.0 : radius;
-  ivec2 lo = ivec2(floor((vec2(first) + 0.5) * scale - 0.5 - reach));
-  ivec2 hi = ivec2(floor((vec2(last) + 0.5) * scale - 0.5 + reach)) + 1;
+  ivec2 lo = ivec2(floor(level_map(first, dst_size, small_size) - reach));
+  ivec2 hi = ivec2(floor(level_map(last, dst_size, small_size) + reach)) + 1;
   ivec2 win = hi - lo + 1;
   for (uint i = gl_LocalInvocationIndex; i < uint(win.x * win.y); i += UP_GROUP_SIZE) {
     ivec2 t = ivec2(int(i) % win.x, int(i) / win.x);
@@ -46,7 +46,7 @@ vec3 upsample_tiled(texture2D small, ivec2 small_size, ivec2 dst_size, float rad
   }
   barrier();
   ivec2 xy = min(ivec2(gl_GlobalInvocationID.xy), dst_size - 1);  // outside: any valid texel
-  vec2 c = map_position(xy, dst_size, small_size);
+  vec2 c = level_map(xy, dst_size, small_size);
   if (FILTER == GLINT_BLOOM_DUAL) {
     vec3 edges = bilinear_window(c + radius * vec2(-1, 0), lo) + bilinear_window(c + radius * vec2(1, 0), lo) +
                  bilinear_window(c + radius * vec2(0, -1), lo) + bilinear_window(c + radius * vec2(0, 1), lo);
