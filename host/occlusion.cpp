@@ -334,14 +334,15 @@ struct LightCuller::Impl {
   uint32_t max_groups_y = kMaxGroupsX;
   uint32_t scan_threads = 1;  // the scan's single workgroup
   // The three dispatches of a cull (docs/OCCLUSION.md): cull + grid test, scan, scatter.
-  detail::ComputePipeline cull, scan, scatter;
+  detail::ComputePipeline cull, scan_tiles, scan, scatter;
   // Header counters and one uvec4 per workgroup (occlusion.h), and one vec4 record per light.
   detail::OwnedBuffer groups, records;
   Buffer groups_state, records_state;
   bool counters_cleared = false;
   // Descriptor sets per distinct set of caller resources, made on first use and kept.
   struct Sets {
-    VkDescriptorSet cull = VK_NULL_HANDLE, scan = VK_NULL_HANDLE, scatter = VK_NULL_HANDLE;
+    VkDescriptorSet cull = VK_NULL_HANDLE, scan_tiles = VK_NULL_HANDLE, scan = VK_NULL_HANDLE,
+                    scatter = VK_NULL_HANDLE;
   };
   // Sets by the resources they name: the depth and Hi-Z views and (buffer, offset, size) of the
   // lights, instances, results, indirect and stats buffers. A fixed-size key: no allocation.
@@ -393,6 +394,10 @@ LightCuller::LightCuller(const Context& context, const LightCullConfig& config) 
   sc.push_constant_bytes = sizeof(GlintCullCompactPush);
   sc.workgroup = {m.scan_threads, 1};
   m.scan = detail::ComputePipeline(context, sc);
+  detail::PipelineDesc st = sc;
+  st.kernel_id = "light_cull_scan_tiles_main";
+  st.bindings = {B};
+  m.scan_tiles = detail::ComputePipeline(context, st);
   detail::PipelineDesc sp;
   sp.kernel_id = "light_cull_scatter_main";
   sp.bindings = {B, B, B, B, B};
@@ -497,6 +502,7 @@ void LightCuller::record(VkCommandBuffer cmd, HiZPyramid& hiz, Image& depth, Buf
     n[1].buffer = out.indirect;
     n[2].buffer = out.stats;
     s.scan = m.allocate(m.scan, n);
+    s.scan_tiles = m.allocate(m.scan_tiles, {n[0]});
     std::vector<detail::DescriptorArena::AnyBinding> p(5);
     p[0].buffer = lights;
     p[1].buffer = m.records_state;
@@ -548,6 +554,16 @@ void LightCuller::record(VkCommandBuffer cmd, HiZPyramid& hiz, Image& depth, Buf
   cp.groups_per_instance = frame.groups_per_instance;
   cp.flags = flags;
   cp.max_group_count_x = m.max_groups_x;
+  cp.tile_groups = m.scan_threads;
+  // 2a. Tiles of scan_threads groups in parallel: slots within each tile, tile totals.
+  const uint32_t group_count = (count + kCullGroup - 1) / kCullGroup;
+  if (group_count > 0) {
+    b.use(m.groups_state, kCompute, kStorageRead | kStorageWrite);
+    b.flush(cmd);
+    m.scan_tiles.dispatch(cmd, sets.scan_tiles, cp, (group_count + m.scan_threads - 1) / m.scan_threads * m.scan_threads,
+                          1);
+  }
+  // 2b. One workgroup: the tiles' first slots, arguments, statistics.
   b.use(m.groups_state, kCompute, kStorageRead | kStorageWrite);
   b.use(out.indirect, kCompute, kStorageWrite);
   b.use(out.stats, kCompute, kStorageWrite);

@@ -2,7 +2,8 @@
 #extension GL_GOOGLE_include_directive : require
 // The last dispatch of the order-preserving compaction (issue 6): one invocation per light. A
 // visible light (its bit set in its workgroup's mask, light_cull.comp) takes the slot
-// first slot of the workgroup (light_cull_scan.comp) + visible lights before it in the mask (a bit
+// first slot of its tile (light_cull_scan.comp) + the group's slot within the tile
+// (light_cull_scan_tiles.comp) + visible lights before it in the mask (a bit
 // count), so visible lights fill the instance buffer in increasing light index on every run: no
 // atomic decides the order. Slots at or beyond the capacity are not written; those lights become
 // GLINT_FLARE_OVERFLOW, so the instances kept are the visible lights with the smallest indices.
@@ -16,7 +17,7 @@ layout(std430, binding = 0) readonly buffer Lights { GlintFlareLight lights[]; }
 layout(std430, binding = 1) readonly buffer Records { vec4 records[]; };  // centre.xy, fraction, ndc z
 layout(std430, binding = 2) readonly buffer Groups {
   uint counters[GLINT_CULL_HEADER_WORDS];
-  uvec4 groups[];  // visibility mask (x, y), first slot (z), 0
+  uvec4 groups[];  // visibility mask (x, y), slot within the tile (z), tile's first slot on its first group (w)
 };
 layout(std430, binding = 3) writeonly buffer Instances { GlintFlareInstance instances[]; };
 layout(std430, binding = 4) writeonly buffer Results { GlintFlareLightResult results[]; };
@@ -31,7 +32,8 @@ void main() {
   const uint bit = b & 31u;
   if (((word >> bit) & 1u) == 0u) return;
   const uint before = uint(bitCount(word & ((1u << bit) - 1u))) + (b < 32u ? 0u : uint(bitCount(g.x)));
-  const uint slot = g.z + before;
+  // The tile's first slot (light_cull_scan.comp) + the group's within the tile + the bits before.
+  const uint slot = groups[(i / GLINT_CULL_GROUP) / pc.tile_groups * pc.tile_groups].w + g.z + before;
   const vec4 record = records[i];
   uint state = GLINT_FLARE_VISIBLE;
   if (slot < pc.capacity) {

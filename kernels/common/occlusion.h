@@ -74,7 +74,8 @@ struct GlintCullCompactPush {
   GLINT_UINT groups_per_instance;  // scan: the dispatch arguments cover instances x this groups
   GLINT_UINT flags;                // scatter: GLINT_CULL_WRITE_RESULTS
   GLINT_UINT max_group_count_x;    // scan: the device's maxComputeWorkGroupCount[0]
-  GLINT_UINT reserved[2];
+  GLINT_UINT tile_groups;          // scans and scatter: 64-light groups per tile of the two-level scan
+  GLINT_UINT reserved;
 };
 
 #endif
