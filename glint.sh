@@ -102,8 +102,8 @@ asan_test() {
 
 # GPU-assisted validation (instrumented shaders check buffer and descriptor accesses on the
 # device) on the tests that compare every kernel with its reference (13 tests, 26 s in Release on
-# 2 cores): the whole GPU suite under it would add minutes that CI's ten do not have (issue 6:
-# "if it runs in time").
+# 2 cores): the whole GPU suite under it would add minutes that CI's ten-minute budget does not
+# have.
 GPU_AV_TESTS="MatchesReference|MatchesItsReference|MatchesTheReference|MatchesTheFloat64|BatchKernelMatchesTheCppTwin|StatisticsAndResultsMatch"
 gpu_assisted_tests() {
   local dir="$1"; shift
@@ -124,7 +124,7 @@ run_fuzz() {
   for src in fuzz/fuzz_*.cpp; do
     name="$(basename "$src" .cpp)"
     work="$(mktemp -d)"
-    log "fuzzing $name for ${seconds}s (seed corpus fuzz/corpus/${name#fuzz_})"
+    log "fuzzing $name for ${seconds}s (starting corpus fuzz/corpus/${name#fuzz_})"
     # OpenEXR may reserve (not touch) up to 2 GiB for an attribute's declared size before it finds
     # the file too short: allow that allocation, stop anything larger.
     "$dir/fuzz/$name" -max_total_time="$seconds" -malloc_limit_mb=2100 -rss_limit_mb=3072 -print_final_stats=1 \

@@ -18,8 +18,8 @@ const Context& context() {
   return *ctx;
 }
 
-CpuImage random_hdr(uint32_t width, uint32_t height, uint32_t seed) {
-  std::mt19937 rng(seed);
+CpuImage random_hdr(uint32_t width, uint32_t height, uint32_t stream) {
+  std::mt19937 rng(stream);
   std::uniform_real_distribution<float> base(0.0f, 1.5f), unit(0.0f, 1.0f);
   CpuImage img(width, height);
   for (size_t i = 0; i < size_t(width) * height; ++i) {

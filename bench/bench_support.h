@@ -12,7 +12,7 @@ namespace glint::bench {
 
 const Context& context();
 /// Random HDR RGBA: values in [0, 1.5) with 2% of pixels between 2 and 40.
-CpuImage random_hdr(uint32_t width, uint32_t height, uint32_t seed);
+CpuImage random_hdr(uint32_t width, uint32_t height, uint32_t stream);
 double median_of(std::vector<double> values);
 
 /// Records `frames` calls of `record_frame` in one command buffer with a timestamp after each, runs

@@ -1,4 +1,4 @@
-// Bloom benchmarks: GPU time from timestamp queries as manual time (STYLE rule 11), bytes/s over
+// Bloom benchmarks: GPU time from timestamp queries as manual time (CONTRIBUTING.md, "Benchmarks"), bytes/s over
 // the bytes-moved floor, and the error against the float64 reference as a counter.
 //
 // Each iteration records kFramesPerIteration blooms back to back in one command buffer with a

@@ -1,16 +1,16 @@
-// Lens-flare draw benchmarks (issue 5, drawing half): GPU time from timestamp queries as manual
-// time (STYLE rule 11) for the raster path (one vkCmdDrawIndirect) and the compute path (indirect
-// gather) into a 1920x1080 RGBA16F image, for 10 lights (the seed's budget: 50 us) and 1000
+// Lens-flare draw benchmarks: GPU time from timestamp queries as manual time (CONTRIBUTING.md,
+// "Benchmarks") for the raster path (one vkCmdDrawIndirect) and the compute path (indirect
+// gather) into a 1920x1080 RGBA16F image, for 10 lights (budget 50 us, docs/PERF.md) and 1000
 // lights. The instance and indirect buffers are device-local and filled once, as the cull would
 // leave them; the frame measured is the draw alone.
 //
 // Light sizes (argument `sizes`):
-// - 0, the original configuration: 10 lights of 40 to 160 px (around the seed's default "Light
-//   Size" of 100), 1000 lights of 8 to 48 px (street lamps in the distance).
-// - 1, mixed: sizes log-uniform over 10 to 100 px, the lower part of the seed's 10 to 500 range
-//   ("Typical | 10-20 lights | Mixed sizes"). Each light covers about 22 size^2 pixels with its
+// - 0, the first configuration: 10 lights of 40 to 160 px (around the default flare size of
+//   100 px), 1000 lights of 8 to 48 px (street lamps in the distance).
+// - 1, mixed: sizes log-uniform over 10 to 100 px, the lower part of the 10 to 500 px range
+//   docs/FLARE.md designs for (a typical scene: 10 to 20 lights of mixed sizes). Each light covers about 22 size^2 pixels with its
 //   nine sprites (docs/FLARE.md), so the 10 lights of configuration 0 cover 2.06 M sprite pixels,
-//   40 times the seed's "100x100 quad x 10 lights, half covered" estimate.
+//   40 times a naive "100x100 quad x 10 lights, half covered" estimate.
 // 0 lights measures the fixed cost of each path.
 //
 // Counters: median_us, sprite_pixels (pixels the sprites cover on screen, from the float64

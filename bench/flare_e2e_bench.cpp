@@ -1,5 +1,5 @@
-// Lens flares end to end (issue 5 speed target: 10 lights at 1920x1080, Hi-Z + cull + draw, at most
-// 30 us median GPU time on the H100): LensFlarePass::record() on device-local resources, i.e. the
+// Lens flares end to end (speed target in docs/PERF.md: 10 lights at 1920x1080, Hi-Z + cull + draw,
+// at most 30 us median GPU time on the H100): LensFlarePass::record() on device-local resources, i.e. the
 // Hi-Z build of a D32 depth buffer, the cull + 4x4 occlusion grid + compaction, the finalize kernel
 // and the indirect draw (raster: vkCmdDrawIndirect; compute: splat + resolve), into an RGBA16F
 // image. GPU time from timestamps as manual time (median of the frames of one command buffer).

@@ -1,4 +1,4 @@
-// Lens-flare visibility benchmarks (issue 5 speed targets): the Hi-Z build of a D32 depth buffer,
+// Lens-flare visibility benchmarks (speed targets in docs/PERF.md): the Hi-Z build of a D32 depth buffer,
 // and the cull + occlusion grid + compaction of a light list, on device-local resources. GPU time
 // from timestamps as manual time (median of the frames of one command buffer), bytes/s over the
 // bytes each stage must move, and error counters against the float64 references:
@@ -117,7 +117,7 @@ void BM_LightCull(benchmark::State& state) {
   const bool with_hiz = state.range(3) != 0;
   const Context& ctx = context();
   const uint32_t w = 1920, h = 1080;
-  // Flares of 8 to 128 pixels (the seed's default is 100).
+  // Flares of 8 to 128 pixels (the default flare size is 100).
   const auto scene = scene_for(w, h, n, 128.0);
   auto depth = make_depth(ctx, scene.depth);
   HiZConfig hc;

@@ -10,7 +10,7 @@ relative L2 error versus the float64 reference (y).
     python3 bench/plot.py --size 1920x1080 --out docs/charts/bloom_pareto.svg \
         "H100=docs/perf/bloom_h100.json" "lavapipe=docs/perf/bloom_lavapipe.json"
 
---chart blur: the Gaussian blur's speed against accuracy (issue 3), one series per method, the method
+--chart blur: the Gaussian blur's speed against accuracy, one series per method, the method
 being the benchmark name's prefix BM_Blur<Method> (BM_BlurSeparable/..., BM_BlurDual/...). Each run
 with a `rel_l2` counter (relative L2 against the exact Gaussian) is one point: median GPU time (x,
 the `median_us` counter or else the run's time) against rel_l2 (log y), labelled with its `sigma`

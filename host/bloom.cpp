@@ -21,7 +21,7 @@ namespace glint {
 using detail::check_range;
 using detail::concat;
 
-// The GLSL push-constant block must match byte for byte (STYLE rule 2).
+// The GLSL push-constant block must match byte for byte (CONTRIBUTING.md, "Shared structs").
 static_assert(sizeof(BloomPush) == 48, "BloomPush layout changed: update kernels/common/bloom_params.h users");
 static_assert(offsetof(BloomPush, threshold) == 16);
 static_assert(offsetof(BloomPush, composite_scale) == 32);

@@ -1,4 +1,4 @@
-// Blur drivers (docs/BLUR.md): BlurPyramid (seed 003) and GaussianBlur. Both are a list of
+// Blur drivers (docs/BLUR.md): BlurPyramid (three cumulative levels) and GaussianBlur. Both are a list of
 // steps planned once per size (pipeline, descriptor set, push constants, image in, image out)
 // that record() walks, writing the barriers between them.
 #include <glint/blur.h>
@@ -106,7 +106,7 @@ uint32_t fused_shared_bytes(FusedShape s, uint32_t radius, bool half_shared) {
   return (half_shared ? 8 : 16) * (padded(w + 2 * radius) * (h + 2 * radius) + padded(w) * (h + 2 * radius));
 }
 
-// The largest tile whose shared memory fits the device (STYLE rule 3): larger tiles re-read less
+// The largest tile whose shared memory fits the device (CONTRIBUTING.md, "Device limits"): larger tiles re-read less
 // apron. CPU devices (lavapipe) get 8-row-high tiles, which keep their per-thread groups small.
 FusedShape fused_shape(const DeviceInfo& info, uint32_t radius, bool half_shared = false) {
   static const FusedShape gpu[] = {{{32, 8}, 4}, {{32, 8}, 2}, {{32, 8}, 1}, {{16, 8}, 2}, {{16, 8}, 1}, {{8, 8}, 1}};

@@ -9,7 +9,7 @@
 namespace glint::blur_plan {
 
 /// Truncation c (in sigmas) of the Gaussian taps (docs/BLUR.md "Gaussian taps from sigma"):
-/// BlurPyramid (seed 003) cuts at 3 sigma, GaussianBlur at 4 sigma.
+/// BlurPyramid cuts at 3 sigma, GaussianBlur at 4 sigma.
 inline constexpr double kPyramidTruncation = 3.0;
 inline constexpr double kGaussTruncation = 4.0;
 /// The largest radius the fused level kernel takes (docs/BLUR.md "Fused level blur").

@@ -67,7 +67,7 @@ void record_starfield(const Context& context, VkCommandBuffer cmd, Image& target
   const double area = double(target.extent.width) * target.extent.height;
   p.star_probability = 0.8f;
   p.cell_px = std::max(3, static_cast<int32_t>(std::lround(std::sqrt(area * 0.8 / params.stars))));
-  p.seed = params.seed;
+  p.variant = params.variant;
   p.min_brightness = params.min_brightness;
   p.max_brightness = params.max_brightness;
   p.sun_brightness = params.sun_brightness;

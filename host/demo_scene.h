@@ -1,5 +1,5 @@
 // The built-in demo scene: an HDR starfield and sun generated on the GPU
-// (kernels/demo_starfield.comp), and for the lens flares (issue 5) a depth buffer with occluders
+// (kernels/demo_starfield.comp), and for the lens flares a depth buffer with occluders
 // and a light list in front of and behind them, generated on the CPU (make_flare_scene).
 #pragma once
 
@@ -17,7 +17,7 @@ struct StarfieldParams {
   float min_brightness = 0.05f;  //!< dimmest star (> 0)
   float max_brightness = 50.0f;  //!< brightest star (>= min_brightness)
   float sun_brightness = 60.0f;  //!< sun disc brightness (10 to 100)
-  uint32_t seed = 1;
+  uint32_t variant = 1;          //!< which random starfield (any value; the same value gives the same stars)
 };
 
 /// Records the starfield and sun into `target` (RGBA16F or RGBA32F with STORAGE usage) and

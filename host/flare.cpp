@@ -1,4 +1,4 @@
-// Lens-flare driver (issue 5, drawing half): validates, generates the element atlas, owns the
+// Lens-flare driver, the drawing half: validates, generates the element atlas, owns the
 // raster and compute pipelines, and records either path. docs/FLARE.md explains the choices.
 #include <cstdio>
 #include <glint/flare.h>

@@ -1,5 +1,5 @@
-// LensFlarePass: HiZPyramid + LightCuller + LensFlare and the buffers between them (issue 5,
-// include/glint/flare_pass.h). Nothing here is new GPU work: the cull is told the draw's
+// LensFlarePass: HiZPyramid + LightCuller + LensFlare and the buffers between them
+// (include/glint/flare_pass.h). Nothing here is new GPU work: the cull is told the draw's
 // vertices_per_instance() and groups_per_instance() (docs/FLARE.md, "Interface with the visibility
 // stage"), and each part writes its own barriers from the buffers' state fields, so the frame is
 // Hi-Z -> cull -> scan -> scatter -> draw on one command buffer with no readback.

@@ -24,7 +24,7 @@ namespace glint {
 using detail::check_range;
 using detail::concat;
 
-// The GLSL push-constant blocks must match byte for byte (STYLE rule 2).
+// The GLSL push-constant blocks must match byte for byte (CONTRIBUTING.md, "Shared structs").
 static_assert(sizeof(GlintHiZPush) == 32);
 static_assert(offsetof(GlintHiZPush, counter_index) == 24);
 static_assert(sizeof(GlintCullPush) == 112);
@@ -370,7 +370,7 @@ LightCuller::LightCuller(const Context& context, const LightCullConfig& config) 
   m.context = &context;
   m.config = config;
   m.arena = detail::DescriptorArena(context, 16, 8);
-  // The group limit and the scan's workgroup size from the device (STYLE rule 3).
+  // The group limit and the scan's workgroup size from the device (CONTRIBUTING.md, "Device limits").
   VkPhysicalDeviceProperties props;
   vkGetPhysicalDeviceProperties(context.physical_device(), &props);
   m.max_groups_x = props.limits.maxComputeWorkGroupCount[0];

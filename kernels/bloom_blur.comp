@@ -1,7 +1,7 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_samplerless_texture_functions : require
-// One direction of the seed's separable 9-tap Gaussian (seed 001: weights for sigma ~ 1.5) at a
+// One direction of a separable 9-tap Gaussian (binomial weights, sigma about 1.5) at a
 // pyramid level, taps at t * radius texels read by linear interpolation (docs/BLOOM.md, gauss9).
 layout(local_size_x_id = 0, local_size_y_id = 1) in;
 

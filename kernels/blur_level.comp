@@ -2,7 +2,7 @@
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_samplerless_texture_functions : require
 #extension GL_EXT_control_flow_attributes : require
-// Fused level blur B(src, wd, hd, sigma) of docs/BLUR.md (seed 003's per-level separable Gaussian,
+// Fused level blur B(src, wd, hd, sigma) of docs/BLUR.md (the per-level separable Gaussian,
 // in one dispatch instead of two): the workgroup loads its tile plus an apron of RADIUS texels
 // into shared memory once (downsampling the source as it loads), runs the horizontal pass in
 // shared memory, then the vertical pass, and writes every output texel once.

@@ -1,6 +1,6 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
-// The demo scene (issue 2, seed 001): an HDR starfield with brightness from 0.05 to 50 and a sun
+// The demo scene: an HDR starfield with brightness from 0.05 to 50 and a sun
 // of brightness 10 to 100, generated on the GPU. Each cell of cell_px pixels may hold one star at
 // a hashed position; stars are small Gaussians (sigma 0.6 px) so they are not aliased dots.
 layout(local_size_x_id = 0, local_size_y_id = 1) in;
@@ -30,7 +30,7 @@ void main() {
   for (int dy = -1; dy <= 1; ++dy) {
     for (int dx = -1; dx <= 1; ++dx) {
       ivec2 cc = cell + ivec2(dx, dy);
-      uint state = hash(uint(cc.x) * 73856093u ^ uint(cc.y) * 19349663u ^ p.seed * 83492791u);
+      uint state = hash(uint(cc.x) * 73856093u ^ uint(cc.y) * 19349663u ^ p.variant * 83492791u);
       if (rand01(state) > p.star_probability) continue;
       vec2 centre = (vec2(cc) + vec2(rand01(state), rand01(state))) * float(p.cell_px);
       // Log-uniform brightness: many dim stars, a few bright ones.

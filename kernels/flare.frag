@@ -1,6 +1,6 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
-// Shades one lens-flare sprite (issue 5 "Raster path"): the shared look function at the pixel
+// Shades one lens-flare sprite (docs/FLARE.md, "The two paths": raster): the shared look function at the pixel
 // centre, premultiplied alpha, added to the HDR image by ONE/ONE blending (flares only add light;
 // alpha is masked out of the write, so the image's alpha is kept).
 #include "flare_look.glsl"

@@ -1,6 +1,6 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
-// Lens-flare billboards (issue 5 "Raster path", seed 004 "Instanced Rendering"): one instanced
+// Lens-flare billboards (docs/FLARE.md, "The two paths": raster, instanced): one instanced
 // draw for all lights. The instance buffer is read by gl_InstanceIndex (no vertex buffers); each
 // instance expands to GLINT_FLARE_SPRITES screen-aligned rectangles, gl_VertexIndex / 6 picking
 // the sprite and gl_VertexIndex % 6 the corner. The rectangle is drawn one pixel larger on every

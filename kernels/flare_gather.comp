@@ -1,7 +1,7 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_control_flow_attributes : require
-// Lens flares for compute-only engines (issue 5 "Compute path"), accumulated by gathering: one
+// Lens flares for compute-only engines (docs/FLARE.md, "The two paths": compute), accumulated by gathering: one
 // workgroup per screen tile of GLINT_FLARE_GATHER_ROWS x workgroup pixels (each invocation keeps
 // its column's pixels in registers), no atomics on the image or on any global buffer.
 // 1. Binning: invocation t takes instance base + t (the count is instance_count of the indirect
@@ -9,7 +9,7 @@
 //    lists each of its sprites whose conservative rectangle (glint_flare_bounds) meets the tile in
 //    a shared list, at a position given by an exclusive prefix sum of the invocations' hit counts
 //    (Hillis & Steele 1986, in shared memory): the list is in (instance, slot) order, the order the
-//    raster path draws in, on every run (issue 6: no atomic decides the order of the sums).
+//    raster path draws in, on every run: no atomic decides the order of the sums, so every run gives the same bits.
 // 2. Sprites: the list is turned into GlintFlareSprite (glint_flare_sprite, the function flare.vert
 //    evaluates) in chunks of one per invocation, kept in shared memory.
 // 3. Shading: every invocation adds glint_flare_shade (the function flare.frag evaluates) of every

@@ -1,7 +1,7 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
-// The compute path's launch arguments (issue 5: the compute path is launched with
-// vkCmdDispatchIndirect): one invocation reads the instance count the compaction wrote and
+// The compute path's launch arguments (the compute path is launched with
+// vkCmdDispatchIndirect, so the host never reads the count back): one invocation reads the instance count the compaction wrote and
 // writes the gather's VkDispatchIndirectCommand: every screen tile when any instance is visible,
 // no workgroup at all when none is (so a frame without visible lights costs the gather nothing).
 // The count never leaves the GPU.

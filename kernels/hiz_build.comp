@@ -1,7 +1,7 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
-// Hi-Z depth pyramid in one dispatch, in the manner of AMD FidelityFX SPD (issue 5, seed 004
-// "Method 3"): every workgroup reduces a 64x64 tile of the base level through up to six levels in
+// Hi-Z depth pyramid in one dispatch, in the manner of AMD FidelityFX SPD (docs/OCCLUSION.md,
+// "Hi-Z pyramid"): every workgroup reduces a 64x64 tile of the base level through up to six levels in
 // shared memory; the last workgroup to finish (found with an atomic counter after a memory barrier
 // on the images) reduces the remaining levels from the 64x64-or-smaller level it can then see.
 // Each texel holds the farthest depth it covers (max for standard Z, min for reversed Z).
@@ -276,7 +276,8 @@ void main() {
   if (pc.tail_levels == 0u) return;  // uniform: a push constant
 
   // Make this group's stores visible, then count it. Without the image barrier before the atomic,
-  // the last group may read stale texels (FidelityFX SPD issue #13).
+  // the last group may read stale texels (reported against FidelityFX SPD:
+  // https://github.com/GPUOpen-Effects/FidelityFX-SPD/issues/13).
   memoryBarrierImage();
   memoryBarrierBuffer();
   barrier();

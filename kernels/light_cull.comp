@@ -1,9 +1,9 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_samplerless_texture_functions : require
-// Cull and occlusion grid test of the lens-flare lights (issue 5; seed 004 "Method 4", grid test on
-// the Hi-Z of "Method 3"), the first of the three dispatches of the order-preserving compaction
-// (issue 6). One invocation per light, GLINT_CULL_GROUP per workgroup:
+// Cull and occlusion grid test of the lens-flare lights (docs/OCCLUSION.md: a grid test on
+// the Hi-Z), the first of the three dispatches of the order-preserving compaction (the same
+// instance order on every run). One invocation per light, GLINT_CULL_GROUP per workgroup:
 // 1. reject disabled lights and lights with a non-finite float field (GLINT_FLARE_DISABLED), then
 //    project (Vulkan conventions) and reject w <= 0, non-finite clip coordinates, depth outside
 //    [0, 1] and |ndc.xy| > margin (GLINT_FLARE_FRUSTUM);

@@ -1,6 +1,6 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
-// The last dispatch of the order-preserving compaction (issue 6): one invocation per light. A
+// The last dispatch of the order-preserving compaction: one invocation per light. A
 // visible light (its bit set in its workgroup's mask, light_cull.comp) takes the slot
 // first slot of its tile (light_cull_scan.comp) + the group's slot within the tile
 // (light_cull_scan_tiles.comp) + visible lights before it in the mask (a bit

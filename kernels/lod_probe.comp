@@ -1,6 +1,6 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
-// Asks the device's own sampler for the LOD of each query (issue 4, "Checked against the
+// Asks the device's own sampler for the LOD of each query (docs/LOD.md, "Measured on
 // hardware"): textureGrad on an atlas whose level i holds the value i, trilinear, anisotropy off,
 // so the returned value is the level the sampler used. The sub-texture derivatives are carried to
 // atlas UV by the chain rule: d(atlas_u) = d(u) * tex_w / atlas_w.

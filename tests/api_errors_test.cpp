@@ -1,4 +1,4 @@
-// Bad input at every public entry point (issue 6, "Bad input and the API"), as one table: each row
+// Bad input at every public entry point, as one table: each row
 // calls one entry point with one bad argument, and must throw glint::Error with the expected code
 // and a message naming the parameter and what is accepted, having recorded no command, created no
 // Vulkan object and left the images' and buffers' state fields as they were. Then memory: a
@@ -194,7 +194,7 @@ std::vector<ApiCase> api_cases() {
                      }});
   }
 
-  // Blur (issue 3): config fields, prepare sizes and images, as for bloom. In-place rows do not
+  // Blur: config fields, prepare sizes and images, as for bloom. In-place rows do not
   // apply (GaussianBlur refuses input == output with its own row; BlurPyramid writes its own
   // levels).
   struct PyramidField {

@@ -1,5 +1,5 @@
-// Bloom on the GPU (lavapipe in CI) against the float64 reference, and the properties the seeds
-// ask for, measured on real GPU output. Validation with synchronization validation is on for
+// Bloom on the GPU (lavapipe in CI) against the float64 reference, and the properties
+// docs/BLOOM.md promises, measured on real GPU output. Validation with synchronization validation is on for
 // every test (support/gpu_test.h fails a test on any message).
 #include <glint/bloom.h>
 
@@ -91,7 +91,7 @@ CpuImage point_source(uint32_t w, uint32_t h, uint32_t px, uint32_t py, float va
   return img;
 }
 
-TEST_F(BloomTest, MipChainOf1080pMatchesTheSeed) {
+TEST_F(BloomTest, MipChainOf1080pHalvesDownTo60x33) {
   auto chain = bloom_mip_chain({1920, 1080}, 5);
   const std::vector<std::pair<uint32_t, uint32_t>> expected = {{960, 540}, {480, 270}, {240, 135}, {120, 67}, {60, 33}};
   ASSERT_EQ(chain.size(), expected.size());
@@ -127,7 +127,7 @@ TEST_F(BloomTest, IterationsAreClampedAtSmallSizesAndReported) {
 }
 
 // Every filter and precision against the float64 reference on random HDR input at an odd size.
-// Tolerances (issue 2): fp32 intermediates 1e-3 relative L2 (fp32 arithmetic lands far below);
+// Tolerances: fp32 intermediates 1e-3 relative L2 (fp32 arithmetic lands far below);
 // fp16 5e-3 (each fp16 store rounds by up to 2^-11 relative, and the chain stores ~2N times).
 TEST_F(BloomTest, MatchesReferenceForEveryFilterAndPrecision) {
   const CpuImage input = random_hdr(97, 61, 7);
@@ -291,7 +291,7 @@ TEST_F(BloomTest, DimPixelsFarFromBrightOnesAreUnchanged) {
   }
 }
 
-// Issue 6, "Range": the output is finite everywhere, also where the scene itself is not. A NaN
+// Range: the output is finite everywhere, also where the scene itself is not. A NaN
 // scene channel counts as 0; the sum is clamped to +-65504 for an RGBA16F output (so a bright
 // scene plus bloom does not round to Inf) and to +-FLT_MAX for RGBA32F (docs/BLOOM.md "Composite").
 TEST_F(BloomTest, NonFiniteAndHugeScenePixelsGiveAFiniteOutput) {
@@ -327,7 +327,7 @@ TEST_F(BloomTest, NonFiniteAndHugeScenePixelsGiveAFiniteOutput) {
   }
 }
 
-// The seed's bug was a vertical streak: the glow of a point must be as wide as it is tall.
+// A classic bloom bug is a vertical streak: the glow of a point must be as wide as it is tall.
 TEST_F(BloomTest, PointSourceGlowIsRadiallySymmetric) {
   const uint32_t n = 257;
   const CpuImage input = point_source(n, n, 128, 128, 1000.0f);

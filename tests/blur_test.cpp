@@ -1,5 +1,5 @@
 // The blur family on the GPU (lavapipe in CI, validation and synchronization validation on)
-// against the float64 reference of docs/BLUR.md, plus the properties issue 3 asks for measured on
+// against the float64 reference of docs/BLUR.md, plus the properties docs/BLUR.md promises, measured on
 // GPU output: constants stay constant, impulse responses are symmetric, sum to 1 and have the
 // expected sigma, odd and degenerate sizes work, and `auto` meets its error bound.
 #include <glint/blur.h>

@@ -1,4 +1,4 @@
-// Lens flares end to end (issue 5) through the public API (LensFlarePass: Hi-Z -> cull -> draw in
+// Lens flares end to end through the public API (LensFlarePass: Hi-Z -> cull -> draw in
 // one command buffer) on a scene with a known occluder: lights behind it add nothing, visible ones
 // add light at their position, the statistics and per-light results match a CPU classification,
 // the raster and compute paths agree within docs/FLARE.md's tolerance, lights behind the camera,

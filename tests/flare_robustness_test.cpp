@@ -1,4 +1,4 @@
-// Robustness of the lens flares and their visibility stage (issue 6), beyond what
+// Robustness of the lens flares and their visibility stage, beyond what
 // occlusion_test.cpp and flare_e2e_test.cpp already cover (zero lights, lights behind the camera,
 // the image of lights at w = 0, overflow counts):
 // - determinism: the Hi-Z pyramid, everything LightCuller writes (instances, indirect arguments,
@@ -85,8 +85,8 @@ struct Scene {
   std::vector<GlintFlareLight> lights;
 };
 
-Scene overlapping_scene(uint32_t w, uint32_t h, uint32_t n, uint32_t seed, float max_size_px) {
-  std::mt19937 rng(seed);
+Scene overlapping_scene(uint32_t w, uint32_t h, uint32_t n, uint32_t stream, float max_size_px) {
+  std::mt19937 rng(stream);
   std::uniform_real_distribution<float> unit(0.0f, 1.0f);
   Scene s;
   s.depth = {w, h, std::vector<float>(size_t(w) * h, 1.0f)};
@@ -675,11 +675,11 @@ TEST_F(FlareRobustnessTest, FlarePassHandlesDegenerateAndThinSizes) {
 TEST_F(FlareRobustnessTest, HiZMatchesTheReferenceAtDegenerateAndThinSizes) {
   const uint32_t max_side = std::min(16384u, context().info().max_image_dimension_2d);
   const VkExtent2D sizes[] = {{1, 1}, {1, 300}, {300, 1}, {4097, 3}, {max_side, 2}, {2, max_side}};
-  uint32_t seed = 41;
+  uint32_t stream = 41;
   for (const VkExtent2D& e : sizes) {
-    const bool reversed = seed % 2 == 1;
-    const VkFormat format = seed % 3 == 0 ? VK_FORMAT_R32_SFLOAT : VK_FORMAT_D32_SFLOAT;
-    std::mt19937 rng(seed++);
+    const bool reversed = stream % 2 == 1;
+    const VkFormat format = stream % 3 == 0 ? VK_FORMAT_R32_SFLOAT : VK_FORMAT_D32_SFLOAT;
+    std::mt19937 rng(stream++);
     std::uniform_real_distribution<float> unit(0.0f, 1.0f);
     reference::DepthImage d{e.width, e.height, std::vector<float>(size_t(e.width) * e.height)};
     for (float& v : d.depth) v = unit(rng);

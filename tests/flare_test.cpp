@@ -1,4 +1,4 @@
-// Lens flares, drawing half (issue 5), on the GPU (lavapipe in CI) against the float64 reference
+// Lens flares, drawing half, on the GPU (lavapipe in CI) against the float64 reference
 // (host/reference/flare_reference.h), and the two paths against each other. The instance and
 // indirect buffers are filled from the CPU through a copy, standing in for the visibility stage,
 // so the barriers from a writer to DRAW_INDIRECT / INDIRECT_COMMAND_READ are exercised. Validation
@@ -120,8 +120,8 @@ CpuImage draw(LensFlare& flare, Path path, const CpuImage& background, VkFormat 
 
 // Random lights over the image and around it: inside, on the edges, partly and fully off screen,
 // sizes 3 to 60 px (tiny ones exercise the coarse atlas levels), HDR colours, fractions, elements.
-std::vector<GlintFlareInstance> random_instances(uint32_t n, uint32_t seed) {
-  std::mt19937 rng(seed);
+std::vector<GlintFlareInstance> random_instances(uint32_t n, uint32_t stream) {
+  std::mt19937 rng(stream);
   std::uniform_real_distribution<float> unit(0.0f, 1.0f);
   std::vector<GlintFlareInstance> out(n);
   for (uint32_t i = 0; i < n; ++i) {

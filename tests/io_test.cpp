@@ -37,8 +37,8 @@ namespace {
 namespace fs = std::filesystem;
 
 // Random HDR colour with a few very bright texels and some tiny ones (half subnormals).
-CpuImage random_image(uint32_t width, uint32_t height, uint32_t seed) {
-  std::mt19937 rng(seed);
+CpuImage random_image(uint32_t width, uint32_t height, uint32_t stream) {
+  std::mt19937 rng(stream);
   std::uniform_real_distribution<float> unit(0.0f, 1.0f);
   CpuImage img(width, height);
   for (float& v : img.rgba) {

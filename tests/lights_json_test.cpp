@@ -64,7 +64,7 @@ TEST(LightsJson, ReadsEveryFieldInFileOrder) {
   EXPECT_EQ(a.enabled, 0u);
   EXPECT_EQ(a.reserved0, 0u);
   EXPECT_EQ(a.reserved1, 0u);
-  // Defaults: colour white, intensity 1, size 100 (the seed's), glow, enabled.
+  // Defaults: colour white, intensity 1, size 100 (kDefaultSizePx), glow, enabled.
   const GlintFlareLight& b = f.lights[1];
   EXPECT_EQ(b.position_z, -1.0f);
   EXPECT_EQ(b.color_r, 1.0f);

@@ -1,8 +1,8 @@
-// Tests of glint's atlas-aware LOD on the CPU (issue 4, docs/LOD.md): the C++ twin of the GLSL
+// Tests of glint's atlas-aware LOD on the CPU (docs/LOD.md): the C++ twin of the GLSL
 // function (host/lod_math.h, the same source as include/glint/gpu/lod.glsl) against the float64
-// reference written from the Vulkan specification (host/reference/lod_reference.h), the seed's
-// cases a to g, and the properties the specification implies. No Vulkan: the GPU's own sampler is
-// compared in tests/lod_test.cpp. Random inputs come from std::mt19937 with fixed seeds.
+// reference written from the Vulkan specification (host/reference/lod_reference.h), the atlas
+// cases a to g of docs/LOD.md, and the properties the specification implies. No Vulkan: the GPU's own sampler is
+// compared in tests/lod_test.cpp. Random inputs come from std::mt19937 started from fixed values.
 #include "lod_math.h"
 #include "reference/lod_reference.h"
 
@@ -24,7 +24,7 @@ namespace ref = glint::reference;
 constexpr float kAtlas = 4096.0f;
 constexpr float kAtlasLevels = 13.0f;  // 4096 -> 1
 constexpr float kAnisoChoices[] = {1.0f, 2.0f, 4.0f, 16.0f};
-constexpr double kTol = 1e-5;  // levels, twin vs reference (issue 4)
+constexpr double kTol = 1e-5;  // levels, twin vs reference (docs/LOD.md, "Float precision of the twin")
 
 GlintLodQuery make_query(float dudx, float dvdx, float dudy, float dvdy, float w, float h, float off_x = 0.0f,
                          float off_y = 0.0f) {
@@ -259,9 +259,9 @@ TEST(LodMath, TwinMatchesFloat64Reference) {
               kCount, interior);
 }
 
-// Seed cases a and b: a 16x16 and a 2048x2048 tile anywhere in a 4096x4096 atlas get the level of
+// Atlas cases a and b: a 16x16 and a 2048x2048 tile anywhere in a 4096x4096 atlas get the level of
 // a standalone texture of the same size, and the level the sampler computes from atlas UV.
-TEST(LodMath, SeedCaseAB_TileInAtlasMatchesStandaloneTexture) {
+TEST(LodMath, AtlasCaseAB_TileInAtlasMatchesStandaloneTexture) {
   std::mt19937 rng(1601u);
   for (float size : {16.0f, 2048.0f}) {
     const float standalone_levels = float(std::log2(size)) + 1.0f;
@@ -298,10 +298,10 @@ TEST(LodMath, SeedCaseAB_TileInAtlasMatchesStandaloneTexture) {
                   2.0f);
 }
 
-// Seed case c: 256x512 agrees with 256x256 when the derivatives are only in u (in both screen
+// Atlas case c: 256x512 agrees with 256x256 when the derivatives are only in u (in both screen
 // directions: du/dy scales by the width, not the height), and is one level higher when they are
 // only in v.
-TEST(LodMath, SeedCaseC_NonSquareScalesUByWidthAndVByHeight) {
+TEST(LodMath, AtlasCaseC_NonSquareScalesUByWidthAndVByHeight) {
   std::mt19937 rng(2560512u);
   const GlintLodAtlas atlas = make_atlas(kAtlas, kAtlas, kAtlasLevels);
   for (int i = 0; i < 3000; ++i) {
@@ -322,9 +322,9 @@ TEST(LodMath, SeedCaseC_NonSquareScalesUByWidthAndVByHeight) {
   EXPECT_FLOAT_EQ(lm::glint_lod_unclamped(make_query(0, 0, 0, 1.0f / 256, 256, 512), atlas), 1.0f);
 }
 
-// Seed case d: a tile at the atlas corner (offset = atlas - size) gets the same level as at the
+// Atlas case d: a tile at the atlas corner (offset = atlas - size) gets the same level as at the
 // origin; one texel further it is outside the atlas and falls back to level 0.
-TEST(LodMath, SeedCaseD_TileAtAtlasCorner) {
+TEST(LodMath, AtlasCaseD_TileAtAtlasCorner) {
   std::mt19937 rng(4095u);
   for (int i = 0; i < 3000; ++i) {
     const GlintLodAtlas atlas = random_atlas(rng);
@@ -343,10 +343,10 @@ TEST(LodMath, SeedCaseD_TileAtAtlasCorner) {
   }
 }
 
-// Seed case e: adjacent tiles with P texels of padding. At the level the function chooses (with
+// Atlas case e: adjacent tiles with P texels of padding. At the level the function chooses (with
 // GLINT_LOD_PADDING_CAP), sampling a box-filtered mip chain bilinearly at tile A's border returns
 // exactly A's colour; one level above the cap does bleed for some layouts.
-TEST(LodMath, SeedCaseE_AdjacentTilesNoBleedAtChosenLevel) {
+TEST(LodMath, AtlasCaseE_AdjacentTilesNoBleedAtChosenLevel) {
   constexpr int kSize = 256;
   const float levels = 9.0f;
   std::mt19937 rng(777u);
@@ -403,9 +403,9 @@ TEST(LodMath, SeedCaseE_AdjacentTilesNoBleedAtChosenLevel) {
               bleed_above_cap);
 }
 
-// Seed case f, REPEAT inside a tile: the shader passes derivatives of the unwrapped UV, and the
+// Atlas case f, REPEAT inside a tile: the shader passes derivatives of the unwrapped UV, and the
 // level shows no jump across a seam; derivatives of fract(uv) (finite differences) would spike.
-TEST(LodMath, SeedCaseF_RepeatSeamsDoNotSpike) {
+TEST(LodMath, AtlasCaseF_RepeatSeamsDoNotSpike) {
   const GlintLodAtlas atlas = make_atlas(kAtlas, kAtlas, kAtlasLevels);
   const float w = 64.0f, h = 32.0f;
   // u(x) = (a x + b) / (c x + 1): a perspective ramp repeating many times across 400 pixels.
@@ -435,11 +435,11 @@ TEST(LodMath, SeedCaseF_RepeatSeamsDoNotSpike) {
   EXPECT_GT(max_step_fract, 3.0) << "fract(uv) differences should spike at seams (the failure this avoids)";
 }
 
-// Seed case g, CLAMP_TO_EDGE: the shader clamps the tile UV to [0, 1], so a minified footprint
+// Atlas case g, CLAMP_TO_EDGE: the shader clamps the tile UV to [0, 1], so a minified footprint
 // sits on the tile's edge. With the padding cap the level stays where the footprint is inside the
 // padding (no bleed); without it the level goes to the top and the edge takes the neighbours'
 // colours.
-TEST(LodMath, SeedCaseG_ClampToEdgeRespectsPadding) {
+TEST(LodMath, AtlasCaseG_ClampToEdgeRespectsPadding) {
   constexpr int kSize = 256;
   const float levels = 9.0f;
   for (int pad : {2, 4, 5, 8, 16}) {
@@ -659,7 +659,7 @@ TEST(LodMath, EveryPathClampsAndInvalidInputGivesLevelZero) {
   }
 }
 
-// The seed's clamp(x, 0.0, 0.0) bug does not exist: a valid query with large derivatives returns
+// No clamp(x, 0.0, 0.0) bug (docs/LOD.md, "The clamp bug"): a valid query with large derivatives returns
 // levels - 1 on every path (isotropic, anisotropic, with bias, with a generous padding cap), also
 // for derivatives so large that the float scale factors overflow.
 TEST(LodMath, LargeDerivativesReachTopLevel) {
@@ -682,7 +682,7 @@ TEST(LodMath, LargeDerivativesReachTopLevel) {
   }
 }
 
-// No magic factor (the seed's 0.35) and no atlas scaling: one tile texel per pixel is level 0,
+// No magic factor (such as 0.35) and no atlas scaling: one tile texel per pixel is level 0,
 // 2^k texels per pixel level k, for any tile size and position; the bias default is 0.
 TEST(LodMath, NoMagicFactorOneTexelPerPixelIsLevelZero) {
   const GlintLodAtlas atlas = make_atlas(kAtlas, kAtlas, kAtlasLevels);

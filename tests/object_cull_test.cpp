@@ -38,7 +38,7 @@ struct SceneSpec {
   bool infinite = false;
   bool flip_y = true;
   uint32_t objects = 1500;
-  uint32_t seed = 1;
+  uint32_t stream = 1;
 };
 
 // A random camera: rotation about a random axis, a translation; a perspective projection.
@@ -253,18 +253,18 @@ std::pair<uint32_t, uint32_t> expect_states(const std::vector<uint32_t>& gpu, co
 }
 
 TEST_F(ObjectCullTest, RandomScenesMatchReference) {
-  uint32_t seed = 11, total_fp = 0, total_hidden = 0, total_visible_gpu = 0;
+  uint32_t stream = 11, total_fp = 0, total_hidden = 0, total_visible_gpu = 0;
   for (bool reversed : {false, true}) {
     for (bool infinite : {false, true}) {
       for (uint32_t cap : {0u, 4u}) {  // full pyramid; capped (wider windows)
         SceneSpec s;
         s.reversed = reversed;
         s.infinite = infinite;
-        s.flip_y = (seed & 1) != 0;
+        s.flip_y = (stream & 1) != 0;
         s.width = cap ? 97 : 160;
         s.height = cap ? 131 : 96;
-        s.seed = seed++;
-        std::mt19937 rng(s.seed);
+        s.stream = stream++;
+        std::mt19937 rng(s.stream);
         const TestCamera cam = make_camera(rng, s);
         const auto depth = make_depth_image(rng, cam, s);
         const auto objs = make_objects(rng, cam, s);

@@ -32,8 +32,8 @@ void to_host(VkCommandBuffer cmd, Buffer& b) {
   barriers.flush(cmd);
 }
 
-reference::DepthImage random_depth(uint32_t w, uint32_t h, uint32_t seed) {
-  std::mt19937 rng(seed);
+reference::DepthImage random_depth(uint32_t w, uint32_t h, uint32_t stream) {
+  std::mt19937 rng(stream);
   std::uniform_real_distribution<float> unit(0.0f, 1.0f);
   reference::DepthImage d{w, h, std::vector<float>(size_t(w) * h)};
   for (float& v : d.depth) v = unit(rng);
@@ -106,12 +106,12 @@ struct HiZCase {
 TEST_F(OcclusionTest, HiZMatchesReferenceAtAllSizes) {
   const HiZCase cases[] = {{1, 1},    {7, 3},    {3, 7},    {2, 1},   {64, 64},  {65, 63},  {127, 129},
                            {130, 67}, {333, 97}, {4097, 2}, {2, 600}, {8200, 2}, {3, 16384}};
-  uint32_t seed = 1;
+  uint32_t stream = 1;
   for (const HiZCase& c : cases) {
     for (VkFormat format : {VK_FORMAT_D32_SFLOAT, VK_FORMAT_R32_SFLOAT}) {
       for (bool reversed : {false, true}) {
         if (format == VK_FORMAT_R32_SFLOAT && (c.w * c.h > 20000)) continue;  // big sizes once per format
-        const auto depth = random_depth(c.w, c.h, seed++);
+        const auto depth = random_depth(c.w, c.h, stream++);
         auto img = make_depth(depth, format);
         HiZConfig config;
         config.extent = {c.w, c.h};
@@ -324,12 +324,12 @@ TEST_F(OcclusionTest, CullMatchesReferenceOnRandomScenes) {
   const SceneCase cases[] = {{257, 143, 600, 4, 120}, {257, 143, 300, 1, 120}, {200, 111, 300, 16, 200},
                              {161, 97, 300, 7, 60},   {1, 1, 40, 4, 10},       {7, 3, 80, 4, 12},
                              {4097, 2, 200, 4, 300}};
-  uint32_t seed = 11;
+  uint32_t stream = 11;
   for (const SceneCase& c : cases) {
     for (bool reversed : {false, true}) {
       // The regular pattern once per case (standard Z): it keeps grid >= brute force too.
       for (int variant : reversed ? std::vector<int>{0} : std::vector<int>{0, 2}) {
-        const auto scene = reference::random_scene(c.w, c.h, c.lights, seed++, reversed, c.max_size);
+        const auto scene = reference::random_scene(c.w, c.h, c.lights, stream++, reversed, c.max_size);
         LightCullConfig config;
         config.grid = c.grid;
         config.capacity = c.lights;
@@ -361,7 +361,7 @@ TEST_F(OcclusionTest, CullMatchesReferenceOnRandomScenes) {
 // has it). UNORM depth is quantized to round(d * (2^bits - 1)) / (2^bits - 1) for the reference,
 // as the GPU reads it. A format the device cannot sample is skipped by name (HiZPyramid refuses it).
 TEST_F(OcclusionTest, CullReadsEveryDepthFormat) {
-  uint32_t seed = 91;
+  uint32_t stream = 91;
   for (VkFormat format : {VK_FORMAT_D16_UNORM, VK_FORMAT_X8_D24_UNORM_PACK32, VK_FORMAT_D24_UNORM_S8_UINT,
                           VK_FORMAT_D32_SFLOAT_S8_UINT}) {
     VkFormatProperties props;
@@ -371,7 +371,7 @@ TEST_F(OcclusionTest, CullReadsEveryDepthFormat) {
       continue;
     }
     const int bits = format == VK_FORMAT_D16_UNORM ? 16 : format == VK_FORMAT_D32_SFLOAT_S8_UINT ? 0 : 24;
-    auto scene = reference::random_scene(161, 97, 300, seed++, false, 60);
+    auto scene = reference::random_scene(161, 97, 300, stream++, false, 60);
     if (bits) {
       const double q = std::ldexp(1.0, bits) - 1.0;
       for (float& v : scene.depth.depth) v = static_cast<float>(std::nearbyint(double(v) * q) / q);
@@ -579,7 +579,8 @@ double oblique_step_bound(double size, uint32_t grid, double slope) {
   return std::min(rows, std::floor(std::fabs(slope) * (rows - 1.0)) + 2.0);
 }
 
-// Issue 5: "the fraction must move in steps no larger than 1/(N x N) as an occluder edge slides".
+// The fraction must move in steps no larger than 1/(N x N) as an occluder edge slides
+// (docs/OCCLUSION.md, "Monotone fading, and the size of the steps").
 // A light slides across an axis-aligned edge (vertical and horizontal, occluder on either side):
 // with multi-jittered samples every footprint edge is at its own offset (spacing size / N^2), so
 // one sample flips at a time (docs/OCCLUSION.md). The regular grid flips a column of N cells at once

@@ -1,7 +1,7 @@
 // Tests of the float64 bloom reference (host/reference/bloom_reference.h) on its own: CPU only,
 // no Vulkan. Hand-computed values check the formulas of docs/BLOOM.md stage by stage; property
 // tests (uniformity, symmetry, monotonicity, locality) check the assembled pipeline on random
-// inputs from fixed seeds.
+// inputs from generators started at fixed values.
 #include "reference/bloom_reference.h"
 
 #include "core/half.h"
@@ -37,8 +37,8 @@ BloomConfig identity_prefilter_config(BloomFilter filter) {
 }
 
 // Random RGB in [lo, hi] per channel, alpha in [0, 1].
-CpuImage random_image(uint32_t w, uint32_t h, uint32_t seed, float lo, float hi) {
-  std::mt19937 rng(seed);
+CpuImage random_image(uint32_t w, uint32_t h, uint32_t stream, float lo, float hi) {
+  std::mt19937 rng(stream);
   std::uniform_real_distribution<float> rgb(lo, hi), alpha(0.0f, 1.0f);
   CpuImage img(w, h);
   for (size_t i = 0; i < img.rgba.size(); i += 4) {
@@ -52,19 +52,19 @@ CpuImage random_image(uint32_t w, uint32_t h, uint32_t seed, float lo, float hi)
 
 // Random RGB in [0.1, 1] on a 1/1024 grid, so that adding 1, 2 or 0.5 in float is exact and an
 // impulse added on top of it is exactly the intended one.
-CpuImage gridded_background(uint32_t w, uint32_t h, uint32_t seed) {
-  CpuImage img = random_image(w, h, seed, 0.1f, 1.0f);
+CpuImage gridded_background(uint32_t w, uint32_t h, uint32_t stream) {
+  CpuImage img = random_image(w, h, stream, 0.1f, 1.0f);
   for (float& v : img.rgba) v = std::round(v * 1024.0f) / 1024.0f;
   return img;
 }
 
 // Non-constant background whose luma is below threshold - knee of the default config (1 - 0.5):
 // every channel is at most 0.45, so luma <= 0.45 and the prefilter gives exactly 0 there.
-CpuImage dark_background(uint32_t w, uint32_t h, uint32_t seed) { return random_image(w, h, seed, 0.0f, 0.45f); }
+CpuImage dark_background(uint32_t w, uint32_t h, uint32_t stream) { return random_image(w, h, stream, 0.0f, 0.45f); }
 
 // Random HDR: channels log-uniform over [e^-4, e^5] (0.018 to 148), a few texels up to 900.
-CpuImage random_hdr(uint32_t w, uint32_t h, uint32_t seed) {
-  std::mt19937 rng(seed);
+CpuImage random_hdr(uint32_t w, uint32_t h, uint32_t stream) {
+  std::mt19937 rng(stream);
   std::uniform_real_distribution<float> expo(-4.0f, 5.0f), u(0.0f, 1.0f);
   CpuImage img(w, h);
   for (size_t i = 0; i < img.rgba.size(); i += 4) {
@@ -320,9 +320,9 @@ TEST(BloomReferenceLevels, MipChainSizesAndClamp) {
 // alone: with an identity prefilter and no Karis guard the downsample is linear, so the difference
 // is the filter's impulse response times the colour, which is hand-computed below.
 std::vector<double> level0_impulse_response(BloomFilter filter, uint32_t w, uint32_t h, uint32_t px, uint32_t py,
-                                            uint32_t seed) {
+                                            uint32_t stream) {
   const BloomConfig config = identity_prefilter_config(filter);
-  const CpuImage bg = gridded_background(w, h, seed);
+  const CpuImage bg = gridded_background(w, h, stream);
   CpuImage with = bg;
   float* t = with.at(px, py);
   t[0] += 1.0f;
@@ -679,7 +679,7 @@ TEST(BloomReferenceBloom, HalfModeRoundsEveryStoredImage) {
       EXPECT_NEAR(out.at(5, 7)[k], want, 1e-12 * want) << bloom_filter_name(filter) << " channel " << k;
       accumulate_rounded |= h(3 * q) != 3 * q;
     }
-    EXPECT_TRUE(accumulate_rounded) << "pick another seed: the accumulation happened to be exact in fp16";
+    EXPECT_TRUE(accumulate_rounded) << "pick another input stream: the accumulation happened to be exact in fp16";
   }
 }
 

@@ -1,6 +1,6 @@
 // Tests of the float64 blur reference (host/reference/blur_reference.h) on its own: CPU only, no
 // Vulkan. Properties of docs/BLUR.md (conservation, constants, symmetry, measured sigma) on random
-// inputs from fixed seeds, a plain gather convolution against the reference's scatter order, and
+// inputs from generators started at fixed values, a plain gather convolution against the reference's scatter order, and
 // the planner's modelled errors against errors measured with the reference.
 #include <gtest/gtest.h>
 
@@ -18,8 +18,8 @@ using blur_plan::Method;
 using blur_plan::Plan;
 
 // Random HDR in all four channels: log-uniform over [e^-4, e^5], a few texels 6x brighter.
-CpuImage random_hdr(uint32_t w, uint32_t h, uint32_t seed) {
-  std::mt19937 rng(seed);
+CpuImage random_hdr(uint32_t w, uint32_t h, uint32_t stream) {
+  std::mt19937 rng(stream);
   std::uniform_real_distribution<float> expo(-4.0f, 5.0f), u(0.0f, 1.0f);
   CpuImage img(w, h);
   for (float& v : img.rgba) v = (u(rng) < 0.01f ? 6.0f : 1.0f) * std::exp(expo(rng));

@@ -17,8 +17,9 @@ What it measures, on the same machine and in the same session as glint:
      W*H*(8+8) + sum over the 5 levels of 2*w*h*8, and that floor over the measured copy
      bandwidth (the floor time).
 
-Why: this is the peer number for docs/PERF.md. Issue 2 quoted peer numbers of 243 us at 1080p
-and 893 us at 2160p on an H100; this script reproduces such a peer in the same session as glint
+Why: this is the peer number for docs/PERF.md. Figures quoted for a similar chain (243 us at
+1080p and 893 us at 2160p on an H100) come from other machines and sessions; this script
+reproduces such a peer in the same session as glint
 so the comparison is like for like (same GPU, same clocks, same driver).
 
 Usage: python3 bench/peers/bloom_torch.py [--sizes 1920x1080,3840x2160] [--reps 200]
@@ -129,8 +130,9 @@ class BloomChain:
         return out
 
 
-def random_hdr(width, height, seed=1234):
-    g = torch.Generator(device="cuda").manual_seed(seed)
+def random_hdr(width, height):
+    # A new generator starts from PyTorch's fixed default state, so every run draws the same image.
+    g = torch.Generator(device="cuda")
     x = torch.rand(1, C, height, width, device="cuda", generator=g) * 2.0
     hot = torch.rand(1, 1, height, width, device="cuda", generator=g) < 0.02
     hot_val = 20.0 + 30.0 * torch.rand(1, 3, height, width, device="cuda", generator=g)

@@ -1,6 +1,6 @@
 """PyTorch and CuPy peer baselines for glint's Gaussian blur benchmark (bench/blur_bench.cpp).
 
-What it measures, on the same machine and in the same session as glint (issue 3):
+What it measures, on the same machine and in the same session as glint:
   1. Device-to-device copy bandwidth (PyTorch): a 1 GiB `dst.copy_(src)`, median of >= 20 timed
      copies, in TB/s counting bytes read + bytes written, as bench/peers/bloom_torch.py does.
      Plus a `clone()` of the RGBA16F image itself, the smallest same-size "filter" there is.
@@ -85,7 +85,7 @@ def torch_peers(width, height, sigma, reps, results):
           "copy_tb_s": copy_tb_s}, results)
     del src, dst
 
-    g = torch.Generator(device="cuda").manual_seed(1234)
+    g = torch.Generator(device="cuda")  # PyTorch's fixed default state: the same image every run
     x = (torch.rand(1, C, height, width, device="cuda", generator=g) * 4.0).half()
     us = median_us(lambda: x.clone(), reps, 20, event, torch.cuda.synchronize)
     emit({"peer": "torch_clone", "device": device, "width": width, "height": height, "dtype": "float16",

@@ -4,13 +4,13 @@ What it measures, on the same machine and in the same session as glint:
   1. Hi-Z pyramid: a D32-like float32 depth buffer (1, 1, H, W) reduced level by level with
      F.max_pool2d(kernel 2, stride 2, ceil_mode=True) until 1x1 (ceil mode keeps the odd
      row/column, so no texel is lost, like glint's fold rule). Captured once in a CUDA graph and
-     replayed; each replay timed with CUDA events (median of --reps). Issue 5 quotes 66 us for
-     3840x2160 on an H100.
+     replayed; each replay timed with CUDA events (median of --reps). docs/PERF.md has the
+     measured peer (60.7 us for 3840x2160 on an H100).
   2. Compaction of 1,000,000 lights: given a visibility mask (about half visible) and the light
      records (12 float32 each, 48 bytes like GlintFlareLight), torch.nonzero + index_select, the
      stream-compaction part of glint's cull alone (no projection, no occlusion test). nonzero
      synchronises with the host, so it cannot be graph-captured; it is timed with CUDA events
-     around each call. Issue 5 quotes 375 us.
+     around each call (docs/PERF.md: 361 us on an H100).
 
 Usage: python3 bench/peers/occlusion_torch.py [--sizes 3840x2160,1920x1080] [--lights 1000000]
                                               [--reps 200] [--out occlusion_torch.json]

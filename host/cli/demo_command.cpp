@@ -35,7 +35,7 @@ struct DemoOptions {
   std::string device;
   std::string preset = "cinematic";
   float exposure = 1.0f;
-  uint32_t seed = 1;
+  uint32_t variant = 1;
 };
 
 void run_demo(const DemoOptions& o) {
@@ -48,7 +48,7 @@ void run_demo(const DemoOptions& o) {
   check_exposure(o.exposure);
   const FlareConfig look = flare_preset_from_name(o.preset);
   demo::StarfieldParams scene_params;
-  scene_params.seed = o.seed;
+  scene_params.variant = o.variant;
 
   namespace fs = std::filesystem;
   std::error_code ec;
@@ -168,8 +168,8 @@ void run_demo(const DemoOptions& o) {
   std::memcpy(&st, stats_down.mapped(), sizeof st);
 
   std::printf("device: %s (%s)\n", context.info().name.c_str(), device_type_name(context.info().type));
-  std::printf("scene: %ux%u RGBA16F starfield (seed %u), depth with 3 occluders, %u lights\n", extent.width,
-              extent.height, o.seed, n);
+  std::printf("scene: %ux%u RGBA16F starfield (variant %u), depth with 3 occluders, %u lights\n", extent.width,
+              extent.height, o.variant, n);
   std::printf(
       "flares: preset %s, raster path, grid 4x4; lights: %u total, %u frustum-culled, %u occluded, %u visible "
       "(%u overflow), %u disabled\n",
@@ -211,7 +211,7 @@ Command add_demo_command(CLI::App& app) {
                   "missing)");
   sub->add_option("--preset", o->preset, kFlarePresetHelp);
   sub->add_option("--exposure", o->exposure, "Linear exposure applied before the PNG tonemap (> 0)");
-  sub->add_option("--seed", o->seed, "Seed of the starfield");
+  sub->add_option("--variant", o->variant, "Which random starfield (any 32-bit number; 1 by default)");
   add_device_option(*sub, o->device);
   return {sub, [o] { run_demo(*o); }};
 }

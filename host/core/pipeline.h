@@ -10,7 +10,7 @@
 
 namespace glint::detail {
 
-/// Workgroup shape for 2D image kernels, chosen from the device's limits (STYLE rule 3).
+/// Workgroup shape for 2D image kernels, chosen from the device's limits (CONTRIBUTING.md, "Device limits").
 struct Workgroup2D {
   uint32_t x = 8;
   uint32_t y = 8;

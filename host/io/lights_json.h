@@ -1,4 +1,4 @@
-// LIGHTS.json, the light list of `glint flare` (issue 5, "CLI"): a view-projection matrix and a
+// LIGHTS.json, the light list of `glint flare`: a view-projection matrix and a
 // list of lights, parsed strictly into the GPU's GlintFlareLight layout (kernels/common/
 // flare_types.h). The parser is a pure function of the text (no file, no Vulkan), so that a fuzz
 // target can call it directly.
@@ -10,7 +10,7 @@
 //       "color": [r, g, b],               linear RGB, each 0 to 65504    default [1, 1, 1]
 //       "intensity": f,                   0 to 65504                     default 1
 //       "size": px,                       flare size in pixels, > 0 and at most kMaxSizePx
-//                                                                        default 100 (the seed's)
+//                                                                        default 100 (kDefaultSizePx)
 //       "element": "glow",                glow | streak | halo | starburst | ghost (any case)
 //                                                                        default "glow"
 //       "enabled": true}                  false: counted as disabled, never drawn
@@ -40,7 +40,7 @@ inline constexpr size_t kMaxLights = 1000000;
 inline constexpr double kMaxSizePx = 4096.0;
 /// Upper bound of colour components and intensity: the largest finite fp16 value (the HDR image).
 inline constexpr double kMaxColor = 65504.0;
-/// Default "size" when a light has none: the seed's default flare size.
+/// Default "size" when a light has none: 100 px, a mid-sized flare in a 1080p frame.
 inline constexpr float kDefaultSizePx = 100.0f;
 /// Largest LIGHTS.json file that load_lights_json() reads (kMaxLights at ~250 bytes each).
 inline constexpr uint64_t kMaxLightsFileBytes = uint64_t(256) << 20;

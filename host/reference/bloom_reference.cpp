@@ -289,7 +289,8 @@ DoubleImage downsample(const DoubleImage& src, LevelSize size, BloomFilter filte
   return dst;
 }
 
-// One direction of the seed's separable 9-tap Gaussian (docs/BLOOM.md, gauss9): tap t at offset
+// One direction of the separable 9-tap Gaussian (docs/BLOOM.md, gauss9: binomial row 12 without
+// its two outer taps a side, renormalised): tap t at offset
 // t * radius texels, read by 1-D linear interpolation with clamp to edge. The weights sum to 1.
 constexpr std::array<double, 5> kGauss9 = {0.2270270270, 0.1945945946, 0.1216216216, 0.0540540541, 0.0162162162};
 

@@ -1,4 +1,4 @@
-// Float64 CPU reference of glint's lens flares (issue 5 drawing half, docs/FLARE.md): the element
+// Float64 CPU reference of glint's lens flares (the drawing half, docs/FLARE.md): the element
 // atlas (every level) and the composite of instances into an image, written from docs/FLARE.md
 // independently of the GLSL (kernels/common/flare_elements.glsl, flare_look.glsl), sharing only
 // the constants of kernels/common/flare_params.h. The sampler is modelled as the Vulkan

@@ -1,4 +1,4 @@
-// Float64 CPU reference of glint's atlas-aware texture LOD (issue 4, docs/LOD.md). Written from
+// Float64 CPU reference of glint's atlas-aware texture LOD (docs/LOD.md). Written from
 // the Vulkan specification's "LOD Operation", independently of include/glint/gpu/lod_impl.h: same
 // inputs (GlintLodQuery / GlintLodAtlas from include/glint/gpu/lod.h), same contract, but double
 // precision throughout, std::hypot for the exact gradient length and an integer search for the

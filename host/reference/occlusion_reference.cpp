@@ -249,9 +249,9 @@ void camera_unproject(const Camera& c, double x, double y, double z, float out[3
   out[2] = static_cast<float>(zv);
 }
 
-Scene random_scene(uint32_t width, uint32_t height, uint32_t light_count, uint32_t seed, bool reversed_z,
+Scene random_scene(uint32_t width, uint32_t height, uint32_t light_count, uint32_t stream, bool reversed_z,
                    double max_size_px) {
-  std::mt19937 rng(seed);
+  std::mt19937 rng(stream);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   Scene s;
   s.camera.aspect = double(width) / height;

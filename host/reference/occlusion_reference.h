@@ -1,4 +1,4 @@
-// Float64 CPU references of the lens-flare visibility stage (issue 5, docs/OCCLUSION.md), written
+// Float64 CPU references of the lens-flare visibility stage (docs/OCCLUSION.md), written
 // from the documented rules, independently of kernels/hiz_build.comp and kernels/light_cull.comp:
 // - the Hi-Z pyramid, each texel computed directly as the farthest of the source pixels it covers
 //   ([c * 2^k, (c + 1) * 2^k), the last texel of a row or column up to the edge), not by the
@@ -94,7 +94,7 @@ struct Scene {
   Camera camera;
   double view_proj[16];
 };
-Scene random_scene(uint32_t width, uint32_t height, uint32_t light_count, uint32_t seed, bool reversed_z,
+Scene random_scene(uint32_t width, uint32_t height, uint32_t light_count, uint32_t stream, bool reversed_z,
                    double max_size_px);
 
 /// True if a stored depth `d` lets a light at depth `z` be seen (not nearer than z - bias).

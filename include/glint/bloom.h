@@ -14,7 +14,7 @@ namespace glint {
 enum class BloomFilter : uint32_t {
   cod13 = 0,   //!< 13-tap downsample, 3x3 tent upsample (Jimenez 2014). Default.
   dual = 1,    //!< dual filter: 5-tap down, 8-tap up (Bjørge 2015). Cheapest; not a Gaussian.
-  gauss9 = 2,  //!< area downsample + the seed's separable 9-tap Gaussian per level.
+  gauss9 = 2,  //!< area downsample + a separable 9-tap Gaussian per level.
 };
 
 /// How the first downsample keeps isolated bright pixels ("fireflies") from dominating the bloom
@@ -27,7 +27,7 @@ enum class FireflyGuard : uint32_t {
                      //!< steady under sub-pixel motion (under 2 %), milder suppression. Default.
 };
 
-/// Bloom settings. Defaults are seed 001's; ranges are checked by validate(), which throws.
+/// Bloom settings. Defaults are given per field; ranges are checked by validate(), which throws.
 /// Shape fields (iterations, filter, firefly_guard, precision) decide images and pipelines: changing them through
 /// Bloom::set_config() rebuilds those. The other fields are per-frame push constants.
 struct BloomConfig {
@@ -43,7 +43,7 @@ struct BloomConfig {
                                             //!< levels finite. Source texels are first clamped to
                                             //!< 65504 (what +Inf and 1e9 become).
   Precision precision = Precision::fp16;    //!< intermediate storage [shape]
-  /// 0: level 0 is half the input (issue 2's chain; the glow is a fixed size in pixels). Else level
+  /// 0: level 0 is half the input (the 1920x1080 chain of docs/BLOOM.md; the glow is a fixed size in pixels). Else level
   /// 0 is this many rows (at most the input's height) with the input's aspect, reached through 2:1
   /// steps and one step of ratio 1 to 2, so the glow is the same fraction of the image at every
   /// resolution down to this height (docs/STABILITY.md "Scale"). 0 or 8 to 16384. [shape]

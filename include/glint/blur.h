@@ -1,4 +1,4 @@
-// The blur family (issue 3, seed 003): a three-level cumulative blur pyramid whose levels are
+// The blur family: a three-level cumulative blur pyramid whose levels are
 // handed to the caller's shaders, and a Gaussian blur of any sigma with a choice of methods.
 // The exact algorithms are in docs/BLUR.md; host/reference/blur_reference.h implements them in
 // float64.
@@ -30,7 +30,7 @@ struct EffectiveSigma {
   double y_px = 0;
 };
 
-/// Blur1, Blur2 and Blur3 of seed 003: level k (1 to 3) is level k-1 (level 0 = the input)
+/// Three cumulative blur levels: level k (1 to 3) is level k-1 (level 0 = the input)
 /// area-downsampled to half size (floor, at least 1) and blurred by one separable Gaussian, in
 /// one dispatch per level (docs/BLUR.md, "Blur pyramid").
 ///

@@ -1,4 +1,4 @@
-// Light-entity anamorphic lens flares, the drawing half (issue 5, seed 004): an element atlas
+// Light-entity anamorphic lens flares, the drawing half: an element atlas
 // generated on the GPU, and two ways to draw every visible light's flare into an HDR image — one
 // instanced vkCmdDrawIndirect (raster path) or a per-screen-tile gather (compute path) that
 // gives the same image within a stated tolerance. The visibility half (Hi-Z, cull, occlusion,
@@ -16,7 +16,7 @@
 
 namespace glint {
 
-/// The seed's presets ("Configuration Presets").
+/// Named looks (docs/FLARE.md, "The look"): each sets only the anamorphic ratio and the intensity.
 enum class FlarePreset : uint32_t {
   retro_subtle = 0,   //!< anamorphic ratio 1.8, intensity 0.6
   retro_intense = 1,  //!< anamorphic ratio 2.5, intensity 1.2
@@ -25,7 +25,7 @@ enum class FlarePreset : uint32_t {
 };
 
 /// Lens-flare look. Every field is a per-frame setting (push constants): changing it never rebuilds
-/// anything. Defaults are the seed's (LensFlareConfig: ratio 2, global intensity 1) and the element
+/// anything. Defaults: ratio 2, global intensity 1, and the element
 /// weights of docs/FLARE.md. validate() throws Error(invalid_argument) naming the field, the value
 /// and the range.
 struct FlareConfig {
@@ -35,18 +35,18 @@ struct FlareConfig {
   float main_weight = 1.0f;        //!< the light's own element (GlintFlareInstance::element, the
                                    //!< central glow by default) at the light (0 to 10)
   float streak_weight = 0.6f;      //!< horizontal streak at the light (0 to 10)
-  float streak_length = 4.0f;      //!< streak width in units of size_px, before the ratio (1 to 10;
-                                   //!< the seed: "2-10x the light's size")
+  float streak_length = 4.0f;      //!< streak width in units of size_px, before the ratio (1 to 10:
+                                   //!< an anamorphic streak spans 2 to 10 times the light's size)
   float halo_weight = 0.25f;       //!< ring around the light (0 to 10)
   float starburst_weight = 0.35f;  //!< radial spikes at the light (0 to 10)
   float ghost_weight = 0.5f;       //!< the five ghosts along the light-to-centre line (0 to 10)
   /// Ghost positions along light -> screen centre: 0 at the light, 1 at the centre, beyond 1 past
-  /// it (each -2 to 3). The seed's 0, 0.3, 0.7, 1.0, 1.5.
+  /// it (each -2 to 3). Default 0, 0.3, 0.7, 1.0, 1.5.
   std::array<float, 5> ghost_positions = {0.0f, 0.3f, 0.7f, 1.0f, 1.5f};
   bool tint = true;  //!< tint the streak and the ghosts (lens-coating colour); false: untinted
   std::array<float, 3> tint_color = {0.55f, 0.8f, 1.0f};  //!< blue-cyan, linear RGB (each 0 to 1)
 
-  /// The seed's preset values on top of the defaults above.
+  /// The preset's ratio and intensity on top of the defaults above.
   static FlareConfig preset(FlarePreset preset);
 
   /// Throws Error(invalid_argument) naming the first field that is out of range or NaN.

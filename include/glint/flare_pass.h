@@ -1,4 +1,4 @@
-// Lens flares end to end (issue 5): the visibility half (occlusion.h: HiZPyramid, LightCuller) and
+// Lens flares end to end: the visibility half (occlusion.h: HiZPyramid, LightCuller) and
 // the drawing half (flare.h: LensFlare) wired together with the buffers that connect them, so that
 // one record() goes from a depth image and a light list to flares added to an HDR image, with no
 // readback in between: Hi-Z build -> cull + occlusion grid + compaction -> vkCmdDrawIndirect

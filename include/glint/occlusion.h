@@ -1,7 +1,7 @@
-// Visibility of lens-flare lights, kept on the GPU (issue 5): a Hi-Z depth pyramid built in one
+// Visibility of lens-flare lights, kept on the GPU: a Hi-Z depth pyramid built in one
 // dispatch (HiZPyramid), and a cull (LightCuller) that projects the lights, culls them against the
 // frustum, tests their occlusion on an N x N grid read from the pyramid, and compacts the visible
-// ones, in increasing light index (issue 6), into an instance buffer for an indirect draw or
+// ones, in increasing light index (so every run gives the same order), into an instance buffer for an indirect draw or
 // dispatch. docs/OCCLUSION.md derives the fold rule, the level choice, the error bound and the
 // compaction; host/reference/occlusion_reference.h holds the float64 references.
 //
@@ -111,9 +111,9 @@ struct LightCullConfig {
   uint32_t capacity = 1024;        //!< GlintFlareInstance slots in the instance buffer (1 to 16777216)
   uint32_t grid = 4;               //!< N: N x N occlusion cells per light (1 to 16)
   float margin_ndc = 1.2f;         //!< frustum margin: lights with |ndc.x| or |ndc.y| above it are
-                                   //!< culled (1 to 8; the seed's 1.2 keeps off-screen ghosts)
+                                   //!< culled (1 to 8; 1.2, a margin that keeps the ghosts of lights just off screen)
   float depth_bias = 0.0f;         //!< NDC depth tolerance: a light up to this much behind a surface
-                                   //!< still counts as visible there (0 to 0.1; the seed uses 0.01)
+                                   //!< still counts as visible there (0 to 0.1; 0.01 hides depth-precision noise on coplanar lights)
   uint32_t max_lights = 1u << 20;  //!< most lights per record() (1 to 4194240 = 65535 x 64); the
                                    //!< culler keeps 16 bytes per light (and 16 per 64) for it
   OcclusionPattern pattern = OcclusionPattern::multi_jittered;  //!< where the N x N samples read

@@ -1,5 +1,5 @@
 // Push constants of the blur kernels (kernels/blur_*.comp), shared with host/blur.cpp
-// (STYLE rule 2). The algorithms are in docs/BLUR.md.
+// (CONTRIBUTING.md, "Shared structs"). The algorithms are in docs/BLUR.md.
 #ifndef GLINT_BLUR_PARAMS_H
 #define GLINT_BLUR_PARAMS_H
 #include "glint/gpu/types.h"

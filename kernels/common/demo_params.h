@@ -7,7 +7,7 @@ struct StarfieldPush {
   GLINT_INT width;
   GLINT_INT height;
   GLINT_INT cell_px;          // one candidate star per cell of cell_px x cell_px pixels
-  GLINT_UINT seed;
+  GLINT_UINT variant;         // which starfield: mixed into the per-cell hash
   GLINT_FLOAT min_brightness; // star brightness range (log-uniform)
   GLINT_FLOAT max_brightness;
   GLINT_FLOAT sun_brightness;

@@ -1,6 +1,5 @@
 // The flare elements as functions of the tile's normalized coordinate q in (-1, 1)^2 (texel centre
-// (i + 0.5) / w * 2 - 1), premultiplied RGBA. Shapes follow seed 004 ("Texture Design and
-// Atlasing"): Gaussian/exponential glow, a wide horizontal streak with a tight vertical profile and
+// (i + 0.5) / w * 2 - 1), premultiplied RGBA. Shapes (docs/FLARE.md, "Elements"): Gaussian/exponential glow, a wide horizontal streak with a tight vertical profile and
 // a central bulge, a soft ring with a slight chromatic spread, radial spikes, and a hexagonal
 // aperture ghost with a brighter rim. Every element is multiplied by a window that is 0 at the
 // tile border, so the padding (zeros) is each tile's own edge value. Only exp, smoothstep, sqrt and

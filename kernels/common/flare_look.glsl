@@ -87,7 +87,7 @@ GlintFlareSprite glint_flare_sprite(GlintFlareInstance inst, uint slot, GlintFla
                            : GLINT_FLARE_GHOST_GAIN_4;
     s.tile = GLINT_FLARE_ELEMENT_GHOST;
     precise vec2 screen_centre = 0.5 * vec2(p.viewport_w, p.viewport_h);
-    centre = light + (screen_centre - light) * t;  // seed: E = L + (C - L) * t
+    centre = light + (screen_centre - light) * t;  // Kilgard's ghost line: E = L + (C - L) * t
     extent = vec2(scale);
     weight = p.weight_ghost * gain;
     tinted = true;

@@ -1,5 +1,5 @@
-// The drawing half of the lens flares (issue 5, seed 004), declared once for GLSL and C++ (STYLE
-// rule 2): the element atlas layout, the sprites every light expands to, and the push constants
+// The drawing half of the lens flares, declared once for GLSL and C++ (CONTRIBUTING.md, "Shared
+// structs"): the element atlas layout, the sprites every light expands to, and the push constants
 // shared by flare.vert, flare.frag and flare_gather.comp. docs/FLARE.md explains
 // every number here. The visibility half meets the drawing half only in flare_types.h.
 #ifndef GLINT_FLARE_PARAMS_H

@@ -1,9 +1,9 @@
-// Push constants and buffer layouts of the visibility stage of the lens flares (issue 5): the Hi-Z
-// build (hiz_build.comp), the cull + occlusion grid test (light_cull.comp), and the order-preserving
-// compaction (issue 6): a single-workgroup scan of the cull's per-workgroup visibility masks that
-// also writes the indirect arguments and statistics (light_cull_scan.comp), then the scatter of the
+// Push constants and buffer layouts of the visibility stage of the lens flares: the Hi-Z build
+// (hiz_build.comp), the cull + occlusion grid test (light_cull.comp), and the order-preserving
+// compaction (the same order on every run): a single-workgroup scan of the cull's per-workgroup
+// visibility masks that also writes the indirect arguments and statistics (light_cull_scan.comp), then the scatter of the
 // visible lights into the instance buffer in light-index order (light_cull_scatter.comp).
-// Declared once for GLSL and C++ (STYLE rule 2); host/occlusion.cpp static_asserts the layouts.
+// Declared once for GLSL and C++ (CONTRIBUTING.md, "Shared structs"); host/occlusion.cpp static_asserts the layouts.
 // docs/OCCLUSION.md explains the algorithms.
 #ifndef GLINT_OCCLUSION_H
 #define GLINT_OCCLUSION_H

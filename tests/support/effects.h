@@ -34,7 +34,7 @@ struct ImageEffect {
 };
 
 /// Every image effect in the tables: bloom with each filter (defaults otherwise) and the Gaussian
-/// blur with each method (issue 3). Flares (issue 5) draw from a light list, not an image: their
+/// blur with each method. Flares draw from a light list, not an image: their
 /// robustness cases live in flare_e2e_test.cpp and occlusion_test.cpp.
 std::vector<ImageEffect> image_effects();
 

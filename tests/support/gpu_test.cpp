@@ -31,8 +31,8 @@ void GpuTest::TearDown() {
   }
 }
 
-CpuImage random_hdr(uint32_t width, uint32_t height, uint32_t seed, float bright_fraction, float peak) {
-  std::mt19937 rng(seed);
+CpuImage random_hdr(uint32_t width, uint32_t height, uint32_t stream, float bright_fraction, float peak) {
+  std::mt19937 rng(stream);
   std::uniform_real_distribution<float> base(0.0f, 1.5f);
   std::uniform_real_distribution<float> unit(0.0f, 1.0f);
   CpuImage img(width, height);

@@ -27,7 +27,7 @@ class GpuTest : public ::testing::Test {
 };
 
 /// Random HDR image: mostly values in [0, 1.5) with a fraction of bright pixels up to `peak`.
-CpuImage random_hdr(uint32_t width, uint32_t height, uint32_t seed, float bright_fraction = 0.02f,
+CpuImage random_hdr(uint32_t width, uint32_t height, uint32_t stream, float bright_fraction = 0.02f,
                     float peak = 40.0f);
 
 /// An image with its content uploaded, in the given format, with test usage flags.
