@@ -15,8 +15,6 @@ DST_LAYOUT(2) uniform writeonly image2D result;
 #include "bloom_params.h"
 layout(push_constant) uniform Push { BloomPush p; };
 
-vec3 source_texel(ivec2 ij) { return vec3(0.0); }  // unused
-
 #include "bloom.glsl"
 #include "bloom_up_tiled.glsl"
 

@@ -2,7 +2,7 @@
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_samplerless_texture_functions : require
 // Pyramid level k-1 -> level k with the filter's downsample (docs/BLOOM.md "Downsample";
-// cod13: Jimenez 2014, dual: Bjørge 2015, gauss9: area average before the seed's 9-tap blur).
+// cod13: Jimenez 2014, dual: Bjørge 2015, gauss9: area average before the 9-tap blur).
 layout(local_size_x_id = 0, local_size_y_id = 1) in;
 
 layout(binding = 0) uniform texture2D src;
@@ -11,8 +11,6 @@ layout(binding = 1, DST_FORMAT) uniform writeonly image2D dst;
 #include "bloom_params.h"
 layout(push_constant) uniform Push { BloomPush p; };
 
-vec3 source_texel(ivec2 ij) { return texelFetch(src, ij, 0).rgb; }
-
 #include "bloom.glsl"
 #include "bloom_down_tiled.glsl"
 
@@ -20,7 +18,7 @@ void main() {
   ivec2 xy = ivec2(gl_GlobalInvocationID.xy);
   ivec2 dst_size = ivec2(p.dst_width, p.dst_height);
   bool inside = all(lessThan(xy, dst_size));
-  g_src_size = ivec2(p.src_width, p.src_height);
-  vec3 c = downsample_any(xy, dst_size, inside, false);
+  BloomSource s = BloomSource(ivec2(p.src_width, p.src_height), false, 0.0, 0.0);
+  vec3 c = downsample_any(src, s, xy, dst_size, inside, false);
   if (inside) imageStore(dst, xy, vec4(c, 1.0));
 }

@@ -11,8 +11,6 @@ layout(binding = 1, DST_FORMAT) uniform image2D level;
 #include "bloom_params.h"
 layout(push_constant) uniform Push { BloomPush p; };
 
-vec3 source_texel(ivec2 ij) { return vec3(0.0); }  // unused: upsample reads `smaller` directly
-
 #include "bloom.glsl"
 #include "bloom_up_tiled.glsl"
 

@@ -1,6 +1,6 @@
-// Bloom building blocks (docs/BLOOM.md). A kernel that includes this defines
-//   vec3 source_texel(ivec2 ij)   // the (possibly prefiltered) source texel, ij already clamped
-// before including it, and declares push constants `p` of type BloomPush.
+// Bloom building blocks (docs/BLOOM.md). Every function takes what it reads as parameters: the
+// including kernel declares its own bindings and push constants and passes them in. FILTER (the
+// BloomFilter, specialization constant 2) selects the filter at pipeline creation.
 #include "bloom_params.h"
 #include "image_io.glsl"
 
@@ -17,7 +17,7 @@ vec3 sanitize(vec3 c) {
   return clamp(c, vec3(0.0), vec3(GLINT_BLOOM_SOURCE_MAX));
 }
 
-// Seed 001's soft knee, knee relative to threshold (docs/BLOOM.md, "Prefilter").
+// Soft knee, knee relative to the threshold as in Unity and Bevy (docs/BLOOM.md, "Prefilter").
 vec3 soft_threshold(vec3 c, float threshold, float knee) {
   float l = luma(c);
   float soft = clamp(l - threshold + knee, 0.0, 2.0 * knee);
@@ -26,7 +26,20 @@ vec3 soft_threshold(vec3 c, float threshold, float knee) {
   return c * factor;
 }
 
-ivec2 g_src_size;
+// Where downsample() reads its source: texels of a texture of `size` texels, clamped to the image,
+// and with bright_pass the prefilter of docs/BLOOM.md (sanitize, then soft_threshold with
+// threshold and knee) applied to each texel before any filtering.
+struct BloomSource {
+  ivec2 size;
+  bool bright_pass;
+  float threshold;
+  float knee;
+};
+
+vec3 source_texel(texture2D src, BloomSource s, ivec2 ij) {
+  vec3 c = texelFetch(src, clamp(ij, ivec2(0), s.size - 1), 0).rgb;
+  return s.bright_pass ? soft_threshold(sanitize(c), s.threshold, s.knee) : c;
+}
 
 // Position in the source of size `s` of texel x of the destination of size `d`, one axis
 // (docs/BLOOM.md "Notation", dual). Between n and floor(n / 2) texels the dual filter maps with the
@@ -48,17 +61,14 @@ vec2 level_map(ivec2 xy, ivec2 dst, ivec2 src) {
   return vec2(dual_map_1d(xy.x, dst.x, src.x), dual_map_1d(xy.y, dst.y, src.y));
 }
 
-vec3 src_at(ivec2 ij) { return source_texel(clamp(ij, ivec2(0), g_src_size - 1)); }
+// Bilinear blend of the four texels around a position whose fractional part is w.
+vec3 bilinear_mix(vec3 a, vec3 b, vec3 c, vec3 d, vec2 w) { return mix(mix(a, b, w.x), mix(c, d, w.x), w.y); }
 
-vec3 src_bilinear(vec2 pos) {
+vec3 source_bilinear(texture2D src, BloomSource s, vec2 pos) {
   vec2 f = floor(pos);
-  vec2 w = pos - f;
   ivec2 i0 = ivec2(f);
-  vec3 a = src_at(i0);
-  vec3 b = src_at(i0 + ivec2(1, 0));
-  vec3 c = src_at(i0 + ivec2(0, 1));
-  vec3 d = src_at(i0 + ivec2(1, 1));
-  return mix(mix(a, b, w.x), mix(c, d, w.x), w.y);
+  return bilinear_mix(source_texel(src, s, i0), source_texel(src, s, i0 + ivec2(1, 0)),
+                      source_texel(src, s, i0 + ivec2(0, 1)), source_texel(src, s, i0 + ivec2(1, 1)), pos - f);
 }
 
 // Accumulates one "box" (docs/BLOOM.md, Karis guard): weight w, mean m.
@@ -68,40 +78,53 @@ void add_box(inout vec3 sum, inout float wsum, vec3 m, float w, bool karis) {
   wsum += k;
 }
 
-vec3 downsample(ivec2 xy, ivec2 dst_size, bool karis) {
+// gauss9's area footprint of destination texel xy: the source interval [lo, hi) in texel-edge
+// coordinates and the texels i0..i1 (inclusive) it touches; area_overlap() is the length of texel
+// i's overlap with [lo, hi) on one axis. A texel's weight is the product of its two overlaps.
+void area_footprint(ivec2 xy, ivec2 dst_size, ivec2 src_size, out vec2 lo, out vec2 hi, out ivec2 i0, out ivec2 i1) {
+  vec2 s = vec2(src_size) / vec2(dst_size);
+  lo = vec2(xy) * s;
+  hi = vec2(xy + 1) * s;
+  i0 = ivec2(floor(lo));
+  i1 = ivec2(ceil(hi)) - 1;
+}
+
+float area_overlap(float lo, float hi, int i) { return min(float(i + 1), hi) - max(float(i), lo); }
+
+// The filter's downsample of `src` to destination texel xy of a dst_size image (docs/BLOOM.md
+// "Downsample"): gauss9's area average, dual's 5 bilinear taps, or cod13's 13 (Jimenez 2014).
+// kernels/bloom_prefilter_smooth.comp repeats this arithmetic, expression for expression, on a
+// source held in shared memory: keep the two the same.
+vec3 downsample(texture2D src, BloomSource s, ivec2 xy, ivec2 dst_size, bool karis) {
   vec3 sum = vec3(0.0);
   float wsum = 0.0;
   if (FILTER == GLINT_BLOOM_GAUSS9) {
-    // Area average: every source texel weighted by its overlap with the destination footprint.
-    vec2 s = vec2(g_src_size) / vec2(dst_size);
-    vec2 lo = vec2(xy) * s;
-    vec2 hi = vec2(xy + 1) * s;
-    ivec2 i0 = ivec2(floor(lo));
-    ivec2 i1 = ivec2(ceil(hi)) - 1;
+    vec2 lo, hi;
+    ivec2 i0, i1;
+    area_footprint(xy, dst_size, s.size, lo, hi, i0, i1);
     for (int j = i0.y; j <= i1.y; ++j) {
-      float wy = min(float(j + 1), hi.y) - max(float(j), lo.y);
+      float wy = area_overlap(lo.y, hi.y, j);
       for (int i = i0.x; i <= i1.x; ++i) {
-        float wx = min(float(i + 1), hi.x) - max(float(i), lo.x);
-        add_box(sum, wsum, src_at(ivec2(i, j)), wx * wy, karis);
+        add_box(sum, wsum, source_texel(src, s, ivec2(i, j)), area_overlap(lo.x, hi.x, i) * wy, karis);
       }
     }
     return sum / wsum;
   }
-  vec2 c = level_map(xy, dst_size, g_src_size);
+  vec2 c = level_map(xy, dst_size, s.size);
   if (FILTER == GLINT_BLOOM_DUAL) {
-    add_box(sum, wsum, src_bilinear(c), 0.5, karis);
-    add_box(sum, wsum, src_bilinear(c + vec2(-1, -1)), 0.125, karis);
-    add_box(sum, wsum, src_bilinear(c + vec2(1, -1)), 0.125, karis);
-    add_box(sum, wsum, src_bilinear(c + vec2(-1, 1)), 0.125, karis);
-    add_box(sum, wsum, src_bilinear(c + vec2(1, 1)), 0.125, karis);
+    add_box(sum, wsum, source_bilinear(src, s, c), 0.5, karis);
+    add_box(sum, wsum, source_bilinear(src, s, c + vec2(-1, -1)), 0.125, karis);
+    add_box(sum, wsum, source_bilinear(src, s, c + vec2(1, -1)), 0.125, karis);
+    add_box(sum, wsum, source_bilinear(src, s, c + vec2(-1, 1)), 0.125, karis);
+    add_box(sum, wsum, source_bilinear(src, s, c + vec2(1, 1)), 0.125, karis);
     return sum / wsum;
   }
-  // cod13: outer 3x3 grid at +-2 and the inner 2x2 at +-1 (Jimenez 2014).
+  // cod13: outer 3x3 grid at +-2 and the inner 2x2 at +-1.
   vec3 g[9];
   for (int j = 0; j < 3; ++j)
-    for (int i = 0; i < 3; ++i) g[j * 3 + i] = src_bilinear(c + vec2(2 * i - 2, 2 * j - 2));
-  vec3 inner = (src_bilinear(c + vec2(-1, -1)) + src_bilinear(c + vec2(1, -1)) +
-                src_bilinear(c + vec2(-1, 1)) + src_bilinear(c + vec2(1, 1))) * 0.25;
+    for (int i = 0; i < 3; ++i) g[j * 3 + i] = source_bilinear(src, s, c + vec2(2 * i - 2, 2 * j - 2));
+  vec3 inner = (source_bilinear(src, s, c + vec2(-1, -1)) + source_bilinear(src, s, c + vec2(1, -1)) +
+                source_bilinear(src, s, c + vec2(-1, 1)) + source_bilinear(src, s, c + vec2(1, 1))) * 0.25;
   add_box(sum, wsum, inner, 0.5, karis);
   add_box(sum, wsum, (g[0] + g[1] + g[3] + g[4]) * 0.25, 0.125, karis);
   add_box(sum, wsum, (g[1] + g[2] + g[4] + g[5]) * 0.25, 0.125, karis);

@@ -3,7 +3,7 @@
 // mean of that 2x2 box. A workgroup loads its source window once into shared memory, forms the box
 // means at every corner once, and each invocation reads its 13 (cod13) or 5 (dual) boxes from
 // there, instead of 52 or 20 texel fetches. Same arithmetic as downsample() up to fp32 rounding.
-// Requires bloom.glsl (src_at, add_box, FILTER) to be included first.
+// Requires bloom.glsl (BloomSource, source_texel, add_box, FILTER) to be included first.
 #extension GL_EXT_control_flow_attributes : require
 
 const uint TILE_W = 2u * gl_WorkGroupSize.x + 4u;  // source texels 2*x0-2 .. 2*(x0+W-1)+3
@@ -20,13 +20,13 @@ shared vec4 s_box[BOX_W * BOX_H];
 #include "bloom_boxes.glsl"
 
 // Every invocation of the workgroup must call this (it has barriers), inside the image or not.
-vec3 downsample_2to1(bool karis) {
+vec3 downsample_2to1(texture2D src, BloomSource s, bool karis) {
   ivec2 origin = ivec2(gl_GlobalInvocationID.xy - gl_LocalInvocationID.xy) * 2 - 2;  // (see bloom_up_tiled)
   // All fetches are issued before the first store, so their latencies overlap.
   vec3 fetched[LOADS_PER_INVOCATION];
   [[unroll]] for (uint n = 0u; n < LOADS_PER_INVOCATION; ++n) {
     uint i = min(gl_LocalInvocationIndex + n * GROUP_SIZE, TILE_W * TILE_H - 1u);
-    fetched[n] = src_at(origin + ivec2(i % TILE_W, i / TILE_W));
+    fetched[n] = source_texel(src, s, origin + ivec2(i % TILE_W, i / TILE_W));
   }
   [[unroll]] for (uint n = 0u; n < LOADS_PER_INVOCATION; ++n) {
     uint i = gl_LocalInvocationIndex + n * GROUP_SIZE;
@@ -54,7 +54,7 @@ vec3 downsample_2to1(bool karis) {
 
 // The downsample of the invocation's texel: the shared-memory 2:1 path when it applies (a
 // uniform branch), else the general one. Call from every invocation.
-vec3 downsample_any(ivec2 xy, ivec2 dst_size, bool inside, bool karis) {
-  if (g_src_size == 2 * dst_size) return downsample_2to1(karis);
-  return inside ? downsample(xy, dst_size, karis) : vec3(0.0);
+vec3 downsample_any(texture2D src, BloomSource s, ivec2 xy, ivec2 dst_size, bool inside, bool karis) {
+  if (s.size == 2 * dst_size) return downsample_2to1(src, s, karis);
+  return inside ? downsample(src, s, xy, dst_size, karis) : vec3(0.0);
 }
