@@ -34,7 +34,7 @@ static_assert(static_cast<uint32_t>(BlurMethod::separable) - 1 == static_cast<ui
 static_assert(static_cast<uint32_t>(BlurMethod::pyramid) == static_cast<uint32_t>(blur_plan::Method::pyramid));
 static_assert(static_cast<uint32_t>(BlurMethod::dual) == static_cast<uint32_t>(blur_plan::Method::dual));
 
-const char* to_string(BlurMethod method) {
+const char* blur_method_name(BlurMethod method) {
   switch (method) {
     case BlurMethod::automatic:
       return "auto";
@@ -47,6 +47,8 @@ const char* to_string(BlurMethod method) {
   }
   return "unknown";
 }
+
+const char* to_string(BlurMethod method) { return blur_method_name(method); }
 
 void BlurPyramidConfig::validate() const {
   const char* names[3] = {"BlurPyramidConfig::sigma_texels[0]", "BlurPyramidConfig::sigma_texels[1]",
@@ -75,7 +77,7 @@ void GaussianBlurConfig::validate() const {
   }
   if (linear_sampling && method != BlurMethod::separable) {
     throw Error(ErrorCode::invalid_argument,
-                concat("GaussianBlurConfig::linear_sampling = true needs method separable, not ", to_string(method)));
+                concat("GaussianBlurConfig::linear_sampling = true needs method separable, not ", blur_method_name(method)));
   }
 }
 

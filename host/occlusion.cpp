@@ -1,5 +1,5 @@
 // Visibility driver for lens flares: the Hi-Z pyramid and the light culler (docs/OCCLUSION.md).
-#include "occlusion.h"
+#include "light_cull_params.h"  // push constants and buffer layouts shared with the kernels
 
 #include <array>
 #include <glint/occlusion.h>

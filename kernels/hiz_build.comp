@@ -17,7 +17,7 @@
 // loops. Every store names its level with a constant, so no switch is left in the fast path.
 layout(local_size_x = 256) in;
 
-#include "occlusion.h"
+#include "light_cull_params.h"
 
 // The level this pipeline reads as its base: 0 (the depth image) or GLINT_HIZ_TILE_LEVELS (the
 // second pass above 4096); the host makes one pipeline per value it needs.

@@ -27,7 +27,7 @@
 layout(local_size_x_id = 0, local_size_y_id = 1) in;
 
 #include "glint/gpu/flare_types.h"
-#include "occlusion.h"
+#include "light_cull_params.h"
 
 layout(binding = 0) uniform texture2D depth_tex;  // level 0
 layout(binding = 1) uniform texture2D hiz_tex;    // mip m = Hi-Z level m + 1

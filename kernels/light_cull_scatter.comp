@@ -11,7 +11,7 @@
 layout(local_size_x_id = 0, local_size_y_id = 1) in;
 
 #include "glint/gpu/flare_types.h"
-#include "occlusion.h"
+#include "light_cull_params.h"
 
 layout(std430, binding = 0) readonly buffer Lights { GlintFlareLight lights[]; };
 layout(std430, binding = 1) readonly buffer Records { vec4 records[]; };  // centre.xy, fraction, ndc z

@@ -226,7 +226,7 @@ const MethodCase kMethodCases[] = {
 };
 
 std::string describe(const MethodCase& c) {
-  return std::string(to_string(c.method)) + (c.linear ? "+linear" : "") + " sigma " + std::to_string(c.sigma);
+  return std::string(blur_method_name(c.method)) + (c.linear ? "+linear" : "") + " sigma " + std::to_string(c.sigma);
 }
 
 GaussianBlurConfig config_of(const MethodCase& c, Precision precision = Precision::fp32) {
@@ -374,19 +374,19 @@ TEST_F(BlurTest, AutoMeetsItsErrorBoundAcrossTheSigmaRange) {
     const CpuImage random = random_hdr(n, n, static_cast<uint32_t>(sigma * 10));
     const CpuImage out = run_gauss(blur, random);
     const double bound = config.max_relative_error;
-    EXPECT_LE(blur.choice().expected_relative_error, bound) << to_string(blur.choice().method);
+    EXPECT_LE(blur.choice().expected_relative_error, bound) << blur_method_name(blur.choice().method);
     // The bound is for the interior (docs/BLUR.md): at the borders the pyramid clamps at its
     // level's resolution, the exact Gaussian at full resolution.
     const uint32_t margin = static_cast<uint32_t>(std::ceil(4 * sigma)) + (2u << blur.choice().levels);
     if (2 * margin < n) {
       EXPECT_LT(reference::rgba_relative_l2_interior(out, reference::exact_gaussian(random, sigma), margin), bound)
-          << to_string(blur.choice().method);
+          << blur_method_name(blur.choice().method);
     }
     const CpuImage impulse = reference::impulse_image(n, n, n / 2, n / 2);
     const CpuImage response = run_gauss(blur, impulse);
     // The model is the worst over impulse positions; the GPU adds fp32 rounding only.
     EXPECT_LT(reference::rgba_relative_l2(response, reference::exact_gaussian(impulse, sigma)), bound * 1.01 + 1e-5)
-        << to_string(blur.choice().method);
+        << blur_method_name(blur.choice().method);
   }
 }
 

@@ -280,7 +280,7 @@ TEST_F(FormatsTest, GaussianBlurWritesB10G11R11) {
     const CpuImage wide = detail::download(context(), out32.state);
     reference::DoubleImage ref{wide.width, wide.height, std::vector<double>(wide.rgba.begin(), wide.rgba.end())};
     const Deviation d = compare(gpu, ref, kB10);
-    EXPECT_EQ(d.outside, 0u) << to_string(method) << ", first " << d.first;
+    EXPECT_EQ(d.outside, 0u) << blur_method_name(method) << ", first " << d.first;
   }
 }
 

@@ -2,7 +2,7 @@
 // occlusion_reference.h): the Hi-Z pyramid bit for bit at odd, tiny and very wide sizes, the cull +
 // grid test + compaction on random scenes (exact grid result, conservative against brute force,
 // error within the bound of docs/OCCLUSION.md), monotone fading, overflow, zero lights, errors.
-#include "occlusion.h"
+#include "light_cull_params.h"
 
 #include <glint/occlusion.h>
 

@@ -107,8 +107,8 @@ void run_gauss(GaussOptions& o) {
       }, o.fp32 ? VK_FORMAT_R32G32B32A32_SFLOAT : VK_FORMAT_R16G16B16A16_SFLOAT);
   print_device(context, o.input, input);
   const BlurChoice& c = blur.choice();
-  std::printf("method: %s%s (asked: %s)", to_string(c.method), c.linear_sampling ? " with linear sampling" : "",
-              to_string(o.config.method));
+  std::printf("method: %s%s (asked: %s)", blur_method_name(c.method), c.linear_sampling ? " with linear sampling" : "",
+              blur_method_name(o.config.method));
   if (c.method == BlurMethod::separable) std::printf(", %u taps", 2 * c.radius + 1);
   if (c.method == BlurMethod::pyramid)
     std::printf(", %u levels, sigma %.3f texels at the last", c.levels, c.level_sigma);

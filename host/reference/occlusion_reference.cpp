@@ -5,7 +5,7 @@
 #include <random>
 #include <stdexcept>
 
-#include "occlusion.h"
+#include "light_cull_params.h"
 
 namespace glint::reference {
 

@@ -210,7 +210,12 @@ class GaussianBlur {
   std::unique_ptr<Impl> impl_;
 };
 
-/// Name of a method ("auto", "separable", "pyramid", "dual").
-const char* to_string(BlurMethod method);
+/// Name of a method ("auto", "separable", "pyramid", "dual"); "unknown" for a value outside the enum.
+/// Named like bloom_filter_name() and firefly_guard_name().
+const char* blur_method_name(BlurMethod method);
+
+/// The same as blur_method_name(). Kept working for existing callers; the name clashed in style with
+/// the other enum names and, unqualified, with std::to_string.
+[[deprecated("use blur_method_name")]] const char* to_string(BlurMethod method);
 
 }  // namespace glint

@@ -658,7 +658,7 @@ int run() {
         hi = std::max(hi, std::isfinite(v) ? v : INFINITY);
       }
     }
-    std::printf("blur: %s, sum %.3f (input %.3f), range [%.4f, %.4f]\n", glint::to_string(blur.choice().method),
+    std::printf("blur: %s, sum %.3f (input %.3f), range [%.4f, %.4f]\n", glint::blur_method_name(blur.choice().method),
                 sum_out, sum_in, double(lo), double(hi));
     f.check(std::fabs(sum_out - sum_in) <= 0.01 * sum_in, "blur: the image sum changed by more than 1%");
     f.check(lo >= kBackground * (1.0 - 4 * kHalfUlp) && hi <= kDisc * 0.3f,

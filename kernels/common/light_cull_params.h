@@ -1,12 +1,13 @@
 // Push constants and buffer layouts of the visibility stage of the lens flares: the Hi-Z build
 // (hiz_build.comp), the cull + occlusion grid test (light_cull.comp), and the order-preserving
 // compaction (the same order on every run): a single-workgroup scan of the cull's per-workgroup
-// visibility masks that also writes the indirect arguments and statistics (light_cull_scan.comp), then the scatter of the
-// visible lights into the instance buffer in light-index order (light_cull_scatter.comp).
-// Declared once for GLSL and C++ (CONTRIBUTING.md, "Shared structs"); host/occlusion.cpp static_asserts the layouts.
-// docs/OCCLUSION.md explains the algorithms.
-#ifndef GLINT_OCCLUSION_H
-#define GLINT_OCCLUSION_H
+// visibility masks that also writes the indirect arguments and statistics (light_cull_scan.comp),
+// then the scatter of the visible lights into the instance buffer in light-index order
+// (light_cull_scatter.comp). Declared once for GLSL and C++ (CONTRIBUTING.md, "Shared structs");
+// host/occlusion.cpp static_asserts the layouts. docs/OCCLUSION.md explains the algorithms. The
+// public C++ API of the same stage is include/glint/occlusion.h.
+#ifndef GLINT_LIGHT_CULL_PARAMS_H
+#define GLINT_LIGHT_CULL_PARAMS_H
 #include "glint/gpu/types.h"
 
 // Hi-Z levels: level 0 is the depth image itself, level k (k >= 1) is max(1, size >> k) on a side
