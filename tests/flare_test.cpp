@@ -162,8 +162,8 @@ TEST_F(FlareTest, PresetsHaveTheSeedsValues) {
   for (const FlareConfig& c : {subtle, intense, cinematic, disabled}) EXPECT_NO_THROW(c.validate());
   const FlareConfig defaults;
   EXPECT_FLOAT_EQ(defaults.anamorphic_ratio, 2.0f);
-  const std::array<float, 5> seed_ghosts = {0.0f, 0.3f, 0.7f, 1.0f, 1.5f};
-  EXPECT_EQ(defaults.ghost_positions, seed_ghosts);
+  const std::array<float, 5> default_ghosts = {0.0f, 0.3f, 0.7f, 1.0f, 1.5f};
+  EXPECT_EQ(defaults.ghost_positions, default_ghosts);
   EXPECT_THROW(FlareConfig::preset(static_cast<FlarePreset>(7)), Error);
 }
 
