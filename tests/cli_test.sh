@@ -442,7 +442,7 @@ cmp -s "$tmp/atomic.png" "$tmp/atomic.png.before" || fail "a failed bloom write 
 no_temporaries "$tmp" "a failed bloom write"
 # The demo's six files: the first three (scene.exr, depth.exr, lights.json) fit under the limit,
 # flares.exr (the scene plus flares) does not; none of the six is replaced.
-ok demo --size 96x64 --seed 7 --out "$tmp/atomic_demo"
+ok demo --size 96x64 --variant 7 --out "$tmp/atomic_demo"
 (cd "$tmp/atomic_demo" && md5sum * >"$tmp/atomic_demo.md5")
 ok demo --size 128x128 --out "$tmp/atomic_sizes"
 first=$(stat -c %s "$tmp/atomic_sizes/scene.exr" "$tmp/atomic_sizes/depth.exr" "$tmp/atomic_sizes/lights.json" | sort -n | tail -1)

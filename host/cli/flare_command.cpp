@@ -1,5 +1,5 @@
 // glint flare --color IN.exr --depth DEPTH.exr --lights LIGHTS.json OUT.exr: lens flares with
-// GPU visibility (issue 5, "CLI"). One command buffer holds the whole frame: the uploads, the Hi-Z
+// GPU visibility. One command buffer holds the whole frame: the uploads, the Hi-Z
 // build, the cull + occlusion grid + compaction, the draw (raster or compute) and the readbacks
 // (image, statistics, per-light results); nothing is read back between the stages.
 //
