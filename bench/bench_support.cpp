@@ -1,11 +1,11 @@
 #include "bench_support.h"
 
-#include "tooling/environment.h"
-
 #include <algorithm>
 #include <cstdio>
 #include <memory>
 #include <random>
+
+#include "tooling/environment.h"
 
 namespace glint::bench {
 

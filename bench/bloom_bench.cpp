@@ -4,9 +4,8 @@
 // Each iteration records kFramesPerIteration blooms back to back in one command buffer with a
 // timestamp between them and reports their median; Google Benchmark then aggregates iterations
 // (run with --benchmark_repetitions=N --benchmark_report_aggregates_only for medians).
-#include <glint/bloom.h>
-
 #include <benchmark/benchmark.h>
+#include <glint/bloom.h>
 
 #include <algorithm>
 #include <cstdlib>
@@ -71,10 +70,10 @@ void BM_Bloom(benchmark::State& state) {
   });
   for (const auto& s : stages.results()) {
     const std::string& l = s.label;
-    const char* key = l.find("bright") != std::string::npos ? "us_prefilter_down0"
+    const char* key = l.find("bright") != std::string::npos       ? "us_prefilter_down0"
                       : l.find("downsample") != std::string::npos ? "us_down"
-                      : l.find("upsample") != std::string::npos ? "us_up"
-                                                                 : "us_composite";
+                      : l.find("upsample") != std::string::npos   ? "us_up"
+                                                                  : "us_composite";
     state.counters[key] = s.ms * 1e3;
   }
   const double bytes = static_cast<double>(bloom.min_bytes_moved(format, format));

@@ -146,7 +146,8 @@ void run_gauss_benchmark(benchmark::State& state, BlurMethod method, bool linear
   state.counters["levels"] = c.levels;
   state.counters["taps"] = c.method == BlurMethod::separable ? 2.0 * c.radius + 1.0 : 0.0;
   state.counters["dispatches"] = c.dispatches;
-  state.SetLabel(std::string(blur_method_name(c.method)) + (c.linear_sampling ? "+linear" : "") + " on " + ctx.info().name);
+  state.SetLabel(std::string(blur_method_name(c.method)) + (c.linear_sampling ? "+linear" : "") + " on " +
+                 ctx.info().name);
 }
 
 void BM_BlurSeparable(benchmark::State& s) { run_gauss_benchmark(s, BlurMethod::separable, false); }

@@ -17,7 +17,14 @@ void BM_BlurPlanAuto(benchmark::State& state) {
     benchmark::DoNotOptimize(plan);
   }
 }
-BENCHMARK(BM_BlurPlanAuto)->Arg(5)->Arg(50)->Arg(240)->Arg(480)->Arg(640)->ArgName("sigma_x10")->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_BlurPlanAuto)
+    ->Arg(5)
+    ->Arg(50)
+    ->Arg(240)
+    ->Arg(480)
+    ->Arg(640)
+    ->ArgName("sigma_x10")
+    ->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace glint::bench

@@ -28,8 +28,8 @@ void BM_CopyFloor(benchmark::State& state) {
   desc.workgroup = detail::choose_workgroup_2d(ctx);
   detail::ComputePipeline copy(ctx, desc);
   detail::DescriptorArena arena(ctx, 1);
-  VkDescriptorSet set = arena.make_set(copy, {{src.state.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL},
-                                              {dst.state.view, VK_IMAGE_LAYOUT_GENERAL}});
+  VkDescriptorSet set = arena.make_set(
+      copy, {{src.state.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL}, {dst.state.view, VK_IMAGE_LAYOUT_GENERAL}});
   BloomPush push{};
   push.dst_width = static_cast<int32_t>(width);
   push.dst_height = static_cast<int32_t>(height);

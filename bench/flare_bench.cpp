@@ -8,9 +8,9 @@
 // - 0, the first configuration: 10 lights of 40 to 160 px (around the default flare size of
 //   100 px), 1000 lights of 8 to 48 px (street lamps in the distance).
 // - 1, mixed: sizes log-uniform over 10 to 100 px, the lower part of the 10 to 500 px range
-//   docs/FLARE.md designs for (a typical scene: 10 to 20 lights of mixed sizes). Each light covers about 22 size^2 pixels with its
-//   nine sprites (docs/FLARE.md), so the 10 lights of configuration 0 cover 2.06 M sprite pixels,
-//   40 times a naive "100x100 quad x 10 lights, half covered" estimate.
+//   docs/FLARE.md designs for (a typical scene: 10 to 20 lights of mixed sizes). Each light covers about 22 size^2
+//   pixels with its nine sprites (docs/FLARE.md), so the 10 lights of configuration 0 cover 2.06 M sprite pixels, 40
+//   times a naive "100x100 quad x 10 lights, half covered" estimate.
 // 0 lights measures the fixed cost of each path.
 //
 // Counters: median_us, sprite_pixels (pixels the sprites cover on screen, from the float64

@@ -1,8 +1,7 @@
 // LodBatch throughput: queries per second (GPU timestamps, manual time), with the largest
 // deviation from the C++ twin as the error counter.
-#include <glint/lod.h>
-
 #include <benchmark/benchmark.h>
+#include <glint/lod.h>
 
 #include <cmath>
 #include <cstring>
@@ -54,7 +53,8 @@ void BM_LodBatch(benchmark::State& state) {
   Profiler profiler(ctx, 17);
   std::vector<double> all;
   for (auto _ : state) {
-    const double ms = median_frame_ms(ctx, profiler, 16, [&](VkCommandBuffer cmd) { batch.record(cmd, q, l, count, atlas); });
+    const double ms =
+        median_frame_ms(ctx, profiler, 16, [&](VkCommandBuffer cmd) { batch.record(cmd, q, l, count, atlas); });
     all.push_back(ms);
     state.SetIterationTime(ms * 1e-3);
   }
@@ -71,7 +71,8 @@ void BM_LodBatch(benchmark::State& state) {
   readback.invalidate();
   const float* levels = static_cast<const float*>(readback.mapped());
   double worst = 0.0;
-  for (uint32_t i = 0; i < count; ++i) worst = std::max(worst, std::fabs(double(levels[i]) - lod_level(queries[i], atlas)));
+  for (uint32_t i = 0; i < count; ++i)
+    worst = std::max(worst, std::fabs(double(levels[i]) - lod_level(queries[i], atlas)));
   state.counters["queries_per_second"] = benchmark::Counter(count, benchmark::Counter::kIsIterationInvariantRate);
   state.counters["bytes_per_second"] = benchmark::Counter(count * 36.0, benchmark::Counter::kIsIterationInvariantRate);
   state.counters["median_us"] = median_of(all) * 1e3;

@@ -84,7 +84,8 @@ void BM_ObjectCull(benchmark::State& state) {
       o.sphere_or_min[3] = r;
     }
   }
-  detail::OwnedImage depth(ctx, {w, h}, VK_FORMAT_D32_SFLOAT, VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT);
+  detail::OwnedImage depth(ctx, {w, h}, VK_FORMAT_D32_SFLOAT,
+                           VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT);
   detail::upload_r32(ctx, depth.state, scene.depth.depth);
   HiZConfig hc;
   hc.extent = {w, h};
@@ -94,7 +95,8 @@ void BM_ObjectCull(benchmark::State& state) {
   cc.capacity = count;
   ObjectCuller culler(ctx, cc);
   auto obj_buf = upload(ctx, objects.data(), VkDeviceSize(count) * sizeof(GlintCullObject));
-  detail::OwnedBuffer vis(ctx, VkDeviceSize(count) * 4, kUsage, false), list(ctx, VkDeviceSize(count) * 4, kUsage, false);
+  detail::OwnedBuffer vis(ctx, VkDeviceSize(count) * 4, kUsage, false),
+      list(ctx, VkDeviceSize(count) * 4, kUsage, false);
   detail::OwnedBuffer indirect(ctx, sizeof(GlintObjectCullIndirect), kUsage, false);
   detail::OwnedBuffer stats(ctx, sizeof(GlintObjectCullStats), kUsage | VK_BUFFER_USAGE_TRANSFER_SRC_BIT, true);
   ObjectCullBuffers buffers{view_of(obj_buf, true), {}, view_of(vis, false)};
@@ -153,7 +155,8 @@ void BM_ObjectCull(benchmark::State& state) {
   const double bytes = double(culler.min_bytes_moved(count, st.written));
   state.counters["bytes_per_second"] = benchmark::Counter(bytes, benchmark::Counter::kIsIterationInvariantRate);
   state.counters["median_us"] = median_of(all) * 1e3;
-  state.counters["objects_per_second"] = benchmark::Counter(double(count), benchmark::Counter::kIsIterationInvariantRate);
+  state.counters["objects_per_second"] =
+      benchmark::Counter(double(count), benchmark::Counter::kIsIterationInvariantRate);
   state.counters["visible_share"] = double(st.visible) / count;
   state.counters["occluded_share"] = double(st.occluded) / count;
   state.counters["mismatches_vs_f64"] = double(mismatches + (st.total != count));

@@ -25,8 +25,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       for (float v : f) {
         if (!std::isfinite(v)) std::abort();
       }
-      if (!(q.tex_w >= 1.0f && q.tex_h >= 1.0f && q.off_x >= 0.0f && q.off_y >= 0.0f &&
-            q.off_x + q.tex_w <= float(w) && q.off_y + q.tex_h <= float(h))) {
+      if (!(q.tex_w >= 1.0f && q.tex_h >= 1.0f && q.off_x >= 0.0f && q.off_y >= 0.0f && q.off_x + q.tex_w <= float(w) &&
+            q.off_y + q.tex_h <= float(h))) {
         std::abort();
       }
     }

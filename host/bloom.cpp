@@ -49,8 +49,8 @@ void BloomConfig::validate() const {
   }
   const auto g = static_cast<uint32_t>(firefly_guard);
   if (g > static_cast<uint32_t>(FireflyGuard::karis_smooth)) {
-    throw Error(ErrorCode::invalid_argument,
-                concat("BloomConfig::firefly_guard = ", g, " is not a FireflyGuard: accepted off, karis, karis_smooth"));
+    throw Error(ErrorCode::invalid_argument, concat("BloomConfig::firefly_guard = ", g,
+                                                    " is not a FireflyGuard: accepted off, karis, karis_smooth"));
   }
   const auto p = static_cast<uint32_t>(precision);
   if (p > 1)
@@ -60,18 +60,24 @@ void BloomConfig::validate() const {
 
 const char* bloom_filter_name(BloomFilter filter) {
   switch (filter) {
-    case BloomFilter::cod13: return "cod13";
-    case BloomFilter::dual: return "dual";
-    case BloomFilter::gauss9: return "gauss9";
+    case BloomFilter::cod13:
+      return "cod13";
+    case BloomFilter::dual:
+      return "dual";
+    case BloomFilter::gauss9:
+      return "gauss9";
   }
   return "?";
 }
 
 const char* firefly_guard_name(FireflyGuard guard) {
   switch (guard) {
-    case FireflyGuard::off: return "off";
-    case FireflyGuard::karis: return "karis";
-    case FireflyGuard::karis_smooth: return "karis_smooth";
+    case FireflyGuard::off:
+      return "off";
+    case FireflyGuard::karis:
+      return "karis";
+    case FireflyGuard::karis_smooth:
+      return "karis_smooth";
   }
   return "?";
 }
@@ -179,15 +185,15 @@ struct Bloom::Impl {
     VkExtent2D extent{0, 0};
     std::vector<LevelSize> chain;
     bool was_clamped = false;
-    std::vector<LevelSize> pre_chain;            // level0_height's 2:1 steps before level 0
+    std::vector<LevelSize> pre_chain;  // level0_height's 2:1 steps before level 0
     std::vector<detail::OwnedImage> pre_levels;
-    std::vector<VkDescriptorSet> pre_sets;        // pre_levels[k] -> pre_levels[k + 1] or level 0
+    std::vector<VkDescriptorSet> pre_sets;  // pre_levels[k] -> pre_levels[k + 1] or level 0
     std::vector<detail::OwnedImage> levels;
     std::vector<detail::OwnedImage> temps;  // gauss9 horizontal pass, one per level
     detail::DescriptorArena internal_sets;
     std::vector<VkDescriptorSet> down_sets, blur_h_sets, blur_v_sets, up_sets;
     std::map<std::pair<VkImageView, VkImageView>, CallerSets> caller_sets;  // they name this pyramid's levels
-    detail::DescriptorArena caller_arena;  // grows by pools of 24 sets
+    detail::DescriptorArena caller_arena;                                   // grows by pools of 24 sets
   };
   detail::SizeCache<Pyramid> cache;
   Pyramid* cur = nullptr;   // the pyramid of the last prepare() or record()
@@ -211,8 +217,8 @@ struct Bloom::Impl {
     const std::string lv = detail::format_variant(level_format());
     const auto S = VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE;
     const auto W = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
-    const char* first = config.firefly_guard == FireflyGuard::karis_smooth ? "bloom_prefilter_smooth_"
-                                                                           : "bloom_prefilter_down_";
+    const char* first =
+        config.firefly_guard == FireflyGuard::karis_smooth ? "bloom_prefilter_smooth_" : "bloom_prefilter_down_";
     prefilter_down = detail::ComputePipeline(*context, desc(first + lv, {S, W}));
     down = detail::ComputePipeline(*context, desc("bloom_down_" + lv, {S, W}));
     blur = config.filter == BloomFilter::gauss9 ? detail::ComputePipeline(*context, desc("bloom_blur_" + lv, {S, W}))
@@ -258,7 +264,8 @@ struct Bloom::Impl {
     P.was_clamped = chain.size() < config.iterations;
     const VkImageUsageFlags usage = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT;
     const bool gauss = config.filter == BloomFilter::gauss9;
-    for (const LevelSize& l : pre_chain) pre_levels.emplace_back(*context, VkExtent2D{l.width, l.height}, level_format(), usage);
+    for (const LevelSize& l : pre_chain)
+      pre_levels.emplace_back(*context, VkExtent2D{l.width, l.height}, level_format(), usage);
     for (const LevelSize& l : chain) {
       levels.emplace_back(*context, VkExtent2D{l.width, l.height}, level_format(), usage);
       if (gauss) temps.emplace_back(*context, VkExtent2D{l.width, l.height}, level_format(), usage);
@@ -479,8 +486,8 @@ void Bloom::set_config(const BloomConfig& config) {
   config.validate();
   const BloomConfig old = impl_->config;
   impl_->config = config;
-  const bool smooth_changed = (old.firefly_guard == FireflyGuard::karis_smooth) !=
-                              (config.firefly_guard == FireflyGuard::karis_smooth);
+  const bool smooth_changed =
+      (old.firefly_guard == FireflyGuard::karis_smooth) != (config.firefly_guard == FireflyGuard::karis_smooth);
   const bool pipelines_changed = old.filter != config.filter || old.precision != config.precision || smooth_changed;
   const bool shape_changed =
       old.iterations != config.iterations || old.level0_height != config.level0_height || pipelines_changed;

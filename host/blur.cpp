@@ -15,8 +15,8 @@
 #include "blur_plan.h"
 #include "core/barriers.h"
 #include "core/check.h"
-#include "core/formats.h"
 #include "core/context_state.h"
+#include "core/formats.h"
 #include "core/pipeline.h"
 #include "core/resources.h"
 #include "core/size_cache.h"
@@ -76,8 +76,9 @@ void GaussianBlurConfig::validate() const {
                 concat("GaussianBlurConfig::precision = ", p, " is not a Precision: accepted fp16, fp32"));
   }
   if (linear_sampling && method != BlurMethod::separable) {
-    throw Error(ErrorCode::invalid_argument,
-                concat("GaussianBlurConfig::linear_sampling = true needs method separable, not ", blur_method_name(method)));
+    throw Error(
+        ErrorCode::invalid_argument,
+        concat("GaussianBlurConfig::linear_sampling = true needs method separable, not ", blur_method_name(method)));
   }
 }
 
@@ -137,10 +138,14 @@ float max_value_for(VkFormat a, VkFormat b) {
 double store_unit(VkFormat format) {
   switch (format) {
     case VK_FORMAT_R32G32B32A32_SFLOAT:
-    case VK_FORMAT_R32G32B32_SFLOAT: return blur_plan::store_unit(23);
-    case VK_FORMAT_B10G11R11_UFLOAT_PACK32: return blur_plan::store_unit(5);  // 6 bits (R, G), 5 (B)
-    case VK_FORMAT_E5B9G9R9_UFLOAT_PACK32: return blur_plan::store_unit(8);   // relative to the largest channel
-    default: return blur_plan::store_unit(10);                                // fp16
+    case VK_FORMAT_R32G32B32_SFLOAT:
+      return blur_plan::store_unit(23);
+    case VK_FORMAT_B10G11R11_UFLOAT_PACK32:
+      return blur_plan::store_unit(5);  // 6 bits (R, G), 5 (B)
+    case VK_FORMAT_E5B9G9R9_UFLOAT_PACK32:
+      return blur_plan::store_unit(8);  // relative to the largest channel
+    default:
+      return blur_plan::store_unit(10);  // fp16
   }
 }
 
@@ -156,13 +161,15 @@ std::string store_variant(VkFormat format) {
 void check_extent_named(const Context& context, VkExtent2D e, const char* where, const char* role) {
   const uint32_t max_dim = context.info().max_image_dimension_2d;
   if (e.width == 0 || e.height == 0 || e.width > max_dim || e.height > max_dim) {
-    throw Error(ErrorCode::unsupported_size, concat(where, ": ", role, *role ? " " : "", "extent ", e.width, "x",
-                                                    e.height, " is out of range: accepted 1 to ", max_dim,
-                                                    " on each side"));
+    throw Error(ErrorCode::unsupported_size,
+                concat(where, ": ", role, *role ? " " : "", "extent ", e.width, "x", e.height,
+                       " is out of range: accepted 1 to ", max_dim, " on each side"));
   }
 }
 
-void check_extent(const Context& context, VkExtent2D e, const char* where) { check_extent_named(context, e, where, ""); }
+void check_extent(const Context& context, VkExtent2D e, const char* where) {
+  check_extent_named(context, e, where, "");
+}
 
 void check_image(const Context& context, const Image& img, const char* where, const char* role, VkImageUsageFlags need,
                  const char* need_name) {
@@ -281,8 +288,7 @@ struct StepProgram {
     std::vector<VkDescriptorSet> sets(steps.size(), VK_NULL_HANDLE);
     for (size_t i = 0; i < steps.size(); ++i) {
       const Step& s = steps[i];
-      sets[i] =
-          (s.src < 0 || s.dst < 0) ? caller_arena.make_mixed_set(*s.pipeline, bindings_of(s, in, out)) : s.set;
+      sets[i] = (s.src < 0 || s.dst < 0) ? caller_arena.make_mixed_set(*s.pipeline, bindings_of(s, in, out)) : s.set;
     }
     return caller_sets.emplace(key, std::move(sets)).first->second;
   }
@@ -349,8 +355,8 @@ Step fused_step(StepProgram& prog, const DeviceInfo& info, int src, int dst, VkE
 }
 
 // A plain per-texel step (upsample, dual down/up) with 2D workgroups.
-Step simple_step(StepProgram& prog, const char* kernel, int src, int dst, VkExtent2D src_size,
-                 VkExtent2D dst_size, VkFormat dst_format, uint32_t flags, float max_value, std::string label,
+Step simple_step(StepProgram& prog, const char* kernel, int src, int dst, VkExtent2D src_size, VkExtent2D dst_size,
+                 VkFormat dst_format, uint32_t flags, float max_value, std::string label,
                  std::vector<VkDescriptorType> bindings = {VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE,
                                                            VK_DESCRIPTOR_TYPE_STORAGE_IMAGE}) {
   Step s;
@@ -463,8 +469,7 @@ const Image& BlurPyramid::level(uint32_t k) const {
   if (k < 1 || k > 3)
     throw Error(ErrorCode::invalid_argument,
                 concat("BlurPyramid::level: k = ", k, " is out of range: accepted 1 to 3"));
-  if (!impl_->cur)
-    throw Error(ErrorCode::invalid_argument, "BlurPyramid::level: call prepare() or record() first");
+  if (!impl_->cur) throw Error(ErrorCode::invalid_argument, "BlurPyramid::level: call prepare() or record() first");
   return impl_->cur->prog.images[k - 1].state;
 }
 
@@ -607,9 +612,9 @@ struct GaussianBlur::Impl {
       const detail::OwnedBuffer* buf = prog.add_taps(taps);
       const int scratch = add(size);
       for (int pass = 0; pass < 2; ++pass) {
-        Step s = simple_step(prog, "blur_linear", pass == 0 ? kInput : scratch, pass == 0 ? scratch : kOutput,
-                             size, size, pass == 0 ? lf : out_format, pass == 0 ? 0u : GLINT_BLUR_FLAG_VERTICAL,
-                             max_value, pass == 0 ? "gauss linear horizontal" : "gauss linear vertical",
+        Step s = simple_step(prog, "blur_linear", pass == 0 ? kInput : scratch, pass == 0 ? scratch : kOutput, size,
+                             size, pass == 0 ? lf : out_format, pass == 0 ? 0u : GLINT_BLUR_FLAG_VERTICAL, max_value,
+                             pass == 0 ? "gauss linear horizontal" : "gauss linear vertical",
                              {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
                               VK_DESCRIPTOR_TYPE_STORAGE_BUFFER});
         s.sampler = true;

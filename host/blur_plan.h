@@ -42,14 +42,14 @@ enum class Method : uint32_t { separable = 0, separable_linear = 1, pyramid = 2,
 /// The parameters of one method for one sigma (input pixels) at one image size.
 struct Plan {
   Method method = Method::separable;
-  double sigma_px = 0;          //!< requested sigma
-  uint32_t radius = 0;          //!< separable: taps radius at full resolution; pyramid: of level k
-  uint32_t levels = 0;          //!< pyramid / dual: k
-  double level_sigma = 0;       //!< pyramid: sigma_k in texels of level k (taps at kGaussTruncation)
-  double dual_offset = 1;       //!< dual: o
-  double effective_sigma_px = 0;   //!< sigma of the method's impulse response (input pixels)
-  double expected_relative_l2 = 0; //!< modelled error against the exact Gaussian (docs/BLUR.md)
-  double cost = 0;              //!< relative cost estimate used by auto (full-resolution texel passes)
+  double sigma_px = 0;              //!< requested sigma
+  uint32_t radius = 0;              //!< separable: taps radius at full resolution; pyramid: of level k
+  uint32_t levels = 0;              //!< pyramid / dual: k
+  double level_sigma = 0;           //!< pyramid: sigma_k in texels of level k (taps at kGaussTruncation)
+  double dual_offset = 1;           //!< dual: o
+  double effective_sigma_px = 0;    //!< sigma of the method's impulse response (input pixels)
+  double expected_relative_l2 = 0;  //!< modelled error against the exact Gaussian (docs/BLUR.md)
+  double cost = 0;                  //!< relative cost estimate used by auto (full-resolution texel passes)
 };
 
 /// How the GPU stores and samples what a plan computes, for the rounding part of the expected

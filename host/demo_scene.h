@@ -4,11 +4,10 @@
 #pragma once
 
 #include <glint/glint.h>
+#include <glint/gpu/flare_types.h>
 
 #include <array>
 #include <vector>
-
-#include <glint/gpu/flare_types.h>
 
 namespace glint::demo {
 

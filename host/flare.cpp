@@ -1,6 +1,5 @@
 // Lens-flare driver, the drawing half: validates, generates the element atlas, owns the
 // raster and compute pipelines, and records either path. docs/FLARE.md explains the choices.
-#include <cstdio>
 #include <glint/flare.h>
 #include <glint/gpu/flare_types.h>
 #include <glint/occlusion.h>
@@ -8,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <cstdio>
 #include <map>
 #include <string>
 #include <tuple>
@@ -123,7 +123,7 @@ struct LensFlare::Impl {
   uint32_t tiles_x = 0, tiles_y = 0;     // gather tiles: workgroup x by workgroup y * GATHER_ROWS
 
   // Atlas: one image with every level, a view of all levels (sampling) and one per level (storage).
-  detail::OwnedImage atlas_image;  // state tracks all levels together
+  detail::OwnedImage atlas_image;      // state tracks all levels together
   VkSampler sampler = VK_NULL_HANDLE;  // owned by the context
   bool atlas_generated = false;
   detail::ComputePipeline atlas_pipeline;
@@ -552,7 +552,8 @@ void LensFlare::record_compute(VkCommandBuffer cmd, Image& color, Buffer& instan
   } else {
     detail::DescriptorArena::AnyBinding dst;
     dst.image = {color.view, VK_IMAGE_LAYOUT_GENERAL};
-    set = m.sets.make_mixed_set(m.gather, {buffer_binding(instances), m.atlas_binding(), buffer_binding(indirect_words), dst});
+    set = m.sets.make_mixed_set(m.gather,
+                                {buffer_binding(instances), m.atlas_binding(), buffer_binding(indirect_words), dst});
     m.gather_sets.emplace(key, set);
   }
 

@@ -1,10 +1,9 @@
 // Compile-time checks that GlintFlareIndirect (include/glint/gpu/flare_types.h, which checks its own
 // std430 layout) puts the indirect arguments where Vulkan reads them.
-#include <cstddef>
-
+#include <glint/gpu/flare_types.h>
 #include <vulkan/vulkan.h>
 
-#include <glint/gpu/flare_types.h>
+#include <cstddef>
 
 static_assert(offsetof(GlintFlareIndirect, vertex_count) == offsetof(VkDrawIndirectCommand, vertexCount));
 static_assert(offsetof(GlintFlareIndirect, instance_count) == offsetof(VkDrawIndirectCommand, instanceCount));

@@ -109,7 +109,8 @@ void LodBatch::record(VkCommandBuffer cmd, Buffer& queries, Buffer& levels, uint
   detail::check_buffer("LodBatch::record", "queries", queries,
                        std::max<VkDeviceSize>(1, VkDeviceSize(count) * sizeof(LodQuery)),
                        VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
-  detail::check_buffer("LodBatch::record", "levels", levels, std::max<VkDeviceSize>(1, VkDeviceSize(count) * sizeof(float)),
+  detail::check_buffer("LodBatch::record", "levels", levels,
+                       std::max<VkDeviceSize>(1, VkDeviceSize(count) * sizeof(float)),
                        VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
   if (count == 0) return;
   VkDescriptorSet set = impl_->set_for(queries, levels);

@@ -59,11 +59,12 @@ void check_buffer(const char* where, const char* role, const Buffer& b, VkDevice
                 concat(where, ": ", role, " buffer size must be its byte count (not 0 or VK_WHOLE_SIZE)"));
   }
   if (b.size < need) {
-    throw Error(ErrorCode::invalid_argument, concat(where, ": ", role, " buffer holds ", b.size, " bytes; ", need, " needed"));
+    throw Error(ErrorCode::invalid_argument,
+                concat(where, ": ", role, " buffer holds ", b.size, " bytes; ", need, " needed"));
   }
   if (b.offset % 4 != 0) {
-    throw Error(ErrorCode::invalid_argument, concat(where, ": ", role, " buffer offset = ", b.offset,
-                                                    " is not a multiple of 4"));
+    throw Error(ErrorCode::invalid_argument,
+                concat(where, ": ", role, " buffer offset = ", b.offset, " is not a multiple of 4"));
   }
 }
 
@@ -87,17 +88,20 @@ float round_up(double v) {
 void camera_push(const ObjectCullFrame& frame, bool reversed_z, GlintObjectCullPush& push) {
   for (int i = 0; i < 16; ++i) {
     if (!std::isfinite(frame.view[i]))
-      throw Error(ErrorCode::invalid_argument, concat("ObjectCullFrame::view[", i, "] = ", frame.view[i], " is not finite"));
+      throw Error(ErrorCode::invalid_argument,
+                  concat("ObjectCullFrame::view[", i, "] = ", frame.view[i], " is not finite"));
     if (!std::isfinite(frame.proj[i]))
-      throw Error(ErrorCode::invalid_argument, concat("ObjectCullFrame::proj[", i, "] = ", frame.proj[i], " is not finite"));
+      throw Error(ErrorCode::invalid_argument,
+                  concat("ObjectCullFrame::proj[", i, "] = ", frame.proj[i], " is not finite"));
   }
   const float* v = frame.view;
   const int affine[4] = {3, 7, 11, 15};
   for (int k = 0; k < 4; ++k) {
     const float want = k == 3 ? 1.0f : 0.0f;
     if (v[affine[k]] != want) {
-      throw Error(ErrorCode::invalid_argument, concat("ObjectCullFrame::view[", affine[k], "] = ", v[affine[k]],
-                                                      " must be ", want, ": the view matrix must be affine (row 3 = 0 0 0 1)"));
+      throw Error(ErrorCode::invalid_argument,
+                  concat("ObjectCullFrame::view[", affine[k], "] = ", v[affine[k]], " must be ", want,
+                         ": the view matrix must be affine (row 3 = 0 0 0 1)"));
     }
   }
   const float* p = frame.proj;
@@ -133,8 +137,8 @@ void camera_push(const ObjectCullFrame& frame, bool reversed_z, GlintObjectCullP
   // plane where it is 1 (standard) or 0 (reversed); no positive solution: infinitely far.
   if (reversed_z ? !(b > 0) : !(b < 0)) {
     throw Error(ErrorCode::invalid_argument,
-                concat("ObjectCullFrame::proj[14] = ", b, " (P23) must be ", reversed_z ? "> 0" : "< 0",
-                       " for ", reversed_z ? "reversed" : "standard", " Z (ObjectCullConfig::reversed_z)"));
+                concat("ObjectCullFrame::proj[14] = ", b, " (P23) must be ", reversed_z ? "> 0" : "< 0", " for ",
+                       reversed_z ? "reversed" : "standard", " Z (ObjectCullConfig::reversed_z)"));
   }
   const double near_w = reversed_z ? b / (1.0 - a) : -b / a;
   const double far_w = reversed_z ? -b / a : b / (1.0 - a);
@@ -190,8 +194,7 @@ struct ObjectCuller::Impl {
   Buffer groups_state, dummy_state;
   bool counters_cleared = false;
   struct Sets {
-    VkDescriptorSet cull = VK_NULL_HANDLE, scan_tiles = VK_NULL_HANDLE, scan = VK_NULL_HANDLE,
-                    scatter = VK_NULL_HANDLE;
+    VkDescriptorSet cull = VK_NULL_HANDLE, scan_tiles = VK_NULL_HANDLE, scan = VK_NULL_HANDLE, scatter = VK_NULL_HANDLE;
   };
   std::map<std::vector<uint64_t>, Sets> sets;
   detail::DescriptorArena arena;
@@ -223,12 +226,9 @@ struct ObjectCuller::Impl {
                  st | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT);
     check_buffer(where, "stats", out.stats, sizeof(GlintObjectCullStats), st);
     // Storage descriptors bind each buffer's whole range, which the device limits.
-    const std::pair<const char*, const Buffer*> bound[] = {{"objects", &in.objects},
-                                                           {"payloads", &in.payloads},
-                                                           {"visibility", &in.visibility},
-                                                           {"list", &out.list},
-                                                           {"indirect", &out.indirect},
-                                                           {"stats", &out.stats}};
+    const std::pair<const char*, const Buffer*> bound[] = {{"objects", &in.objects},       {"payloads", &in.payloads},
+                                                           {"visibility", &in.visibility}, {"list", &out.list},
+                                                           {"indirect", &out.indirect},    {"stats", &out.stats}};
     for (const auto& [role, b] : bound) {
       if (b == &in.payloads && config.payload_words == 0) continue;
       if (b->size > max_range) {
@@ -243,22 +243,23 @@ struct ObjectCuller::Impl {
     const HiZConfig& hc = hiz.config();
     if (hc.reversed_z != config.reversed_z) {
       throw Error(ErrorCode::invalid_argument,
-                  concat(where, ": HiZConfig::reversed_z = ", hc.reversed_z, " differs from ObjectCullConfig::reversed_z = ",
-                         config.reversed_z));
+                  concat(where, ": HiZConfig::reversed_z = ", hc.reversed_z,
+                         " differs from ObjectCullConfig::reversed_z = ", config.reversed_z));
     }
-    if (!depth.image || !depth.view) throw Error(ErrorCode::invalid_argument, concat(where, ": depth image or view is null"));
+    if (!depth.image || !depth.view)
+      throw Error(ErrorCode::invalid_argument, concat(where, ": depth image or view is null"));
     if (depth.format != hc.format || depth.extent.width != hc.extent.width || depth.extent.height != hc.extent.height) {
       throw Error(ErrorCode::invalid_argument,
                   concat(where, ": depth (", detail::format_name(depth.format), " ", depth.extent.width, "x",
-                         depth.extent.height, ") does not match the Hi-Z pyramid (", detail::format_name(hc.format), " ",
-                         hc.extent.width, "x", hc.extent.height, ")"));
+                         depth.extent.height, ") does not match the Hi-Z pyramid (", detail::format_name(hc.format),
+                         " ", hc.extent.width, "x", hc.extent.height, ")"));
     }
     if (!(depth.usage & VK_IMAGE_USAGE_SAMPLED_BIT))
       throw Error(ErrorCode::missing_usage, concat(where, ": depth image lacks VK_IMAGE_USAGE_SAMPLED_BIT usage"));
   }
 
-  void run(VkCommandBuffer cmd, HiZPyramid* hiz, Image* depth, uint32_t mode, GlintObjectCullPush push,
-           uint32_t count, ObjectCullBuffers& in, ObjectCullOutputs& out, Profiler* profiler);
+  void run(VkCommandBuffer cmd, HiZPyramid* hiz, Image* depth, uint32_t mode, GlintObjectCullPush push, uint32_t count,
+           ObjectCullBuffers& in, ObjectCullOutputs& out, Profiler* profiler);
 };
 
 ObjectCuller::ObjectCuller(const Context& context, const ObjectCullConfig& config) : impl_(std::make_unique<Impl>()) {

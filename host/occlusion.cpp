@@ -1,11 +1,9 @@
 // Visibility driver for lens flares: the Hi-Z pyramid and the light culler (docs/OCCLUSION.md).
-#include "light_cull_params.h"  // push constants and buffer layouts shared with the kernels
-
-#include <array>
-#include <glint/occlusion.h>
 #include <glint/gpu/flare_types.h>
+#include <glint/occlusion.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstddef>
 #include <map>
@@ -14,10 +12,11 @@
 
 #include "core/barriers.h"
 #include "core/check.h"
-#include "core/formats.h"
 #include "core/context_state.h"
+#include "core/formats.h"
 #include "core/pipeline.h"
 #include "core/resources.h"
+#include "light_cull_params.h"  // push constants and buffer layouts shared with the kernels
 
 namespace glint {
 
@@ -348,7 +347,7 @@ struct LightCuller::Impl {
   // lights, instances, results, indirect and stats buffers. A fixed-size key: no allocation.
   using SetKey = std::array<uint64_t, 17>;
   std::map<SetKey, Sets> sets;
-  detail::DescriptorArena arena;  // pools of 16 sets, 8 descriptors of a type each (the scatter binds 5 buffers)
+  detail::DescriptorArena arena;      // pools of 16 sets, 8 descriptors of a type each (the scatter binds 5 buffers)
   detail::OwnedBuffer dummy_results;  // bound when the caller wants no per-light results
   Buffer dummy_state;
 
@@ -468,9 +467,9 @@ void LightCuller::record(VkCommandBuffer cmd, HiZPyramid& hiz, Image& depth, Buf
   const VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
   detail::check_buffer(where, "lights", lights, VkDeviceSize(count) * sizeof(GlintFlareLight), storage);
   detail::check_buffer(where, "instances", out.instances, VkDeviceSize(m.config.capacity) * sizeof(GlintFlareInstance),
-               storage);
+                       storage);
   detail::check_buffer(where, "indirect", out.indirect, sizeof(GlintFlareIndirect),
-               storage | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT);
+                       storage | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT);
   detail::check_buffer(where, "stats", out.stats, sizeof(GlintFlareStats), storage);
   const bool want_results = out.results.buffer != VK_NULL_HANDLE;
   if (want_results) {

@@ -6,6 +6,8 @@
 // allocate through the same operator new inside vkCmd* calls (lavapipe and the validation layer
 // do); an allocation counts only when the nearest caller outside the C++ runtime is this program,
 // where glint is linked statically (found with backtrace() and dladdr()).
+#include <dlfcn.h>
+#include <execinfo.h>
 #include <glint/bloom.h>
 #include <glint/blur.h>
 #include <glint/flare_pass.h>
@@ -13,9 +15,6 @@
 
 #include <cstdlib>
 #include <cstring>
-#include <dlfcn.h>
-#include <execinfo.h>
-
 #include <new>
 #include <string>
 
@@ -45,8 +44,9 @@ bool called_from_this_program(void* caller) {
     // The C++ runtime, and its templates instantiated in this program (std::string members that
     // a library calls may resolve to this program's copy).
     if (std::strstr(info.dli_fname, "libstdc++") || std::strstr(info.dli_fname, "libgcc")) return 1;
-    if (info.dli_sname && (std::strncmp(info.dli_sname, "_ZNSt", 5) == 0 || std::strncmp(info.dli_sname, "_ZNKSt", 6) == 0 ||
-                           std::strncmp(info.dli_sname, "_ZSt", 4) == 0))
+    if (info.dli_sname &&
+        (std::strncmp(info.dli_sname, "_ZNSt", 5) == 0 || std::strncmp(info.dli_sname, "_ZNKSt", 6) == 0 ||
+         std::strncmp(info.dli_sname, "_ZSt", 4) == 0))
       return 1;
     if (info.dli_fbase == self.dli_fbase) return 0;
     return 2;

@@ -284,33 +284,39 @@ std::vector<ApiCase> api_cases() {
                    }});
 
   // A null command buffer and image layouts outside the VkImageLayout enumeration.
-  cases.push_back({"Bloom::record null command buffer", ErrorCode::invalid_argument,
+  cases.push_back({"Bloom::record null command buffer",
+                   ErrorCode::invalid_argument,
                    {"Bloom::record", "command buffer is null"},
                    [](Fixture& fx, VkCommandBuffer, std::vector<Image*>& images, auto&) {
                      fx.bloom.record(VK_NULL_HANDLE, *images[0], *images[1]);
                    }});
-  cases.push_back({"BlurPyramid::record null command buffer", ErrorCode::invalid_argument,
+  cases.push_back({"BlurPyramid::record null command buffer",
+                   ErrorCode::invalid_argument,
                    {"BlurPyramid::record", "command buffer is null"},
                    [](Fixture& fx, VkCommandBuffer, std::vector<Image*>& images, auto&) {
                      fx.pyramid.record(VK_NULL_HANDLE, *images[0]);
                    }});
-  cases.push_back({"GaussianBlur::record null command buffer", ErrorCode::invalid_argument,
+  cases.push_back({"GaussianBlur::record null command buffer",
+                   ErrorCode::invalid_argument,
                    {"GaussianBlur::record", "command buffer is null"},
                    [](Fixture& fx, VkCommandBuffer, std::vector<Image*>& images, auto&) {
                      fx.gauss.record(VK_NULL_HANDLE, *images[0], *images[1]);
                    }});
-  cases.push_back({"LodBatch::record null command buffer", ErrorCode::invalid_argument,
+  cases.push_back({"LodBatch::record null command buffer",
+                   ErrorCode::invalid_argument,
                    {"LodBatch::record", "command buffer is null"},
                    [](Fixture& fx, VkCommandBuffer, auto&, std::vector<Buffer*>& b) {
                      fx.lod.record(VK_NULL_HANDLE, *b[0], *b[1], 16, LodAtlasConfig{});
                    }});
-  cases.push_back({"Bloom::record input layout 12345", ErrorCode::invalid_argument,
+  cases.push_back({"Bloom::record input layout 12345",
+                   ErrorCode::invalid_argument,
                    {"Bloom::record", "input Image::layout = 12345", "accepts"},
                    [](Fixture& fx, VkCommandBuffer cmd, std::vector<Image*>& images, auto&) {
                      images[0]->layout = static_cast<VkImageLayout>(12345);
                      fx.bloom.record(cmd, *images[0], *images[1]);
                    }});
-  cases.push_back({"GaussianBlur::record output layout PREINITIALIZED", ErrorCode::invalid_argument,
+  cases.push_back({"GaussianBlur::record output layout PREINITIALIZED",
+                   ErrorCode::invalid_argument,
                    {"GaussianBlur::record", "output Image::layout = VK_IMAGE_LAYOUT_PREINITIALIZED"},
                    [](Fixture& fx, VkCommandBuffer cmd, std::vector<Image*>& images, auto&) {
                      images[1]->layout = VK_IMAGE_LAYOUT_PREINITIALIZED;

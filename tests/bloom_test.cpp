@@ -187,8 +187,8 @@ TEST_F(BloomTest, MatchesReferenceForEveryGuardAndLevel0Height) {
           norm += want * want;
         }
         EXPECT_GT(norm, 0.0);
-        EXPECT_LT(std::sqrt(diff / norm), 1e-3) << bloom_filter_name(filter) << " guard " << firefly_guard_name(guard) << " "
-                                                << c.w << "x" << c.h << " level0_height " << c.level0_height;
+        EXPECT_LT(std::sqrt(diff / norm), 1e-3) << bloom_filter_name(filter) << " guard " << firefly_guard_name(guard)
+                                                << " " << c.w << "x" << c.h << " level0_height " << c.level0_height;
       }
     }
   }

@@ -392,9 +392,9 @@ TEST_F(ContextTest, AllocationBeyondTheHeapIsRefusedBeforeAllocating) {
   } catch (const Error& e) {
     EXPECT_EQ(e.code(), ErrorCode::unsupported_size);
     const std::string what = e.what();
-    EXPECT_NE(what.find("a test request needs " + std::to_string(req.size) + " bytes of memory heap " +
-                        std::to_string(heap)),
-              std::string::npos)
+    EXPECT_NE(
+        what.find("a test request needs " + std::to_string(req.size) + " bytes of memory heap " + std::to_string(heap)),
+        std::string::npos)
         << what;
   }
   EXPECT_EQ(context().objects_created(), objects);

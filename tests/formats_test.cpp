@@ -2,24 +2,25 @@
 // float colour formats the device supports, Hi-Z on every depth format, one layer of an array
 // image, and refusals that name the format, the layer count or the feature they refused.
 // Validation with synchronization validation is on (support/gpu_test.h).
-#include <cstdio>
+#include "core/formats.h"
+
 #include <glint/bloom.h>
 #include <glint/blur.h>
 #include <glint/occlusion.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <random>
 #include <string>
 
 #include "core/barriers.h"
 #include "core/check.h"
-#include "core/formats.h"
 #include "core/half.h"
 #include "core/packed_float.h"
-#include "reference/blur_reference.h"
 #include "reference/bloom_reference.h"
+#include "reference/blur_reference.h"
 #include "reference/occlusion_reference.h"
 #include "support/gpu_test.h"
 
@@ -36,7 +37,8 @@ class FormatsTest : public GpuTest {};
 // (creating a storage image of a format without STORAGE_IMAGE is invalid).
 VkImageUsageFlags usage_for(VkFormat format) {
   VkImageUsageFlags u = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
-  if (detail::format_features(context(), format) & VK_FORMAT_FEATURE_2_STORAGE_IMAGE_BIT) u |= VK_IMAGE_USAGE_STORAGE_BIT;
+  if (detail::format_features(context(), format) & VK_FORMAT_FEATURE_2_STORAGE_IMAGE_BIT)
+    u |= VK_IMAGE_USAGE_STORAGE_BIT;
   return u;
 }
 
@@ -101,16 +103,18 @@ Deviation compare(const CpuImage& gpu, const reference::DoubleImage& ref, VkForm
         double r = ref.at(x, y)[c];
         if (out_format == kB10) r = std::clamp(r, 0.0, detail::ufloat_max(c == 2 ? 5 : 6));
         const double g = gpu.at(x, y)[c];
-        const double bound = (store_ulp(out_format, c) + std::ldexp(1.0, -14)) * std::abs(r) +
-                             store_floor(out_format) + 1e-30;
+        const double bound =
+            (store_ulp(out_format, c) + std::ldexp(1.0, -14)) * std::abs(r) + store_floor(out_format) + 1e-30;
         const double ratio = std::abs(g - r) / bound;
         if (!(ratio <= 1.0)) {
           if (d.outside++ == 0) {
             d.first = detail::concat("(", x, ", ", y, ") channel ", c, ": ", g, " vs ", r);
           }
         }
-        if (std::isfinite(ratio)) d.worst = std::max(d.worst, ratio);
-        else d.worst = INFINITY;
+        if (std::isfinite(ratio))
+          d.worst = std::max(d.worst, ratio);
+        else
+          d.worst = INFINITY;
       }
     }
   }
@@ -129,9 +133,7 @@ CpuImage run_bloom(const BloomConfig& config, const CpuImage& input, VkFormat in
 // reference within the output format's rounding.
 TEST_F(FormatsTest, BloomReadsAndWritesB10G11R11WithinItsRounding) {
   const CpuImage input = random_hdr(61, 47, 21);
-  const struct {
-    VkFormat in, out;
-  } pairs[] = {{kB10, kB10}, {kF16, kB10}, {kB10, kF32}};
+  const struct { VkFormat in, out; } pairs[] = {{kB10, kB10}, {kF16, kB10}, {kB10, kF32}};
   for (BloomFilter filter : {BloomFilter::cod13, BloomFilter::dual, BloomFilter::gauss9}) {
     for (const auto& p : pairs) {
       BloomConfig config;
@@ -408,8 +410,8 @@ TEST_P(HiZDepthFormat, MatchesTheReference) {
       for (size_t i = 0; i < gpu.size(); ++i) {
         const double r = ref[k - 1].depth[i];
         if (!(std::abs(double(gpu[i]) - r) <= rel * r) && bad++ < 3) {
-          ADD_FAILURE() << name << (reversed ? " reversed" : "") << " level " << k << " texel " << i << ": "
-                        << gpu[i] << " vs " << r;
+          ADD_FAILURE() << name << (reversed ? " reversed" : "") << " level " << k << " texel " << i << ": " << gpu[i]
+                        << " vs " << r;
         }
       }
       EXPECT_EQ(bad, 0u) << name << " level " << k;

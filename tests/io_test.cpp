@@ -1,14 +1,13 @@
 // host/io: EXR and PNG round trips, and every way a file can be bad ending in Error(io_failure),
 // never a crash. No GPU. Truncation is tried at every length of a small file (as meshoptimizer's
 // tests do for buffers), so run this under GLINT_SANITIZE=ON as well.
-#include <glint/glint.h>
-#include <gtest/gtest.h>
-
 #include <ImfChannelList.h>
 #include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
 #include <ImfOutputFile.h>
 #include <ImfRgbaFile.h>
+#include <glint/glint.h>
+#include <gtest/gtest.h>
 #include <png.h>
 #include <signal.h>
 #include <sys/resource.h>
@@ -85,8 +84,8 @@ void write_float_channels(const std::string& path, int width, int height, const 
   for (size_t c = 0; c < names.size(); ++c) {
     for (int y = 0; y < height; ++y)
       for (int x = 0; x < width; ++x) planes[c][size_t(y) * width + x] = value(c, x, y);
-    fb.insert(names[c], Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(planes[c].data()), sizeof(float),
-                                   sizeof(float) * width));
+    fb.insert(names[c],
+              Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(planes[c].data()), sizeof(float), sizeof(float) * width));
   }
   Imf::OutputFile file(path.c_str(), header);
   file.setFrameBuffer(fb);
@@ -201,7 +200,8 @@ TEST_F(IoTest, ReadChannelByNameElseFirst) {
   EXPECT_EQ(first.name, "Z");
   EXPECT_EQ(io::read_exr_channel(path, "").name, "Z");
   // Several channels and none of them R, G, B or Y: read_exr refuses rather than guesses.
-  expect_io_failure(path, [&] { io::read_exr(path); }, "channels: Z, albedo, mask");
+  expect_io_failure(
+      path, [&] { io::read_exr(path); }, "channels: Z, albedo, mask");
 }
 
 TEST_F(IoTest, DataWindowWithOffsetIsTheImage) {
@@ -232,27 +232,34 @@ TEST_F(IoTest, DataWindowWithOffsetIsTheImage) {
 
 TEST_F(IoTest, MissingDirectoryEmptyAndForeignFilesFail) {
   const std::string missing = file("missing.exr");
-  expect_io_failure(missing, [&] { io::read_exr(missing); }, "no such file");
-  expect_io_failure(missing, [&] { io::read_exr_channel(missing, "Z"); }, "no such file");
+  expect_io_failure(
+      missing, [&] { io::read_exr(missing); }, "no such file");
+  expect_io_failure(
+      missing, [&] { io::read_exr_channel(missing, "Z"); }, "no such file");
 
   const std::string dir = dir_.string();
-  expect_io_failure(dir, [&] { io::read_exr(dir); }, "directory");
+  expect_io_failure(
+      dir, [&] { io::read_exr(dir); }, "directory");
 
   const std::string empty = file("empty.exr");
   write_bytes(empty, "", 0);
-  expect_io_failure(empty, [&] { io::read_exr(empty); }, "empty");
+  expect_io_failure(
+      empty, [&] { io::read_exr(empty); }, "empty");
 
   const std::string noise = file("noise.exr");
   std::mt19937 rng(3);
   std::vector<char> bytes(4096);
   for (char& b : bytes) b = static_cast<char>(rng());
   write_bytes(noise, bytes.data(), bytes.size());
-  expect_io_failure(noise, [&] { io::read_exr(noise); }, "not an OpenEXR file");
-  expect_io_failure(noise, [&] { io::read_exr_channel(noise, ""); }, "not an OpenEXR file");
+  expect_io_failure(
+      noise, [&] { io::read_exr(noise); }, "not an OpenEXR file");
+  expect_io_failure(
+      noise, [&] { io::read_exr_channel(noise, ""); }, "not an OpenEXR file");
 
   const std::string png = file("image.png");
   io::write_png_tonemapped(png, random_image(4, 4, 1));
-  expect_io_failure(png, [&] { io::read_exr(png); }, "not an OpenEXR file");
+  expect_io_failure(
+      png, [&] { io::read_exr(png); }, "not an OpenEXR file");
 }
 
 TEST_F(IoTest, TruncatedExrFailsAtEveryLength) {
@@ -307,8 +314,10 @@ TEST_F(IoTest, OversizedExrIsRejectedBeforeAllocation) {
     out.setFrameBuffer(row.data(), 1, size_t(width));
     out.writePixels(1);
   }
-  expect_io_failure(path, [&] { io::read_exr(path); }, "larger than glint reads");
-  expect_io_failure(path, [&] { io::read_exr_channel(path, "R"); }, "larger than glint reads");
+  expect_io_failure(
+      path, [&] { io::read_exr(path); }, "larger than glint reads");
+  expect_io_failure(
+      path, [&] { io::read_exr_channel(path, "R"); }, "larger than glint reads");
 }
 
 TEST_F(IoTest, WriteFailuresAreIoFailures) {
@@ -322,8 +331,10 @@ TEST_F(IoTest, WriteFailuresAreIoFailures) {
   expect_io_failure(dir, [&] { io::write_png_tonemapped(dir, img); });
 
   const std::string empty = file("empty.exr");
-  expect_io_failure(empty, [&] { io::write_exr_half(empty, CpuImage()); }, "empty");
-  expect_io_failure(empty, [&] { io::write_png_tonemapped(empty, CpuImage()); }, "empty");
+  expect_io_failure(
+      empty, [&] { io::write_exr_half(empty, CpuImage()); }, "empty");
+  expect_io_failure(
+      empty, [&] { io::write_png_tonemapped(empty, CpuImage()); }, "empty");
 
   CpuImage inconsistent(4, 4);
   inconsistent.rgba.resize(10);
@@ -388,9 +399,9 @@ TEST_F(IoTest, PngHoldsTheTonemappedSrgbPixels) {
       }
     }
   }
-  EXPECT_EQ(rgb[0], 0);      // NaN
+  EXPECT_EQ(rgb[0], 0);        // NaN
   EXPECT_EQ(rgb[3 + 1], 255);  // +Inf
-  EXPECT_EQ(rgb[6 + 2], 0);  // negative
+  EXPECT_EQ(rgb[6 + 2], 0);    // negative
 }
 
 // ---- AtomicOutputs ----
@@ -440,31 +451,40 @@ TEST_F(IoTest, AtomicOutputsReplaceAllFilesOnCommit) {
 TEST_F(IoTest, AtomicOutputsLeaveEverythingOnAFailingWrite) {
   io::write_text_file(file("a.txt"), "old a");
   io::write_text_file(file("b.txt"), "old b");
-  expect_io_failure(file("b.txt"), [&] {
-    io::AtomicOutputs out;
-    out.write(file("a.txt"), [](const std::string& tmp) { io::write_text_file(tmp, "new a"); });
-    out.write(file("b.txt"), [](const std::string& tmp) {
-      io::write_text_file(tmp, "half of b");  // partly written, then the device is full
-      throw Error(ErrorCode::io_failure, tmp + ": No space left on device");
-    });
-    out.commit();
-  }, "No space left on device");
+  expect_io_failure(
+      file("b.txt"),
+      [&] {
+        io::AtomicOutputs out;
+        out.write(file("a.txt"), [](const std::string& tmp) { io::write_text_file(tmp, "new a"); });
+        out.write(file("b.txt"), [](const std::string& tmp) {
+          io::write_text_file(tmp, "half of b");  // partly written, then the device is full
+          throw Error(ErrorCode::io_failure, tmp + ": No space left on device");
+        });
+        out.commit();
+      },
+      "No space left on device");
   EXPECT_EQ(read_text(file("a.txt")), "old a");
   EXPECT_EQ(read_text(file("b.txt")), "old b");
   EXPECT_TRUE(temporaries_in(dir_).empty());
   // An exception of another type is reported as io_failure naming the target too.
-  expect_io_failure(file("a.txt"), [&] {
-    io::AtomicOutputs out;
-    out.write(file("a.txt"), [](const std::string&) { throw std::runtime_error("disk on fire"); });
-  }, "disk on fire");
+  expect_io_failure(
+      file("a.txt"),
+      [&] {
+        io::AtomicOutputs out;
+        out.write(file("a.txt"), [](const std::string&) { throw std::runtime_error("disk on fire"); });
+      },
+      "disk on fire");
   EXPECT_EQ(read_text(file("a.txt")), "old a");
   EXPECT_TRUE(temporaries_in(dir_).empty());
   // A missing directory fails before any writer runs.
   bool ran = false;
-  expect_io_failure(file("no/such/x.txt"), [&] {
-    io::AtomicOutputs out;
-    out.write(file("no/such/x.txt"), [&](const std::string&) { ran = true; });
-  }, "does not exist");
+  expect_io_failure(
+      file("no/such/x.txt"),
+      [&] {
+        io::AtomicOutputs out;
+        out.write(file("no/such/x.txt"), [&](const std::string&) { ran = true; });
+      },
+      "does not exist");
   EXPECT_FALSE(ran);
 }
 

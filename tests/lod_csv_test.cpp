@@ -1,5 +1,7 @@
 // host/io/lod_csv: QUERIES.csv of `glint lod` read strictly: the header rule, every data row parsed
 // or rejected with its line and field, the ranges of the tile, and the size and line caps. No GPU.
+#include "io/lod_csv.h"
+
 #include <glint/glint.h>
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -10,8 +12,6 @@
 #include <fstream>
 #include <initializer_list>
 #include <string>
-
-#include "io/lod_csv.h"
 
 namespace glint::io {
 namespace {
@@ -70,7 +70,8 @@ TEST(LodCsv, AFirstRowOfUnderflowingNumbersIsData) {
   expect_error("nan,0,0,0.1,256,256,0,0\n", {"line 1", "field 1 (dudx)", "out of range", "finite"});
   // A header must name 8 fields; only the first content line may be one.
   expect_error("a,b,c\n", {"line 1", "header has 3 fields"});
-  expect_error("0,0,0,0,1,1,0,0\ndudx,dvdx,dudy,dvdy,tex_w,tex_h,off_x,off_y\n", {"line 2", "field 1 (dudx)", "'dudx'"});
+  expect_error("0,0,0,0,1,1,0,0\ndudx,dvdx,dudy,dvdy,tex_w,tex_h,off_x,off_y\n",
+               {"line 2", "field 1 (dudx)", "'dudx'"});
   expect_error("# c\nh1,h2,h3,h4,h5,h6,h7,h8\nh1,h2,h3,h4,h5,h6,h7,h8\n", {"line 3", "not a number"});
 }
 
@@ -111,7 +112,8 @@ TEST(LodCsv, MalformedLines) {
 // Every prefix of a valid file either parses (ending at a row boundary, or a row whose numbers
 // are still valid when cut) or is an error; never a crash.
 TEST(LodCsv, EveryTruncationParsesOrFails) {
-  const std::string text = "dudx,dvdx,dudy,dvdy,tex_w,tex_h,off_x,off_y\n0.25,0,0,0.25,64,64,128,128\n1,2,3,4,5,6,7,8\n";
+  const std::string text =
+      "dudx,dvdx,dudy,dvdy,tex_w,tex_h,off_x,off_y\n0.25,0,0,0.25,64,64,128,128\n1,2,3,4,5,6,7,8\n";
   ASSERT_EQ(parse_lod_csv(text, 4096, 4096).queries.size(), 2u);
   for (size_t n = 0; n <= text.size(); ++n) {
     try {

@@ -4,7 +4,6 @@
 // cases a to g of docs/LOD.md, and the properties the specification implies. No Vulkan: the GPU's own sampler is
 // compared in tests/lod_test.cpp. Random inputs come from std::mt19937 started from fixed values.
 #include "lod_math.h"
-#include "reference/lod_reference.h"
 
 #include <gtest/gtest.h>
 
@@ -15,6 +14,8 @@
 #include <random>
 #include <string>
 #include <vector>
+
+#include "reference/lod_reference.h"
 
 namespace {
 
@@ -40,8 +41,8 @@ GlintLodQuery make_query(float dudx, float dvdx, float dudy, float dvdy, float w
   return q;
 }
 
-GlintLodAtlas make_atlas(float w, float h, float levels, float bias = 0.0f, uint32_t flags = 0u,
-                         float max_aniso = 1.0f, float padding = 0.0f) {
+GlintLodAtlas make_atlas(float w, float h, float levels, float bias = 0.0f, uint32_t flags = 0u, float max_aniso = 1.0f,
+                         float padding = 0.0f) {
   GlintLodAtlas a{};
   a.atlas_w = w;
   a.atlas_h = h;
@@ -115,9 +116,9 @@ GlintLodAtlas random_atlas(std::mt19937& rng) {
 // and the sampler scales by the atlas size W (docs/LOD.md). Float64, no clamp.
 double sampler_view_unclamped(const GlintLodQuery& q, const GlintLodAtlas& a) {
   const double W = a.atlas_w, H = a.atlas_h;
-  GlintLodQuery atlas_q = make_query(float(q.dudx * double(q.tex_w) / W), float(q.dvdx * double(q.tex_h) / H),
-                                     float(q.dudy * double(q.tex_w) / W), float(q.dvdy * double(q.tex_h) / H),
-                                     a.atlas_w, a.atlas_h);
+  GlintLodQuery atlas_q =
+      make_query(float(q.dudx * double(q.tex_w) / W), float(q.dvdx * double(q.tex_h) / H),
+                 float(q.dudy * double(q.tex_w) / W), float(q.dvdy * double(q.tex_h) / H), a.atlas_w, a.atlas_h);
   GlintLodAtlas whole = a;
   whole.flags &= ~GLINT_LOD_PADDING_CAP;
   return ref::lod_unclamped(atlas_q, whole);
@@ -247,7 +248,8 @@ TEST(LodMath, TwinMatchesFloat64Reference) {
     const double err = std::fabs(twin - exact);
     worst = std::max(worst, err);
     if (exact > 0.0 && exact < a.levels - 1.0) ++interior;
-    if (!(err <= kTol) && ++failures <= 10) ADD_FAILURE() << "twin " << twin << " reference " << exact << " for " << describe(q, a);
+    if (!(err <= kTol) && ++failures <= 10)
+      ADD_FAILURE() << "twin " << twin << " reference " << exact << " for " << describe(q, a);
     // The scale factors themselves agree to float precision.
     EXPECT_NEAR(lm::glint_lod_rho_x(q), ref::lod_rho_x(q), 1e-6 * ref::lod_rho_x(q) + 1e-30);
     EXPECT_NEAR(lm::glint_lod_rho_y(q), ref::lod_rho_y(q), 1e-6 * ref::lod_rho_y(q) + 1e-30);
@@ -290,9 +292,9 @@ TEST(LodMath, AtlasCaseAB_TileInAtlasMatchesStandaloneTexture) {
     EXPECT_GT(compared, 1000) << size;
   }
   // Hand values: 4 tile texels per pixel is level 2 whatever the tile's size and place.
-  EXPECT_FLOAT_EQ(lm::glint_lod(make_query(4.0f / 16, 0, 0, 4.0f / 16, 16, 16, 4080, 0),
-                                make_atlas(kAtlas, kAtlas, kAtlasLevels)),
-                  2.0f);
+  EXPECT_FLOAT_EQ(
+      lm::glint_lod(make_query(4.0f / 16, 0, 0, 4.0f / 16, 16, 16, 4080, 0), make_atlas(kAtlas, kAtlas, kAtlasLevels)),
+      2.0f);
   EXPECT_FLOAT_EQ(lm::glint_lod(make_query(4.0f / 2048, 0, 0, 4.0f / 2048, 2048, 2048, 2048, 2048),
                                 make_atlas(kAtlas, kAtlas, kAtlasLevels)),
                   2.0f);
@@ -309,7 +311,8 @@ TEST(LodMath, AtlasCaseC_NonSquareScalesUByWidthAndVByHeight) {
     if (dx == 0.0f && dy == 0.0f) continue;
     const GlintLodQuery tall_u = make_query(dx, 0, dy, 0, 256, 512, 1024, 512);
     const GlintLodQuery square_u = make_query(dx, 0, dy, 0, 256, 256, 3000, 17);
-    EXPECT_EQ(lm::glint_lod_unclamped(tall_u, atlas), lm::glint_lod_unclamped(square_u, atlas)) << describe(tall_u, atlas);
+    EXPECT_EQ(lm::glint_lod_unclamped(tall_u, atlas), lm::glint_lod_unclamped(square_u, atlas))
+        << describe(tall_u, atlas);
     EXPECT_EQ(lm::glint_lod(tall_u, atlas), lm::glint_lod(square_u, atlas)) << describe(tall_u, atlas);
     EXPECT_NEAR(ref::lod(tall_u, atlas), ref::lod(square_u, atlas), 1e-12);
     const GlintLodQuery tall_v = make_query(0, dx, 0, dy, 256, 512, 1024, 512);
@@ -369,11 +372,11 @@ TEST(LodMath, AtlasCaseE_AdjacentTilesNoBleedAtChosenLevel) {
           const double ratio = std::exp2(std::uniform_real_distribution<double>(0.0, 4.0)(rng));
           GlintLodQuery q = make_query(float(texels * std::cos(angle) / tw), float(texels * std::sin(angle) / a_tile.h),
                                        float(-texels / ratio * std::sin(angle) / tw),
-                                       float(texels / ratio * std::cos(angle) / a_tile.h), float(tw),
-                                       float(a_tile.h), float(a_tile.x), float(a_tile.y));
-          const GlintLodAtlas atlas = make_atlas(kSize, kSize, levels, 0.0f,
-                                                 GLINT_LOD_PADDING_CAP | (aniso ? GLINT_LOD_ANISOTROPIC : 0u), 4.0f,
-                                                 float(pad));
+                                       float(texels / ratio * std::cos(angle) / a_tile.h), float(tw), float(a_tile.h),
+                                       float(a_tile.x), float(a_tile.y));
+          const GlintLodAtlas atlas =
+              make_atlas(kSize, kSize, levels, 0.0f, GLINT_LOD_PADDING_CAP | (aniso ? GLINT_LOD_ANISOTROPIC : 0u), 4.0f,
+                         float(pad));
           const double cap = lm::glint_lod_padding_cap(q, atlas);
           const double reach = aniso ? 0.5 * std::max(ref::lod_rho_x(q), ref::lod_rho_y(q)) : 0.0;
           if (pad - reach < 2.0) continue;  // the footprint alone is longer than the padding
@@ -470,8 +473,8 @@ TEST(LodMath, DoublingDerivativesAddsOneLevel) {
     a.flags &= ~GLINT_LOD_PADDING_CAP;
     const double l1 = lm::glint_lod(q, a), l2 = lm::glint_lod(scaled(q, 2.0f), a);
     const double u1 = ref::lod_unclamped(q, a);
-    EXPECT_NEAR(lm::glint_lod_unclamped(scaled(q, 2.0f), a) - lm::glint_lod_unclamped(q, a),
-                u1 > -1e9 ? 1.0 : 0.0, kTol)
+    EXPECT_NEAR(lm::glint_lod_unclamped(scaled(q, 2.0f), a) - lm::glint_lod_unclamped(q, a), u1 > -1e9 ? 1.0 : 0.0,
+                kTol)
         << describe(q, a);
     if (u1 > 1e-4 && u1 + 1.0 < a.levels - 1.0 - 1e-4) {
       EXPECT_NEAR(l2 - l1, 1.0, kTol) << describe(q, a);
@@ -522,9 +525,9 @@ TEST(LodMath, AnisotropicCases) {
       const double major = 64.0, minor = major / ratio;
       const bool x_major = step % 2 == 0;
       const double mx = x_major ? major : minor, my = x_major ? minor : major;
-      const GlintLodQuery q = make_query(float(mx * std::cos(angle) / 200), float(mx * std::sin(angle) / 100),
-                                         float(-my * std::sin(angle) / 200), float(my * std::cos(angle) / 100),
-                                         200, 100, 7, 9);
+      const GlintLodQuery q =
+          make_query(float(mx * std::cos(angle) / 200), float(mx * std::sin(angle) / 100),
+                     float(-my * std::sin(angle) / 200), float(my * std::cos(angle) / 100), 200, 100, 7, 9);
       const double expected = std::log2(major / std::min(ratio, double(max_aniso)));
       EXPECT_NEAR(lm::glint_lod(q, an), expected, kTol) << "ratio " << ratio << " max_aniso " << max_aniso;
       EXPECT_NEAR(ref::lod(q, an), expected, 1e-6) << "ratio " << ratio << " max_aniso " << max_aniso;
@@ -563,8 +566,8 @@ TEST(LodMath, PaddingCapCoversAnisotropicMajorAxis) {
   const Rect b_tile{a_tile.x + a_tile.w + 2 * kPad, a_tile.y, 32, 32};
   const MipChain mips = build_atlas(kSize, a_tile, b_tile, kPad);
   const GlintLodQuery q = make_query(24.0f / 32, 0.0f, 0.0f, 0.5f / 32, 32, 32, kPad + 3, kPad);  // rho_max = 24
-  const GlintLodAtlas an = make_atlas(kSize, kSize, 9, 0.0f, GLINT_LOD_ANISOTROPIC | GLINT_LOD_PADDING_CAP, 16.0f,
-                                      float(kPad));
+  const GlintLodAtlas an =
+      make_atlas(kSize, kSize, 9, 0.0f, GLINT_LOD_ANISOTROPIC | GLINT_LOD_PADDING_CAP, 16.0f, float(kPad));
   GlintLodAtlas iso_cap = an;
   iso_cap.flags = GLINT_LOD_PADDING_CAP;
   EXPECT_EQ(lm::glint_lod_padding_cap(q, an), 1.0f);       // 2^2 + 12 <= 16 < 2^3 + 12
@@ -585,20 +588,48 @@ TEST(LodMath, EveryPathClampsAndInvalidInputGivesLevelZero) {
     for (int k = 0; k < 2 && std::bernoulli_distribution(0.5)(rng); ++k) {
       const float v = specials[std::uniform_int_distribution<int>(0, 8)(rng)];
       switch (std::uniform_int_distribution<int>(0, 13)(rng)) {
-        case 0: q.dudx = v; break;
-        case 1: q.dvdx = v; break;
-        case 2: q.dudy = v; break;
-        case 3: q.dvdy = v; break;
-        case 4: q.tex_w = v; break;
-        case 5: q.tex_h = v; break;
-        case 6: q.off_x = v; break;
-        case 7: q.off_y = v; break;
-        case 8: a.atlas_w = v; break;
-        case 9: a.atlas_h = v; break;
-        case 10: a.levels = v; break;
-        case 11: a.bias = v; break;
-        case 12: a.padding = v; break;
-        default: a.levels = std::floor(std::fabs(v)); break;
+        case 0:
+          q.dudx = v;
+          break;
+        case 1:
+          q.dvdx = v;
+          break;
+        case 2:
+          q.dudy = v;
+          break;
+        case 3:
+          q.dvdy = v;
+          break;
+        case 4:
+          q.tex_w = v;
+          break;
+        case 5:
+          q.tex_h = v;
+          break;
+        case 6:
+          q.off_x = v;
+          break;
+        case 7:
+          q.off_y = v;
+          break;
+        case 8:
+          a.atlas_w = v;
+          break;
+        case 9:
+          a.atlas_h = v;
+          break;
+        case 10:
+          a.levels = v;
+          break;
+        case 11:
+          a.bias = v;
+          break;
+        case 12:
+          a.padding = v;
+          break;
+        default:
+          a.levels = std::floor(std::fabs(v));
+          break;
       }
     }
     const float l = lm::glint_lod(q, a);
@@ -613,7 +644,8 @@ TEST(LodMath, EveryPathClampsAndInvalidInputGivesLevelZero) {
     if (!ref::lod_valid(q, a)) {
       EXPECT_EQ(l, 0.0f) << describe(q, a);
       EXPECT_EQ(r, 0.0);
-    } else if (a.levels <= 64.0f && std::fabs(a.bias) <= 16.0f && ref::lod_rho_x(q) < 1e18 && ref::lod_rho_y(q) < 1e18) {
+    } else if (a.levels <= 64.0f && std::fabs(a.bias) <= 16.0f && ref::lod_rho_x(q) < 1e18 &&
+               ref::lod_rho_y(q) < 1e18) {
       // Inside float's comfortable range (a mip chain has at most 33 levels, maxSamplerLodBias is
       // small, and scale factors near 2^64 overflow float squares) the twin matches the reference.
       EXPECT_NEAR(l, r, kTol) << describe(q, a);

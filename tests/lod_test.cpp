@@ -43,10 +43,9 @@ std::vector<LodQuery> random_queries(size_t n, uint32_t stream, bool isotropic_o
 }
 
 detail::OwnedBuffer host_buffer(VkDeviceSize bytes) {
-  return detail::OwnedBuffer(context(), bytes,
-                             VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
-                                 VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                             true);
+  return detail::OwnedBuffer(
+      context(), bytes,
+      VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT, true);
 }
 
 Buffer view(const detail::OwnedBuffer& b) {
@@ -142,8 +141,8 @@ TEST_F(LodTest, BadInputIsRejected) {
   EXPECT_THROW(nan_bias.validate(), Error);
 }
 
-// The hardware check (docs/LOD.md, "Measured on hardware"). The atlas is 4096x4096 R32F with 13 levels, level i cleared to i,
-// sampled trilinear with anisotropy off, so the returned value is the sampler's (clamped) LOD.
+// The hardware check (docs/LOD.md, "Measured on hardware"). The atlas is 4096x4096 R32F with 13 levels, level i cleared
+// to i, sampled trilinear with anisotropy off, so the returned value is the sampler's (clamped) LOD.
 struct LevelAtlas {
   VkImage image = VK_NULL_HANDLE;
   VkDeviceMemory memory = VK_NULL_HANDLE;
@@ -229,7 +228,8 @@ std::vector<float> probe_sampler(const char* kernel, const LevelAtlas& atlas, co
   desc.push_constant_bytes = sizeof(GlintLodAtlas) + 4;
   desc.workgroup = {64, 1};
   detail::ComputePipeline probe(context(), desc);
-  VkDescriptorPoolSize sizes[] = {{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1}, {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 2}};
+  VkDescriptorPoolSize sizes[] = {{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1},
+                                  {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 2}};
   VkDescriptorPoolCreateInfo pi{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
   pi.maxSets = 1;
   pi.poolSizeCount = 2;
@@ -250,7 +250,8 @@ std::vector<float> probe_sampler(const char* kernel, const LevelAtlas& atlas, co
   qbuf.flush();
   VkDescriptorImageInfo ii{atlas.sampler, atlas.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
   VkDescriptorBufferInfo bq{qbuf.buffer(), 0, VK_WHOLE_SIZE}, bl{lbuf.buffer(), 0, VK_WHOLE_SIZE};
-  VkWriteDescriptorSet w[3] = {{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET}, {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET},
+  VkWriteDescriptorSet w[3] = {{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET},
+                               {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET},
                                {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET}};
   for (uint32_t i = 0; i < 3; ++i) {
     w[i].dstSet = set;
@@ -325,10 +326,11 @@ TEST_F(LodTest, DeviceSamplerStaysInsideTheSpecificationWindow) {
       ++counted;
     }
   }
-  std::printf("lod hardware check on %s (mipmapPrecisionBits %u): %zu queries, %zu outside the spec window; "
-              "vs exact length: mean |dev| %.4f, mean dev %+.4f, max |dev| %.4f levels\n",
-              context().info().name.c_str(), props.limits.mipmapPrecisionBits, queries.size(), outside,
-              sum_dev / counted, sum_signed / counted, max_dev);
+  std::printf(
+      "lod hardware check on %s (mipmapPrecisionBits %u): %zu queries, %zu outside the spec window; "
+      "vs exact length: mean |dev| %.4f, mean dev %+.4f, max |dev| %.4f levels\n",
+      context().info().name.c_str(), props.limits.mipmapPrecisionBits, queries.size(), outside, sum_dev / counted,
+      sum_signed / counted, max_dev);
   RecordProperty("mean_abs_deviation_levels", std::to_string(sum_dev / counted));
   RecordProperty("max_abs_deviation_levels", std::to_string(max_dev));
   EXPECT_EQ(outside, 0u);
@@ -367,10 +369,11 @@ TEST_F(LodTest, ExplicitLevelBlendStaysWithinTheGuaranteedMipmapPrecision) {
   }
   const double guaranteed = 1.0 / 16 + 1.0 / 256;
   const double claimed = std::ldexp(1.0, -int(props.limits.mipmapPrecisionBits)) + 1.0 / 256;
-  std::printf("explicit level blend on %s: worst |delta' - frac(lambda)| %.5f levels; claimed mipmapPrecisionBits %u "
-              "(%.5f), guaranteed 4 bits (%.5f)%s\n",
-              context().info().name.c_str(), worst, props.limits.mipmapPrecisionBits, claimed, guaranteed,
-              worst > claimed ? ": the device blends more coarsely than it claims" : "");
+  std::printf(
+      "explicit level blend on %s: worst |delta' - frac(lambda)| %.5f levels; claimed mipmapPrecisionBits %u "
+      "(%.5f), guaranteed 4 bits (%.5f)%s\n",
+      context().info().name.c_str(), worst, props.limits.mipmapPrecisionBits, claimed, guaranteed,
+      worst > claimed ? ": the device blends more coarsely than it claims" : "");
   RecordProperty("explicit_level_worst_deviation", std::to_string(worst));
   EXPECT_LE(worst, guaranteed);
   EXPECT_GT(blended, queries.size() / 2) << "the probe is not blending levels";

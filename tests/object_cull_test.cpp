@@ -64,8 +64,10 @@ TestCamera make_camera(std::mt19937& rng, const SceneSpec& s) {
   for (int col = 0; col < 4; ++col)
     for (int row = 0; row < 4; ++row) {
       double v = 0;
-      if (row < 3) v = col < 3 ? R[row * 3 + col] : c.t[row];
-      else v = col == 3 ? 1 : 0;
+      if (row < 3)
+        v = col < 3 ? R[row * 3 + col] : c.t[row];
+      else
+        v = col == 3 ? 1 : 0;
       c.cam.view[col * 4 + row] = static_cast<float>(v);
     }
   c.cam.reversed_z = s.reversed;
@@ -78,7 +80,8 @@ TestCamera make_camera(std::mt19937& rng, const SceneSpec& s) {
 void to_world(const TestCamera& c, const double v[3], float out[3]) {
   double d[3] = {v[0] - c.cam.view[12], v[1] - c.cam.view[13], v[2] - c.cam.view[14]};
   for (int i = 0; i < 3; ++i)
-    out[i] = static_cast<float>(c.cam.view[i * 4 + 0] * d[0] + c.cam.view[i * 4 + 1] * d[1] + c.cam.view[i * 4 + 2] * d[2]);
+    out[i] =
+        static_cast<float>(c.cam.view[i * 4 + 0] * d[0] + c.cam.view[i * 4 + 1] * d[1] + c.cam.view[i * 4 + 2] * d[2]);
 }
 
 double depth_of(const TestCamera& c, double distance) {
@@ -114,14 +117,20 @@ std::vector<GlintCullObject> make_objects(std::mt19937& rng, const TestCamera& c
     o = {};
     const double pick = u(rng);
     double dist = 0.3 + u(rng) * 60.0;
-    if (pick < 0.05) dist = -u(rng) * 5.0;                               // behind the camera
-    else if (pick < 0.10) dist = c.near_z + (u(rng) - 0.5) * 0.3;        // at the near plane
-    else if (pick < 0.13) dist = c.far_z * (0.9 + 0.3 * u(rng));          // at the far plane
+    if (pick < 0.05)
+      dist = -u(rng) * 5.0;  // behind the camera
+    else if (pick < 0.10)
+      dist = c.near_z + (u(rng) - 0.5) * 0.3;  // at the near plane
+    else if (pick < 0.13)
+      dist = c.far_z * (0.9 + 0.3 * u(rng));  // at the far plane
     const double ndc_x = (u(rng) * 2 - 1) * 1.5, ndc_y = (u(rng) * 2 - 1) * 1.5;
     const double ad = std::max(std::abs(dist), 0.05);
     const double v[3] = {ndc_x * ad / P00, ndc_y * ad / P11, -dist};
     const double size_pick = u(rng);
-    const double rad = size_pick < 0.25 ? ad * 1e-4 * u(rng) : size_pick < 0.6 ? ad * 0.01 : size_pick < 0.9 ? ad * 0.1 * u(rng) : ad * 1.5 * u(rng);
+    const double rad = size_pick < 0.25  ? ad * 1e-4 * u(rng)
+                       : size_pick < 0.6 ? ad * 0.01
+                       : size_pick < 0.9 ? ad * 0.1 * u(rng)
+                                         : ad * 1.5 * u(rng);
     float w[3];
     to_world(c, v, w);
     if (u(rng) < 0.5) {
@@ -139,11 +148,16 @@ std::vector<GlintCullObject> make_objects(std::mt19937& rng, const TestCamera& c
       }
     }
     const double bad = u(rng);  // malformed bounds: counted visible
-    if (bad < 0.005) o.sphere_or_min[1] = nan;
-    else if (bad < 0.01) o.box_max[2] = o.kind == GLINT_OBJECT_BOX ? inf : o.box_max[2];
-    else if (bad < 0.013) o.sphere_or_min[3] = o.kind == GLINT_OBJECT_SPHERE ? -1.0f : o.sphere_or_min[3];
-    else if (bad < 0.016) o.kind = 7;
-    else if (bad < 0.019 && o.kind == GLINT_OBJECT_BOX) std::swap(o.sphere_or_min[0], o.box_max[0]);
+    if (bad < 0.005)
+      o.sphere_or_min[1] = nan;
+    else if (bad < 0.01)
+      o.box_max[2] = o.kind == GLINT_OBJECT_BOX ? inf : o.box_max[2];
+    else if (bad < 0.013)
+      o.sphere_or_min[3] = o.kind == GLINT_OBJECT_SPHERE ? -1.0f : o.sphere_or_min[3];
+    else if (bad < 0.016)
+      o.kind = 7;
+    else if (bad < 0.019 && o.kind == GLINT_OBJECT_BOX)
+      std::swap(o.sphere_or_min[0], o.box_max[0]);
   }
   return out;
 }
@@ -209,10 +223,14 @@ struct GpuScene {
 
 const char* state_name(uint32_t s) {
   switch (s) {
-    case GLINT_OBJECT_STATE_VISIBLE: return "visible";
-    case GLINT_OBJECT_STATE_OCCLUDED: return "occluded";
-    case GLINT_OBJECT_STATE_FRUSTUM: return "frustum";
-    case GLINT_OBJECT_STATE_NONE: return "none";
+    case GLINT_OBJECT_STATE_VISIBLE:
+      return "visible";
+    case GLINT_OBJECT_STATE_OCCLUDED:
+      return "occluded";
+    case GLINT_OBJECT_STATE_FRUSTUM:
+      return "frustum";
+    case GLINT_OBJECT_STATE_NONE:
+      return "none";
   }
   return "poison";
 }
@@ -283,8 +301,8 @@ TEST_F(ObjectCullTest, RandomScenesMatchReference) {
           out.host(cmd);
           to_host(cmd, g.buffers.visibility);
         });
-        const std::string what = std::string(reversed ? "reversed" : "standard") + (infinite ? " infinite" : " finite") +
-                                 (cap ? " capped" : "");
+        const std::string what = std::string(reversed ? "reversed" : "standard") +
+                                 (infinite ? " infinite" : " finite") + (cap ? " capped" : "");
         const auto gpu = g.states(s.objects);
         const auto pyramid = reference::hiz_pyramid(depth, reversed, g.hiz.levels());
         uint32_t invalid = 0;
@@ -381,7 +399,8 @@ TEST_F(ObjectCullTest, TwoPhaseMovingCameraMissesNothing) {
       const std::string what = std::string(reversed ? "reversed" : "standard") + " frame " + std::to_string(f);
       const auto states = g.states(objs.size());
       const auto* sv = single_vis.as<uint32_t>();
-      EXPECT_EQ(states, std::vector<uint32_t>(sv, sv + objs.size())) << what << ": phase 2 states differ from single phase";
+      EXPECT_EQ(states, std::vector<uint32_t>(sv, sv + objs.size()))
+          << what << ": phase 2 states differ from single phase";
       const auto e = early.words(early.args().draw_count), l = late.words(late.args().draw_count);
       // Expected lists from the reference: phase 1 = history visible and inside the frustum.
       const auto pyramid = reference::hiz_pyramid(depth, reversed, g.hiz.levels());
@@ -556,21 +575,55 @@ TEST_F(ObjectCullTest, ErrorsBeforeRecording) {
     culler.record(cmd, g.hiz, g.depth_image.state, f, g.buffers, out.out);
   };
   ObjectCullFrame f = frame_of(cam.cam, 64);
-  expect_throw("count = 65", [&](VkCommandBuffer c) { auto x = f; x.count = 65; rec(x, c); });
-  expect_throw("proj[4]", [&](VkCommandBuffer c) { auto x = f; x.proj[4] = 0.5f; rec(x, c); });
-  expect_throw("proj[11]", [&](VkCommandBuffer c) { auto x = f; x.proj[11] = -2.0f; rec(x, c); });
-  expect_throw("proj[14]", [&](VkCommandBuffer c) { auto x = f; x.proj[14] = -x.proj[14]; rec(x, c); });
-  expect_throw("view[7]", [&](VkCommandBuffer c) { auto x = f; x.view[7] = 1.0f; rec(x, c); });
-  expect_throw("view[5]", [&](VkCommandBuffer c) { auto x = f; x.view[5] = std::nanf(""); rec(x, c); });
+  expect_throw("count = 65", [&](VkCommandBuffer c) {
+    auto x = f;
+    x.count = 65;
+    rec(x, c);
+  });
+  expect_throw("proj[4]", [&](VkCommandBuffer c) {
+    auto x = f;
+    x.proj[4] = 0.5f;
+    rec(x, c);
+  });
+  expect_throw("proj[11]", [&](VkCommandBuffer c) {
+    auto x = f;
+    x.proj[11] = -2.0f;
+    rec(x, c);
+  });
+  expect_throw("proj[14]", [&](VkCommandBuffer c) {
+    auto x = f;
+    x.proj[14] = -x.proj[14];
+    rec(x, c);
+  });
+  expect_throw("view[7]", [&](VkCommandBuffer c) {
+    auto x = f;
+    x.view[7] = 1.0f;
+    rec(x, c);
+  });
+  expect_throw("view[5]", [&](VkCommandBuffer c) {
+    auto x = f;
+    x.view[5] = std::nanf("");
+    rec(x, c);
+  });
   expect_throw("objects buffer holds", [&](VkCommandBuffer c) {
     auto saved = g.buffers.objects;
     g.buffers.objects.size = 32;
-    try { rec(f, c); } catch (...) { g.buffers.objects = saved; throw; }
+    try {
+      rec(f, c);
+    } catch (...) {
+      g.buffers.objects = saved;
+      throw;
+    }
   });
   expect_throw("VK_WHOLE_SIZE", [&](VkCommandBuffer c) {
     auto saved = out.out.stats;
     out.out.stats.size = VK_WHOLE_SIZE;
-    try { rec(f, c); } catch (...) { out.out.stats = saved; throw; }
+    try {
+      rec(f, c);
+    } catch (...) {
+      out.out.stats = saved;
+      throw;
+    }
   });
   expect_throw("reversed_z", [&](VkCommandBuffer c) {
     ObjectCullConfig rc = cc;

@@ -2,8 +2,6 @@
 // occlusion_reference.h): the Hi-Z pyramid bit for bit at odd, tiny and very wide sizes, the cull +
 // grid test + compaction on random scenes (exact grid result, conservative against brute force,
 // error within the bound of docs/OCCLUSION.md), monotone fading, overflow, zero lights, errors.
-#include "light_cull_params.h"
-
 #include <glint/occlusion.h>
 
 #include <algorithm>
@@ -16,6 +14,7 @@
 
 #include "core/barriers.h"
 #include "core/transfer.h"
+#include "light_cull_params.h"
 #include "reference/occlusion_reference.h"
 #include "support/flare_scene.h"
 #include "support/gpu_test.h"
@@ -24,7 +23,6 @@ namespace glint::test {
 namespace {
 
 class OcclusionTest : public GpuTest {};
-
 
 void to_host(VkCommandBuffer cmd, Buffer& b) {
   detail::Barriers barriers;
@@ -340,8 +338,7 @@ TEST_F(OcclusionTest, CullMatchesReferenceOnRandomScenes) {
         const auto run = run_cull(scene.depth, format, reversed, scene.lights, vp, config);
         const uint32_t levels = static_cast<uint32_t>(std::floor(std::log2(double(std::max(c.w, c.h)))));
         const std::string what = std::to_string(c.w) + "x" + std::to_string(c.h) + " N=" + std::to_string(c.grid) +
-                                 (reversed ? " reversed" : " standard") +
-                                 (variant == 2 ? " regular" : "");
+                                 (reversed ? " reversed" : " standard") + (variant == 2 ? " regular" : "");
         expect_cull_matches(run, scene, config, reversed, levels, what);
         // Enough of every kind in the larger scenes that the checks above mean something.
         if (c.lights >= 300) {
@@ -804,8 +801,8 @@ TEST_F(OcclusionTest, BadConfigAndArgumentsThrow) {
     big.groups_per_instance = 65535;
     ASSERT_EQ(wide.max_groups_per_instance(), uint32_t(group_limit / wide_config.capacity));
     ASSERT_LT(wide.max_groups_per_instance(), 65535u);
-    expect_error([&] { wide.record(cmd, hiz, img.state, lights.view, 10, big, wide_out); },
-                 ErrorCode::invalid_argument, "maxComputeWorkGroupCount");
+    expect_error([&] { wide.record(cmd, hiz, img.state, lights.view, 10, big, wide_out); }, ErrorCode::invalid_argument,
+                 "maxComputeWorkGroupCount");
     LightCullFrame nan = frame;
     nan.view_proj[5] = std::nanf("");
     expect_error([&] { culler.record(cmd, hiz, img.state, lights.view, 10, nan, out); }, ErrorCode::invalid_argument,

@@ -2,10 +2,6 @@
 // no Vulkan. Hand-computed values check the formulas of docs/BLOOM.md stage by stage; property
 // tests (uniformity, symmetry, monotonicity, locality) check the assembled pipeline on random
 // inputs from generators started at fixed values.
-#include "reference/bloom_reference.h"
-
-#include "core/half.h"
-
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -17,6 +13,9 @@
 #include <stdexcept>
 #include <string>
 #include <vector>
+
+#include "core/half.h"
+#include "reference/bloom_reference.h"
 
 namespace glint::reference {
 namespace {
@@ -534,7 +533,7 @@ TEST(BloomReferenceLevels, KarisGuardOnlyOnTheFirstDownsample) {
       diff_if_guarded = std::max(diff_if_guarded, std::abs(levels[1].rgba[i + k] - guarded.rgba[i + k]));
       norm = std::max(norm, std::abs(levels[1].rgba[i + k]));
     }
-  EXPECT_LT(err, 1e-6 * norm);             // only float rounding of the fed-back level 0
+  EXPECT_LT(err, 1e-6 * norm);              // only float rounding of the fed-back level 0
   EXPECT_GT(diff_if_guarded, 1e-3 * norm);  // a guard at level 1 would be visible
 
   // And the guard does change level 0.
@@ -582,12 +581,18 @@ TEST(BloomReferenceUpsample, ImpulseResponsesAtHandComputedTexels) {
     double expected;
   };
   const Probe probes[] = {
-      {BloomFilter::cod13, 2, 2, 0.4375 * 0.4375},   {BloomFilter::cod13, 3, 3, 0.4375 * 0.4375},
-      {BloomFilter::cod13, 2, 3, 0.4375 * 0.4375},   {BloomFilter::cod13, 0, 0, 0.1875 * 0.1875},
-      {BloomFilter::cod13, 5, 5, 0.1875 * 0.1875},   {BloomFilter::cod13, 0, 2, 0.1875 * 0.4375},
-      {BloomFilter::dual, 2, 2, 2.375 / 12.0},       {BloomFilter::dual, 3, 3, 2.375 / 12.0},
-      {BloomFilter::dual, 0, 0, 0.125 / 12.0},       {BloomFilter::gauss9, 2, 2, 0.5625},
-      {BloomFilter::gauss9, 0, 0, 0.0},              {BloomFilter::gauss9, 2, 3, 0.75 * 0.75},
+      {BloomFilter::cod13, 2, 2, 0.4375 * 0.4375},
+      {BloomFilter::cod13, 3, 3, 0.4375 * 0.4375},
+      {BloomFilter::cod13, 2, 3, 0.4375 * 0.4375},
+      {BloomFilter::cod13, 0, 0, 0.1875 * 0.1875},
+      {BloomFilter::cod13, 5, 5, 0.1875 * 0.1875},
+      {BloomFilter::cod13, 0, 2, 0.1875 * 0.4375},
+      {BloomFilter::dual, 2, 2, 2.375 / 12.0},
+      {BloomFilter::dual, 3, 3, 2.375 / 12.0},
+      {BloomFilter::dual, 0, 0, 0.125 / 12.0},
+      {BloomFilter::gauss9, 2, 2, 0.5625},
+      {BloomFilter::gauss9, 0, 0, 0.0},
+      {BloomFilter::gauss9, 2, 3, 0.75 * 0.75},
   };
   const double colour[3] = {1.0, 2.0, 0.5};
   for (const Probe& p : probes) {
@@ -639,7 +644,8 @@ TEST(BloomReferenceBloom, UniformImageStaysUniform) {
             for (size_t k = 0; k < 3; ++k) {
               const double want = double(c[k]) + double(config.intensity) * pf[k];
               ASSERT_NEAR(out.at(x, y)[k], want, 1e-12 * want)
-                  << bloom_filter_name(filter) << " " << s.w << "x" << s.h << " guard " << firefly_guard_name(guard) << " at " << x << "," << y;
+                  << bloom_filter_name(filter) << " " << s.w << "x" << s.h << " guard " << firefly_guard_name(guard)
+                  << " at " << x << "," << y;
               // fp16 storage rounds each stored value the same way everywhere: still uniform.
               ASSERT_EQ(half.at(x, y)[k], half.at(0, 0)[k]);
               ASSERT_NEAR(half.at(x, y)[k], want, 2e-3 * want);
@@ -705,9 +711,7 @@ TEST(BloomReferenceBloom, HalfModeStoresTheGauss9HorizontalPass) {
   for (uint32_t y = 0; y < 2; ++y)
     for (uint32_t x = 0; x < 2; ++x)
       for (size_t k = 0; k < 3; ++k) {
-        const auto H = [&](uint32_t hx, uint32_t hy) {
-          return (w0 + S) * block[hy][hx][k] + S * block[hy][1 - hx][k];
-        };
+        const auto H = [&](uint32_t hx, uint32_t hy) { return (w0 + S) * block[hy][hx][k] + S * block[hy][1 - hx][k]; };
         const double want = h((w0 + S) * h(H(x, y)) + S * h(H(x, 1 - y)));
         const double unrounded_h = h((w0 + S) * H(x, y) + S * H(x, 1 - y));
         EXPECT_EQ(levels[0].at(x, y)[k], want) << x << "," << y << " channel " << k;
@@ -731,7 +735,8 @@ TEST(BloomReferenceBloom, BrighterPointAddsMoreEnergy) {
         if (b < 0.5f) {
           EXPECT_EQ(e, 0.0) << bloom_filter_name(filter) << ": a point below threshold - knee must add nothing";
         } else {
-          EXPECT_GT(e, prev) << bloom_filter_name(filter) << " guard " << firefly_guard_name(guard) << " brightness " << b;
+          EXPECT_GT(e, prev) << bloom_filter_name(filter) << " guard " << firefly_guard_name(guard) << " brightness "
+                             << b;
         }
         prev = e;
       }
@@ -790,7 +795,8 @@ TEST(BloomReferenceBloom, OffCentrePointIsStillNearlyIsotropic) {
       config.filter = filter;
       config.iterations = 4;
       const Glow g = glow_of(bloom(in, config), in);
-      EXPECT_NEAR(g.mxx, g.myy, 0.05 * 0.5 * (g.mxx + g.myy)) << bloom_filter_name(filter) << " at " << p.x << "," << p.y;
+      EXPECT_NEAR(g.mxx, g.myy, 0.05 * 0.5 * (g.mxx + g.myy))
+          << bloom_filter_name(filter) << " at " << p.x << "," << p.y;
       EXPECT_NEAR(g.cx, p.x, 1.5) << bloom_filter_name(filter);
       EXPECT_NEAR(g.cy, p.y, 1.5) << bloom_filter_name(filter);
     }
@@ -934,7 +940,7 @@ TEST(BloomReferenceRelativeL2, HandComputed) {
   ref.height = 1;
   ref.rgba = {3, 4, 0, 1, 0, 0, 0, 1};
   CpuImage gpu(2, 1);
-  gpu.rgba = {3, 4, 1, 0.25f, 0, 0, 0, 7};  // alpha differs and must not count
+  gpu.rgba = {3, 4, 1, 0.25f, 0, 0, 0, 7};       // alpha differs and must not count
   EXPECT_DOUBLE_EQ(relative_l2(gpu, ref), 0.2);  // |(0,0,1)| / |(3,4,0)|
   gpu.rgba = {3, 4, 0, 9, 0, 0, 0, 9};
   EXPECT_EQ(relative_l2(gpu, ref), 0.0);

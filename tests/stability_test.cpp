@@ -134,7 +134,8 @@ TEST_F(StabilityTest, BloomExtentIsFixedInPixelsForFixedIterations) {
     }
     // Level sizes round differently at the two resolutions (720 -> ... 45, 22; 1080 -> ... 67, 33):
     // measured 1.00 to 1.06 (docs/STABILITY.md); in widths the ratio is 1.5.
-    EXPECT_NEAR(r90[0] / r90[1], 1.0, 0.1) << bloom_filter_name(filter) << ": r90 " << r90[0] << " vs " << r90[1] << " px";
+    EXPECT_NEAR(r90[0] / r90[1], 1.0, 0.1)
+        << bloom_filter_name(filter) << ": r90 " << r90[0] << " vs " << r90[1] << " px";
   }
 }
 
@@ -184,9 +185,12 @@ TEST_F(StabilityTest, ABadPixelStaysInsideItsFootprint) {
     float rgb[3];
     bool shows;  // changes the bloom compared with 0 (positive after sanitizing)
   };
-  const Bad bads[] = {{"NaN", {nan, nan, nan}, false},     {"+Inf", {inf, inf, inf}, true},
-                      {"-Inf", {-inf, -inf, -inf}, false}, {"negative", {-5, -1e9f, -0.0f}, false},
-                      {"1e9", {1e9f, 1e9f, 1e9f}, true},   {"mixed", {nan, inf, -inf}, true},
+  const Bad bads[] = {{"NaN", {nan, nan, nan}, false},
+                      {"+Inf", {inf, inf, inf}, true},
+                      {"-Inf", {-inf, -inf, -inf}, false},
+                      {"negative", {-5, -1e9f, -0.0f}, false},
+                      {"1e9", {1e9f, 1e9f, 1e9f}, true},
+                      {"mixed", {nan, inf, -inf}, true},
                       {"FLT_MAX", {3.4e38f, 3.4e38f, -3.4e38f}, true}};
   for (const ImageEffect& effect : image_effects()) {
     const uint32_t footprint = effect.footprint_px({w, h});
@@ -250,7 +254,8 @@ TEST_F(StabilityTest, Fp16LevelsDoNotOverflowAtTheLargestClamp) {
       peak = std::max(peak, want);
     }
     EXPECT_LT(std::sqrt(diff / norm), 5e-3) << bloom_filter_name(filter);
-    EXPECT_GT(peak, 0.25 * config.intensity * 7999.0) << bloom_filter_name(filter) << ": the clamped light must spill over";
+    EXPECT_GT(peak, 0.25 * config.intensity * 7999.0)
+        << bloom_filter_name(filter) << ": the clamped light must spill over";
   }
 }
 
@@ -311,7 +316,8 @@ TEST_F(StabilityTest, BlurPyramidHandlesSizesBadValuesAndIsDeterministic) {
     const auto ref = reference::blur_pyramid(input, sigmas, false, reference::kBlurMaxValueFp32);
     for (int k = 0; k < 3; ++k) {
       ASSERT_TRUE(all_finite(levels[k])) << e.width << "x" << e.height << " level " << k + 1;
-      EXPECT_LT(reference::rgba_relative_l2(levels[k], ref[k]), 2e-3) << e.width << "x" << e.height << " level " << k + 1;
+      EXPECT_LT(reference::rgba_relative_l2(levels[k], ref[k]), 2e-3)
+          << e.width << "x" << e.height << " level " << k + 1;
     }
   }
   CpuImage bad = random_hdr(120, 90, 8, 0.03f, 400.0f);

@@ -147,13 +147,14 @@ int main_impl(int argc, char** argv) {
             double m = 0;
             for (double e : s.energy) m += e / s.energy.size();
             for (double e : s.energy) rel.push_back(e / m);
-            chart.emplace_back(std::string(bloom_filter_name(f)) + " " + firefly_guard_name(guard) + (value > 5000 ? " 1e4" : " 1e3"),
-                               rel);
+            chart.emplace_back(
+                std::string(bloom_filter_name(f)) + " " + firefly_guard_name(guard) + (value > 5000 ? " 1e4" : " 1e3"),
+                rel);
           }
           double mean = 0;
           for (double e : s.energy) mean += e / s.energy.size();
-          std::printf("| %s | %s | %g | %g | %.4f | %.4f | %.3f | %.4g |\n", bloom_filter_name(f), firefly_guard_name(guard), maxb,
-                      value, ev.spread, ev.max_step, hi - lo, mean);
+          std::printf("| %s | %s | %g | %g | %.4f | %.4f | %.3f | %.4g |\n", bloom_filter_name(f),
+                      firefly_guard_name(guard), maxb, value, ev.spread, ev.max_step, hi - lo, mean);
         }
       }
     }
@@ -168,7 +169,8 @@ int main_impl(int argc, char** argv) {
   draw_chart(chart, out_dir + "/firefly_energy.png");
   filmstrip(ctx, out_dir + "/firefly_frames.png");
   std::printf(
-      "\n| filter | iterations | level0_height | size | r50 / width | r90 / width | sigma / width |\n|---|---|---|---|---|---|---|\n");
+      "\n| filter | iterations | level0_height | size | r50 / width | r90 / width | sigma / width "
+      "|\n|---|---|---|---|---|---|---|\n");
   for (BloomFilter f : {BloomFilter::cod13, BloomFilter::dual, BloomFilter::gauss9}) {
     struct Row {
       VkExtent2D e;
@@ -194,8 +196,8 @@ int main_impl(int argc, char** argv) {
         const auto st = analysis::light_stats(added, e.width, e.height);
         const double r50 = analysis::radius_holding(added, e.width, e.height, cx, cy, 0.5);
         const double r90 = analysis::radius_holding(added, e.width, e.height, cx, cy, 0.9);
-        std::printf("| %s | %u | %u | %ux%u | %.5f | %.5f | %.5f |\n", bloom_filter_name(f), it, row.level0_height, e.width,
-                    e.height, r50 / e.width, r90 / e.width, std::sqrt(st.xx + st.yy) / e.width);
+        std::printf("| %s | %u | %u | %ux%u | %.5f | %.5f | %.5f |\n", bloom_filter_name(f), it, row.level0_height,
+                    e.width, e.height, r50 / e.width, r90 / e.width, std::sqrt(st.xx + st.yy) / e.width);
       }
     }
   }

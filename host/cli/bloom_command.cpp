@@ -1,10 +1,10 @@
 // glint bloom IN.exr OUT.exr: bloom of an EXR file on a standalone context, written as RGBA half
 // EXR (and optionally a tonemapped PNG). Ranges are checked by BloomConfig::validate(), not here,
 // so the CLI and the library can never disagree about them.
+#include <glint/bloom.h>
+
 #include <cstdio>
 #include <memory>
-
-#include <glint/bloom.h>
 
 #include "cli/commands.h"
 #include "core/resources.h"
@@ -59,13 +59,13 @@ void run_bloom(BloomOptions& o) {
   Bloom bloom(context, o.config);
   bloom.prepare(extent);  // throws unsupported_size before any image is made for a too-large input
   Profiler profiler(context);
-  const CpuImage output =
-      run_image_effect(context, input, profiler, [&](VkCommandBuffer cmd, Image& in, Image& out, Profiler* p) {
-        bloom.record(cmd, in, out, p);
-      }, o.fp32 ? VK_FORMAT_R32G32B32A32_SFLOAT : VK_FORMAT_R16G16B16A16_SFLOAT);
+  const CpuImage output = run_image_effect(
+      context, input, profiler,
+      [&](VkCommandBuffer cmd, Image& in, Image& out, Profiler* p) { bloom.record(cmd, in, out, p); },
+      o.fp32 ? VK_FORMAT_R32G32B32A32_SFLOAT : VK_FORMAT_R16G16B16A16_SFLOAT);
   print_device(context, o.input, input);
-  std::printf("bloom: filter %s, %s intermediates, %u level%s", bloom_filter_name(o.config.filter), o.fp32 ? "fp32" : "fp16",
-              bloom.levels(), bloom.levels() == 1 ? "" : "s");
+  std::printf("bloom: filter %s, %s intermediates, %u level%s", bloom_filter_name(o.config.filter),
+              o.fp32 ? "fp32" : "fp16", bloom.levels(), bloom.levels() == 1 ? "" : "s");
   if (bloom.clamped()) {
     std::printf(" (clamped: --iterations %u does not fit %ux%u)\n", o.config.iterations, input.width, input.height);
   } else {
@@ -86,7 +86,8 @@ void run_bloom(BloomOptions& o) {
 
 Command add_bloom_command(CLI::App& app) {
   auto o = std::make_shared<BloomOptions>();
-  CLI::App* sub = app.add_subcommand("bloom", "Apply bloom to an OpenEXR image; write RGBA half EXR (float with --fp32)");
+  CLI::App* sub =
+      app.add_subcommand("bloom", "Apply bloom to an OpenEXR image; write RGBA half EXR (float with --fp32)");
   sub->add_option("input", o->input, "Input OpenEXR file (R,G,B[,A], or one grey channel)")->required();
   sub->add_option("output", o->output, "Output OpenEXR file (RGBA half; 32-bit float with --fp32)")->required();
   sub->add_option("--threshold", o->config.threshold, "Luminance where bloom starts (0 to 65504)");
@@ -100,7 +101,8 @@ Command add_bloom_command(CLI::App& app) {
   sub->add_option("--max-brightness", o->config.max_brightness, "Per-channel clamp of level 0 (1e-3 to 8000)");
   sub->add_option("--level0-height", o->config.level0_height,
                   "Rows of pyramid level 0 (0 = half the input; 8 to 16384 makes the glow resolution independent)");
-  sub->add_flag("--fp32", o->fp32, "Keep the pyramid and the output in RGBA32F and write 32-bit float EXR (default: RGBA16F, half EXR)");
+  sub->add_flag("--fp32", o->fp32,
+                "Keep the pyramid and the output in RGBA32F and write 32-bit float EXR (default: RGBA16F, half EXR)");
   sub->add_option("--png", o->png, "Also write a tonemapped (ACES fitted) 8-bit sRGB PNG here");
   sub->add_option("--exposure", o->exposure, "Linear exposure applied before the PNG tonemap (> 0)");
   add_device_option(*sub, o->device);

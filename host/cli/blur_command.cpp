@@ -101,10 +101,10 @@ void run_gauss(GaussOptions& o) {
   GaussianBlur blur(context, o.config);
   blur.prepare(extent);
   Profiler profiler(context);
-  const CpuImage output =
-      run_image_effect(context, input, profiler, [&](VkCommandBuffer cmd, Image& in, Image& out, Profiler* p) {
-        blur.record(cmd, in, out, p);
-      }, o.fp32 ? VK_FORMAT_R32G32B32A32_SFLOAT : VK_FORMAT_R16G16B16A16_SFLOAT);
+  const CpuImage output = run_image_effect(
+      context, input, profiler,
+      [&](VkCommandBuffer cmd, Image& in, Image& out, Profiler* p) { blur.record(cmd, in, out, p); },
+      o.fp32 ? VK_FORMAT_R32G32B32A32_SFLOAT : VK_FORMAT_R16G16B16A16_SFLOAT);
   print_device(context, o.input, input);
   const BlurChoice& c = blur.choice();
   std::printf("method: %s%s (asked: %s)", blur_method_name(c.method), c.linear_sampling ? " with linear sampling" : "",
@@ -132,14 +132,16 @@ Command add_blur_command(CLI::App& app) {
   sub->add_option("output_prefix", o->prefix, "Output prefix (PREFIX.blur1.exr ...)")->required();
   sub->add_option("--sigmas", o->sigmas,
                   "Sigma of each level in texels of that level, a,b,c (each 0.3 to 4; default 1.2,1.2,1.2)");
-  sub->add_flag("--fp32", o->fp32, "Keep the levels in RGBA32F and write 32-bit float EXR (default: RGBA16F, half EXR)");
+  sub->add_flag("--fp32", o->fp32,
+                "Keep the levels in RGBA32F and write 32-bit float EXR (default: RGBA16F, half EXR)");
   add_device_option(*sub, o->device);
   return {sub, [o] { run_blur(*o); }};
 }
 
 Command add_gauss_command(CLI::App& app) {
   auto o = std::make_shared<GaussOptions>();
-  CLI::App* sub = app.add_subcommand("gauss", "Gaussian blur of an OpenEXR image; write RGBA half EXR (float with --fp32)");
+  CLI::App* sub =
+      app.add_subcommand("gauss", "Gaussian blur of an OpenEXR image; write RGBA half EXR (float with --fp32)");
   sub->add_option("input", o->input, "Input OpenEXR file")->required();
   sub->add_option("output", o->output, "Output OpenEXR file (RGBA half; 32-bit float with --fp32)")->required();
   sub->add_option("--sigma", o->config.sigma_px, "Standard deviation in pixels (0.5 to 64)")->required();
@@ -148,7 +150,8 @@ Command add_gauss_command(CLI::App& app) {
   sub->add_option("--max-error", o->config.max_relative_error,
                   "auto/pyramid: bound on the modelled relative L2 error (1e-4 to 1)");
   sub->add_flag("--linear", o->linear, "separable: pair taps into bilinear sampler fetches (9 taps in 5)");
-  sub->add_flag("--fp32", o->fp32, "RGBA32F intermediates and output, written as 32-bit float EXR (default: RGBA16F, half EXR)");
+  sub->add_flag("--fp32", o->fp32,
+                "RGBA32F intermediates and output, written as 32-bit float EXR (default: RGBA16F, half EXR)");
   add_device_option(*sub, o->device);
   return {sub, [o] { run_gauss(*o); }};
 }

@@ -7,13 +7,12 @@
 #include <glint/glint.h>
 
 #include <CLI/CLI.hpp>
-
-#include "core/cpu_image.h"
-#include "io/exr_io.h"
-
 #include <functional>
 #include <string>
 #include <vector>
+
+#include "core/cpu_image.h"
+#include "io/exr_io.h"
 
 namespace glint::cli {
 

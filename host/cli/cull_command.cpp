@@ -13,8 +13,8 @@
 
 #include <cfloat>
 #include <cmath>
-#include <cstring>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -49,7 +49,8 @@ constexpr uint64_t kMaxObjectsFileBytes = uint64_t(1) << 30;
 float number(const std::string& path, const nlohmann::json& v, const std::string& where) {
   if (!v.is_number()) bad(path, where + " is not a number");
   const double d = v.get<double>();
-  if (!std::isfinite(d) || std::abs(d) > double(FLT_MAX)) bad(path, where + " = " + v.dump() + " is not a finite float");
+  if (!std::isfinite(d) || std::abs(d) > double(FLT_MAX))
+    bad(path, where + " = " + v.dump() + " is not a finite float");
   return static_cast<float>(d);
 }
 
@@ -90,7 +91,8 @@ ObjectsFile read_objects(const std::string& path, uint32_t max_objects) {
   numbers(path, j["proj"], "proj", 16, f.frame.proj);
   const auto& list = j["objects"];
   if (!list.is_array()) bad(path, "\"objects\" must be an array");
-  if (list.size() > max_objects) bad(path, "\"objects\" holds " + std::to_string(list.size()) + "; at most " + std::to_string(max_objects));
+  if (list.size() > max_objects)
+    bad(path, "\"objects\" holds " + std::to_string(list.size()) + "; at most " + std::to_string(max_objects));
   f.objects.resize(list.size());
   for (size_t i = 0; i < list.size(); ++i) {
     const std::string at = "objects[" + std::to_string(i) + "]";
@@ -103,7 +105,8 @@ ObjectsFile read_objects(const std::string& path, uint32_t max_objects) {
     if (o.contains("sphere")) {
       g.kind = GLINT_OBJECT_SPHERE;
       numbers(path, o["sphere"], at + ".sphere", 4, g.sphere_or_min);
-      if (!(g.sphere_or_min[3] >= 0)) bad(path, at + ".sphere[3] = " + o["sphere"][3].dump() + ": the radius must be >= 0");
+      if (!(g.sphere_or_min[3] >= 0))
+        bad(path, at + ".sphere[3] = " + o["sphere"][3].dump() + ": the radius must be >= 0");
     } else {
       g.kind = GLINT_OBJECT_BOX;
       float b[6];
@@ -124,9 +127,12 @@ ObjectsFile read_objects(const std::string& path, uint32_t max_objects) {
 
 const char* state_name(uint32_t s) {
   switch (s) {
-    case GLINT_OBJECT_STATE_VISIBLE: return "visible";
-    case GLINT_OBJECT_STATE_OCCLUDED: return "occluded";
-    case GLINT_OBJECT_STATE_FRUSTUM: return "frustum";
+    case GLINT_OBJECT_STATE_VISIBLE:
+      return "visible";
+    case GLINT_OBJECT_STATE_OCCLUDED:
+      return "occluded";
+    case GLINT_OBJECT_STATE_FRUSTUM:
+      return "frustum";
   }
   throw Error(ErrorCode::vulkan_failure, "the cull left object state " + std::to_string(s));
 }
@@ -151,10 +157,11 @@ void run(const CullOptions& o) {
   cc.reversed_z = o.reverse_z;
   ObjectCuller culler(context, cc);
 
-  detail::OwnedImage depth(context, extent, VK_FORMAT_D32_SFLOAT, VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT);
+  detail::OwnedImage depth(context, extent, VK_FORMAT_D32_SFLOAT,
+                           VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT);
   const detail::OwnedBuffer depth_up = detail::make_upload_staging_r32(context, depth.image(), depth_in.values);
-  const VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT |
-                                   VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT;
+  const VkBufferUsageFlags usage =
+      VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT;
   auto host_buffer = [&](VkDeviceSize bytes) {
     bytes = std::max<VkDeviceSize>(bytes, 16);
     return detail::OwnedBuffer(context, bytes, usage, true);
@@ -188,9 +195,10 @@ void run(const CullOptions& o) {
   const auto* states = static_cast<const uint32_t*>(visibility.mapped());
   const GlintObjectCullStats st = *static_cast<const GlintObjectCullStats*>(stats.mapped());
 
-  std::string out = "{\"total\": " + std::to_string(st.total) + ", \"frustum_culled\": " +
-                    std::to_string(st.frustum_culled) + ", \"occluded\": " + std::to_string(st.occluded) +
-                    ", \"visible\": " + std::to_string(st.visible) + ", \"objects\": [";
+  std::string out = "{\"total\": " + std::to_string(st.total) +
+                    ", \"frustum_culled\": " + std::to_string(st.frustum_culled) +
+                    ", \"occluded\": " + std::to_string(st.occluded) + ", \"visible\": " + std::to_string(st.visible) +
+                    ", \"objects\": [";
   for (uint32_t i = 0; i < n; ++i) {
     if (i) out += ", ";
     out += std::string("\"") + state_name(states[i]) + "\"";
@@ -212,7 +220,8 @@ void run(const CullOptions& o) {
 
 Command add_cull_command(CLI::App& app) {
   auto o = std::make_shared<CullOptions>();
-  CLI::App* sub = app.add_subcommand("cull", "Occlusion-cull bounding spheres and boxes against a depth image (on the GPU)");
+  CLI::App* sub =
+      app.add_subcommand("cull", "Occlusion-cull bounding spheres and boxes against a depth image (on the GPU)");
   sub->add_option("--depth", o->depth,
                   "Depth OpenEXR file: one float channel named Z (else the first channel), values in [0, 1]")
       ->required();
@@ -220,8 +229,9 @@ Command add_cull_command(CLI::App& app) {
                   "OBJECTS.json: {\"view\": [16], \"proj\": [16] (column-major, Vulkan perspective), \"objects\": "
                   "[{\"sphere\": [x,y,z,r]} | {\"box\": [minx,miny,minz,maxx,maxy,maxz]}]}")
       ->required();
-  sub->add_option("output", o->output,
-                  "Output JSON: {\"total\", \"frustum_culled\", \"occluded\", \"visible\", \"objects\": [state per object]}")
+  sub->add_option(
+         "output", o->output,
+         "Output JSON: {\"total\", \"frustum_culled\", \"occluded\", \"visible\", \"objects\": [state per object]}")
       ->required();
   sub->add_flag("--reverse-z", o->reverse_z, "Depth 1 is near and 0 far (reversed Z)");
   sub->add_flag("--stats", o->stats, "Print the GPU time of each stage");

@@ -44,7 +44,8 @@ void run_demo(const DemoOptions& o) {
   // What the demo holds on the host at once, per pixel: the depth (4 bytes) and its EXR, three
   // read-back RGBA16F images staged (8 bytes each) and converted to float (16 bytes each), the
   // fill of the largest upload (16), the PNG (4) and the EXR writer's copy of one image (8).
-  tools::check_host_memory("glint demo at " + o.size, uint64_t(extent.width) * extent.height * (4 + 4 + 3 * (8 + 16) + 16 + 4 + 8));
+  tools::check_host_memory("glint demo at " + o.size,
+                           uint64_t(extent.width) * extent.height * (4 + 4 + 3 * (8 + 16) + 16 + 4 + 8));
   check_exposure(o.exposure);
   const FlareConfig look = flare_preset_from_name(o.preset);
   demo::StarfieldParams scene_params;

@@ -29,7 +29,9 @@ Command add_lod_command(CLI::App& app) {
   sub->add_option("--aniso", o->aniso, "anisotropic LOD with this maxAnisotropy (1 to 64); 0 = isotropic");
   sub->add_option("--bias", o->bias, "LOD bias (-16 to 16)");
   sub->add_option("--padding", o->padding, "texels of padding around each tile; caps the level (0 to 65536)");
-  sub->add_option("QUERIES.csv", o->in, "rows dudx,dvdx,dudy,dvdy,tex_w,tex_h,off_x,off_y; optional header of 8 names (docs/LOD.md)")->required();
+  sub->add_option("QUERIES.csv", o->in,
+                  "rows dudx,dvdx,dudy,dvdy,tex_w,tex_h,off_x,off_y; optional header of 8 names (docs/LOD.md)")
+      ->required();
   sub->add_option("OUT.csv", o->out, "the rows again with a lod column")->required();
   add_device_option(*sub, o->device);
   return {sub, [o, sub] {
@@ -46,8 +48,8 @@ Command add_lod_command(CLI::App& app) {
             }
             if (sub->count("--padding")) {
               if (!(o->padding >= 0.0f)) {
-                throw Error(ErrorCode::invalid_argument, "--padding = " + std::to_string(o->padding) +
-                                                             " is out of range: accepted 0 to 65536");
+                throw Error(ErrorCode::invalid_argument,
+                            "--padding = " + std::to_string(o->padding) + " is out of range: accepted 0 to 65536");
               }
               atlas.padding_texels = o->padding;
             }

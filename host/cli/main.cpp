@@ -27,8 +27,10 @@ int exit_code_for(glint::ErrorCode code) {
     case glint::ErrorCode::invalid_argument:
     case glint::ErrorCode::io_failure:
     case glint::ErrorCode::no_device:
-    case glint::ErrorCode::unsupported_size: return 2;
-    default: return 1;  // vulkan_failure, and formats or usages the CLI itself chose
+    case glint::ErrorCode::unsupported_size:
+      return 2;
+    default:
+      return 1;  // vulkan_failure, and formats or usages the CLI itself chose
   }
 }
 
@@ -42,14 +44,9 @@ int main(int argc, char** argv) {
   app.require_subcommand(0, 1);  // none is reported below, so that "glint typo" says "typo"
   app.footer("Exit status: 0 ok, 2 bad input (flags, files, device choice), 1 internal failure.");
   std::vector<glint::cli::Command> commands = {
-      glint::cli::add_devices_command(app),
-      glint::cli::add_bloom_command(app),
-      glint::cli::add_demo_command(app),
-      glint::cli::add_lod_command(app),
-      glint::cli::add_blur_command(app),
-      glint::cli::add_gauss_command(app),
-      glint::cli::add_flare_command(app),
-      glint::cli::add_cull_command(app),
+      glint::cli::add_devices_command(app), glint::cli::add_bloom_command(app), glint::cli::add_demo_command(app),
+      glint::cli::add_lod_command(app),     glint::cli::add_blur_command(app),  glint::cli::add_gauss_command(app),
+      glint::cli::add_flare_command(app),   glint::cli::add_cull_command(app),
   };
 
   try {
@@ -58,7 +55,9 @@ int main(int argc, char** argv) {
     if (e.get_exit_code() == static_cast<int>(CLI::ExitCodes::Success)) return app.exit(e);  // --help, --version
     return print_error(std::string(e.what()) + " (see glint --help)", 2);
   }
-  if (app.get_subcommands().empty()) return print_error("a subcommand is required: devices, bloom, demo, lod, blur, gauss, flare or cull (see glint --help)", 2);
+  if (app.get_subcommands().empty())
+    return print_error(
+        "a subcommand is required: devices, bloom, demo, lod, blur, gauss, flare or cull (see glint --help)", 2);
 
   try {
     // OpenEXR compresses and decompresses in parallel when given threads (a 1080p demo writes two).

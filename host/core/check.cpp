@@ -29,8 +29,8 @@ void check_buffer(const char* where, const char* role, const Buffer& b, VkDevice
                   VkDeviceSize offset_alignment) {
   if (!b.buffer) throw Error(ErrorCode::invalid_argument, concat(where, ": ", role, " buffer is null"));
   if ((b.usage & usage) != usage) {
-    throw Error(ErrorCode::missing_usage, concat(where, ": ", role, " buffer lacks usage ", usage_names(usage & ~b.usage),
-                                                 " (needs ", usage_names(usage), ")"));
+    throw Error(ErrorCode::missing_usage, concat(where, ": ", role, " buffer lacks usage ",
+                                                 usage_names(usage & ~b.usage), " (needs ", usage_names(usage), ")"));
   }
   if (b.size == VK_WHOLE_SIZE || b.size == 0) {
     throw Error(ErrorCode::invalid_argument,
@@ -43,8 +43,8 @@ void check_buffer(const char* where, const char* role, const Buffer& b, VkDevice
                 concat(where, ": ", role, " buffer holds ", b.size, " bytes: accepted at least ", need));
   }
   if (b.offset % offset_alignment != 0) {
-    throw Error(ErrorCode::invalid_argument, concat(where, ": ", role, " buffer offset = ", b.offset,
-                                                    " is not a multiple of ", offset_alignment));
+    throw Error(ErrorCode::invalid_argument,
+                concat(where, ": ", role, " buffer offset = ", b.offset, " is not a multiple of ", offset_alignment));
   }
 }
 
@@ -60,9 +60,9 @@ void check_image_layout(const char* where, const char* role, const Image& image)
                      l == VK_IMAGE_LAYOUT_DEPTH_READ_ONLY_STENCIL_ATTACHMENT_OPTIMAL ||
                      l == VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_STENCIL_READ_ONLY_OPTIMAL ||
                      l == VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL || l == VK_IMAGE_LAYOUT_DEPTH_READ_ONLY_OPTIMAL ||
-                     l == VK_IMAGE_LAYOUT_STENCIL_ATTACHMENT_OPTIMAL || l == VK_IMAGE_LAYOUT_STENCIL_READ_ONLY_OPTIMAL ||
-                     l == VK_IMAGE_LAYOUT_READ_ONLY_OPTIMAL || l == VK_IMAGE_LAYOUT_ATTACHMENT_OPTIMAL ||
-                     l == VK_IMAGE_LAYOUT_PRESENT_SRC_KHR;
+                     l == VK_IMAGE_LAYOUT_STENCIL_ATTACHMENT_OPTIMAL ||
+                     l == VK_IMAGE_LAYOUT_STENCIL_READ_ONLY_OPTIMAL || l == VK_IMAGE_LAYOUT_READ_ONLY_OPTIMAL ||
+                     l == VK_IMAGE_LAYOUT_ATTACHMENT_OPTIMAL || l == VK_IMAGE_LAYOUT_PRESENT_SRC_KHR;
   if (!known) {
     throw Error(ErrorCode::invalid_argument,
                 concat(where, ": ", role, " Image::layout = ", uint32_t(l),
@@ -71,8 +71,9 @@ void check_image_layout(const char* where, const char* role, const Image& image)
   }
   if (l == VK_IMAGE_LAYOUT_PREINITIALIZED) {
     throw Error(ErrorCode::invalid_argument,
-                concat(where, ": ", role, " Image::layout = VK_IMAGE_LAYOUT_PREINITIALIZED: glint takes optimal-tiling "
-                                          "images; transition it first"));
+                concat(where, ": ", role,
+                       " Image::layout = VK_IMAGE_LAYOUT_PREINITIALIZED: glint takes optimal-tiling "
+                       "images; transition it first"));
   }
 }
 

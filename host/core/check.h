@@ -29,8 +29,7 @@ std::string concat(const Parts&... parts) {
 /// Throws Error(invalid_argument) unless lo <= value <= hi (NaN fails).
 inline void check_range(const char* name, double value, double lo, double hi) {
   if (!(value >= lo && value <= hi)) {
-    throw Error(ErrorCode::invalid_argument,
-                concat(name, " = ", value, " is out of range: accepted ", lo, " to ", hi));
+    throw Error(ErrorCode::invalid_argument, concat(name, " = ", value, " is out of range: accepted ", lo, " to ", hi));
   }
 }
 

@@ -1,32 +1,44 @@
 // Context: standalone (own instance and device) or adopted (the engine's), device selection,
 // validation messages, run_once for tools, and the timestamp profiler.
-#include "core/barriers.h"
-#include "core/check.h"
-#include "core/context_state.h"
-
 #include <algorithm>
 #include <cctype>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 
+#include "core/barriers.h"
+#include "core/check.h"
+#include "core/context_state.h"
+
 namespace glint {
 namespace detail {
 
 const char* vk_result_name(VkResult r) {
   switch (r) {
-    case VK_SUCCESS: return "VK_SUCCESS";
-    case VK_ERROR_OUT_OF_HOST_MEMORY: return "VK_ERROR_OUT_OF_HOST_MEMORY";
-    case VK_ERROR_OUT_OF_DEVICE_MEMORY: return "VK_ERROR_OUT_OF_DEVICE_MEMORY";
-    case VK_ERROR_INITIALIZATION_FAILED: return "VK_ERROR_INITIALIZATION_FAILED";
-    case VK_ERROR_DEVICE_LOST: return "VK_ERROR_DEVICE_LOST";
-    case VK_ERROR_LAYER_NOT_PRESENT: return "VK_ERROR_LAYER_NOT_PRESENT";
-    case VK_ERROR_EXTENSION_NOT_PRESENT: return "VK_ERROR_EXTENSION_NOT_PRESENT";
-    case VK_ERROR_FEATURE_NOT_PRESENT: return "VK_ERROR_FEATURE_NOT_PRESENT";
-    case VK_ERROR_INCOMPATIBLE_DRIVER: return "VK_ERROR_INCOMPATIBLE_DRIVER";
-    case VK_ERROR_FORMAT_NOT_SUPPORTED: return "VK_ERROR_FORMAT_NOT_SUPPORTED";
-    case VK_ERROR_OUT_OF_POOL_MEMORY: return "VK_ERROR_OUT_OF_POOL_MEMORY";
-    default: return "VkResult error";
+    case VK_SUCCESS:
+      return "VK_SUCCESS";
+    case VK_ERROR_OUT_OF_HOST_MEMORY:
+      return "VK_ERROR_OUT_OF_HOST_MEMORY";
+    case VK_ERROR_OUT_OF_DEVICE_MEMORY:
+      return "VK_ERROR_OUT_OF_DEVICE_MEMORY";
+    case VK_ERROR_INITIALIZATION_FAILED:
+      return "VK_ERROR_INITIALIZATION_FAILED";
+    case VK_ERROR_DEVICE_LOST:
+      return "VK_ERROR_DEVICE_LOST";
+    case VK_ERROR_LAYER_NOT_PRESENT:
+      return "VK_ERROR_LAYER_NOT_PRESENT";
+    case VK_ERROR_EXTENSION_NOT_PRESENT:
+      return "VK_ERROR_EXTENSION_NOT_PRESENT";
+    case VK_ERROR_FEATURE_NOT_PRESENT:
+      return "VK_ERROR_FEATURE_NOT_PRESENT";
+    case VK_ERROR_INCOMPATIBLE_DRIVER:
+      return "VK_ERROR_INCOMPATIBLE_DRIVER";
+    case VK_ERROR_FORMAT_NOT_SUPPORTED:
+      return "VK_ERROR_FORMAT_NOT_SUPPORTED";
+    case VK_ERROR_OUT_OF_POOL_MEMORY:
+      return "VK_ERROR_OUT_OF_POOL_MEMORY";
+    default:
+      return "VkResult error";
   }
 }
 
@@ -53,9 +65,8 @@ VkDeviceMemory ContextState::allocate(const VkMemoryRequirements& req, VkMemoryP
     source = "the budget left (VK_EXT_memory_budget)";
   }
   auto refuse = [&](const char* why) {
-    return Error(ErrorCode::unsupported_size,
-                 concat(what, " needs ", req.size, " bytes of memory heap ", heap, "; ", why, " ", available,
-                        " bytes: make it smaller or free memory"));
+    return Error(ErrorCode::unsupported_size, concat(what, " needs ", req.size, " bytes of memory heap ", heap, "; ",
+                                                     why, " ", available, " bytes: make it smaller or free memory"));
   };
   if (req.size > available) throw refuse(concat(source, " is").c_str());
   VkMemoryAllocateInfo alloc{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
@@ -80,9 +91,9 @@ uint64_t validation_messages_all_contexts() { return g_validation_messages.load(
 
 namespace {
 
-VKAPI_ATTR VkBool32 VKAPI_CALL on_validation_message(
-    VkDebugUtilsMessageSeverityFlagBitsEXT severity, VkDebugUtilsMessageTypeFlagsEXT,
-    const VkDebugUtilsMessengerCallbackDataEXT* data, void* user) {
+VKAPI_ATTR VkBool32 VKAPI_CALL on_validation_message(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
+                                                     VkDebugUtilsMessageTypeFlagsEXT,
+                                                     const VkDebugUtilsMessengerCallbackDataEXT* data, void* user) {
   auto* state = static_cast<ContextState*>(user);
   if (severity < VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT) return VK_FALSE;
   std::string text = data && data->pMessage ? data->pMessage : "(no message)";
@@ -140,8 +151,8 @@ VkInstance make_instance(bool validation, bool gpu_assisted, ContextState* state
   features.pEnabledValidationFeatures = enables;
 
   VkDebugUtilsMessengerCreateInfoEXT messenger_info{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
-  messenger_info.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT |
-                                   VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
+  messenger_info.messageSeverity =
+      VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
   messenger_info.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT |
                                VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
                                VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
@@ -176,17 +187,23 @@ std::vector<VkPhysicalDevice> physical_devices(VkInstance instance) {
 
 int type_rank(VkPhysicalDeviceType t) {
   switch (t) {
-    case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU: return 0;
-    case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU: return 1;
-    case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU: return 2;
-    case VK_PHYSICAL_DEVICE_TYPE_CPU: return 3;
-    default: return 4;
+    case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU:
+      return 0;
+    case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU:
+      return 1;
+    case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU:
+      return 2;
+    case VK_PHYSICAL_DEVICE_TYPE_CPU:
+      return 3;
+    default:
+      return 4;
   }
 }
 
 VkPhysicalDevice choose_device(VkInstance instance, std::string wanted) {
   auto devices = physical_devices(instance);
-  if (devices.empty()) throw Error(ErrorCode::no_device, "no Vulkan device found (Debian: mesa-vulkan-drivers gives lavapipe)");
+  if (devices.empty())
+    throw Error(ErrorCode::no_device, "no Vulkan device found (Debian: mesa-vulkan-drivers gives lavapipe)");
   std::vector<VkPhysicalDeviceProperties> props(devices.size());
   for (size_t i = 0; i < devices.size(); ++i) vkGetPhysicalDeviceProperties(devices[i], &props[i]);
   if (!wanted.empty()) {
@@ -194,7 +211,8 @@ VkPhysicalDevice choose_device(VkInstance instance, std::string wanted) {
     if (numeric) {
       unsigned long idx = std::strtoul(wanted.c_str(), nullptr, 10);
       if (idx >= devices.size()) {
-        throw Error(ErrorCode::no_device, concat("device index ", wanted, " is out of range: accepted 0 to ", devices.size() - 1));
+        throw Error(ErrorCode::no_device,
+                    concat("device index ", wanted, " is out of range: accepted 0 to ", devices.size() - 1));
       }
       return devices[idx];
     }
@@ -263,9 +281,9 @@ void fill_info(ContextState& s) {
 // what the physical device supports, which the AdoptInfo contract asks the engine to have enabled
 // (Vulkan cannot be asked which features a device was created with).
 struct AdoptedFeatures {
-  bool synchronization2 = false;  // vkCmdPipelineBarrier2, vkCmdWriteTimestamp2: every barrier glint records
-  bool maintenance4 = false;      // LocalSizeId: every kernel takes its workgroup size from specialization
-  bool dynamic_rendering = false; // vkCmdBeginRendering: LensFlare's raster path only
+  bool synchronization2 = false;   // vkCmdPipelineBarrier2, vkCmdWriteTimestamp2: every barrier glint records
+  bool maintenance4 = false;       // LocalSizeId: every kernel takes its workgroup size from specialization
+  bool dynamic_rendering = false;  // vkCmdBeginRendering: LensFlare's raster path only
 };
 
 AdoptedFeatures adopted_features(const AdoptInfo& a) {
@@ -281,18 +299,21 @@ AdoptedFeatures adopted_features(const AdoptInfo& a) {
           break;
         }
         case VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SYNCHRONIZATION_2_FEATURES:
-          f.synchronization2 = f.synchronization2 ||
-                               reinterpret_cast<const VkPhysicalDeviceSynchronization2Features*>(p)->synchronization2 == VK_TRUE;
+          f.synchronization2 =
+              f.synchronization2 ||
+              reinterpret_cast<const VkPhysicalDeviceSynchronization2Features*>(p)->synchronization2 == VK_TRUE;
           break;
         case VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MAINTENANCE_4_FEATURES:
           f.maintenance4 = f.maintenance4 ||
                            reinterpret_cast<const VkPhysicalDeviceMaintenance4Features*>(p)->maintenance4 == VK_TRUE;
           break;
         case VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DYNAMIC_RENDERING_FEATURES:
-          f.dynamic_rendering = f.dynamic_rendering ||
-                                reinterpret_cast<const VkPhysicalDeviceDynamicRenderingFeatures*>(p)->dynamicRendering == VK_TRUE;
+          f.dynamic_rendering =
+              f.dynamic_rendering ||
+              reinterpret_cast<const VkPhysicalDeviceDynamicRenderingFeatures*>(p)->dynamicRendering == VK_TRUE;
           break;
-        default: break;
+        default:
+          break;
       }
     }
     return f;
@@ -374,9 +395,9 @@ Context Context::create(const ContextOptions& options) {
   VkPhysicalDeviceProperties props;
   vkGetPhysicalDeviceProperties(s.physical_device, &props);
   if (props.apiVersion < VK_API_VERSION_1_3) {
-    throw Error(ErrorCode::no_device, concat("device '", props.deviceName, "' supports Vulkan ",
-                                             VK_API_VERSION_MAJOR(props.apiVersion), ".",
-                                             VK_API_VERSION_MINOR(props.apiVersion), "; glint needs 1.3"));
+    throw Error(ErrorCode::no_device,
+                concat("device '", props.deviceName, "' supports Vulkan ", VK_API_VERSION_MAJOR(props.apiVersion), ".",
+                       VK_API_VERSION_MINOR(props.apiVersion), "; glint needs 1.3"));
   }
 
   VkPhysicalDeviceVulkan13Features f13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
@@ -385,11 +406,12 @@ Context Context::create(const ContextOptions& options) {
   VkPhysicalDeviceFeatures2 supported{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
   supported.pNext = &f12;
   vkGetPhysicalDeviceFeatures2(s.physical_device, &supported);
-  for (auto [name, supported_feature] : {std::pair{"synchronization2", f13.synchronization2},
-                                         std::pair{"maintenance4", f13.maintenance4}}) {
+  for (auto [name, supported_feature] :
+       {std::pair{"synchronization2", f13.synchronization2}, std::pair{"maintenance4", f13.maintenance4}}) {
     if (!supported_feature) {
-      throw Error(ErrorCode::no_device, concat("device '", props.deviceName, "' does not support VkPhysicalDeviceVulkan13Features::",
-                                               name, ", which glint needs"));
+      throw Error(ErrorCode::no_device,
+                  concat("device '", props.deviceName, "' does not support VkPhysicalDeviceVulkan13Features::", name,
+                         ", which glint needs"));
     }
   }
 
@@ -463,14 +485,15 @@ Context Context::adopt(const AdoptInfo& a) {
                                                     " is out of range: accepted 0 to ", n - 1));
   }
   if (!(families[a.queue_family_index].queueFlags & VK_QUEUE_COMPUTE_BIT)) {
-    throw Error(ErrorCode::invalid_argument, concat("AdoptInfo::queue_family_index = ", a.queue_family_index,
-                                                    " has no compute capability"));
+    throw Error(ErrorCode::invalid_argument,
+                concat("AdoptInfo::queue_family_index = ", a.queue_family_index, " has no compute capability"));
   }
   // The instance's version bounds what the device may use (Vulkan spec, "Version Numbers": a
   // physical device's apiVersion above the instance's is not available to the application).
   if (a.api_version < VK_API_VERSION_1_3) {
     throw Error(ErrorCode::invalid_argument,
-                concat("AdoptInfo::api_version = ", a.api_version == 0 ? std::string("0 (not set)") : detail::version_string(a.api_version),
+                concat("AdoptInfo::api_version = ",
+                       a.api_version == 0 ? std::string("0 (not set)") : detail::version_string(a.api_version),
                        " is out of range: glint needs the instance created with VkApplicationInfo::apiVersion >= 1.3 "
                        "(VK_API_VERSION_1_3), and api_version must say what it was created with"));
   }
@@ -481,16 +504,16 @@ Context Context::adopt(const AdoptInfo& a) {
                                              detail::version_string(props.apiVersion), "; glint needs 1.3"));
   }
   const detail::AdoptedFeatures features = detail::adopted_features(a);
-  const char* source = a.enabled_features ? " is not enabled (AdoptInfo::enabled_features)"
-                                          : " is not supported by the physical device";
+  const char* source =
+      a.enabled_features ? " is not enabled (AdoptInfo::enabled_features)" : " is not supported by the physical device";
   const ErrorCode code = a.enabled_features ? ErrorCode::invalid_argument : ErrorCode::no_device;
   if (!features.synchronization2) {
     throw Error(code, concat("VkPhysicalDeviceVulkan13Features::synchronization2", source,
-                                             "; glint records every barrier with vkCmdPipelineBarrier2"));
+                             "; glint records every barrier with vkCmdPipelineBarrier2"));
   }
   if (!features.maintenance4) {
     throw Error(code, concat("VkPhysicalDeviceVulkan13Features::maintenance4", source,
-                                             "; glint's kernels take their workgroup size from specialization (LocalSizeId)"));
+                             "; glint's kernels take their workgroup size from specialization (LocalSizeId)"));
   }
   auto state = std::make_unique<detail::ContextState>();
   state->instance = a.instance;

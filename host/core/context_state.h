@@ -6,11 +6,11 @@
 #include <atomic>
 #include <functional>
 #include <map>
-#include <tuple>
-#include <utility>
 #include <memory>
 #include <mutex>
 #include <string>
+#include <tuple>
+#include <utility>
 #include <vector>
 
 namespace glint::detail {

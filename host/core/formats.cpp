@@ -43,18 +43,21 @@ const char* float_color_formats() {
 
 const char* qualified_variant(VkFormat format) {
   switch (format) {
-    case VK_FORMAT_R16G16B16A16_SFLOAT: return "rgba16f";
-    case VK_FORMAT_R32G32B32A32_SFLOAT: return "rgba32f";
-    case VK_FORMAT_B10G11R11_UFLOAT_PACK32: return "r11f_g11f_b10f";
-    default: return nullptr;
+    case VK_FORMAT_R16G16B16A16_SFLOAT:
+      return "rgba16f";
+    case VK_FORMAT_R32G32B32A32_SFLOAT:
+      return "rgba32f";
+    case VK_FORMAT_B10G11R11_UFLOAT_PACK32:
+      return "r11f_g11f_b10f";
+    default:
+      return nullptr;
   }
 }
 
-void check_color_read(const Context& context, VkFormat format, const char* where, const char* role,
-                      bool linear) {
+void check_color_read(const Context& context, VkFormat format, const char* where, const char* role, bool linear) {
   if (!is_float_color(format)) {
-    throw Error(ErrorCode::unsupported_format, concat(where, ": ", role, " format is ", format_name(format),
-                                                      "; accepted ", float_color_formats()));
+    throw Error(ErrorCode::unsupported_format,
+                concat(where, ": ", role, " format is ", format_name(format), "; accepted ", float_color_formats()));
   }
   const VkFormatFeatureFlags2 f = format_features(context, format);
   if (!(f & VK_FORMAT_FEATURE_2_SAMPLED_IMAGE_BIT)) {
@@ -72,8 +75,8 @@ void check_color_read(const Context& context, VkFormat format, const char* where
 
 const char* check_color_write(const Context& context, VkFormat format, const char* where, const char* role) {
   if (!is_float_color(format)) {
-    throw Error(ErrorCode::unsupported_format, concat(where, ": ", role, " format is ", format_name(format),
-                                                      "; accepted ", float_color_formats()));
+    throw Error(ErrorCode::unsupported_format,
+                concat(where, ": ", role, " format is ", format_name(format), "; accepted ", float_color_formats()));
   }
   const VkFormatFeatureFlags2 f = format_features(context, format);
   const char* qualified = qualified_variant(format);
@@ -83,12 +86,13 @@ const char* check_color_write(const Context& context, VkFormat format, const cha
   if ((f & VK_FORMAT_FEATURE_2_STORAGE_IMAGE_BIT) && (f & VK_FORMAT_FEATURE_2_STORAGE_WRITE_WITHOUT_FORMAT_BIT)) {
     return "noformat";
   }
-  throw Error(ErrorCode::unsupported_format,
-              concat(where, ": ", role, " format is ", format_name(format), ", which device '", context.info().name,
-                     "' cannot write as a storage image (",
-                     (f & VK_FORMAT_FEATURE_2_STORAGE_IMAGE_BIT) ? "no VK_FORMAT_FEATURE_2_STORAGE_WRITE_WITHOUT_FORMAT_BIT"
-                                                                 : "no VK_FORMAT_FEATURE_2_STORAGE_IMAGE_BIT",
-                     " with optimal tiling)"));
+  throw Error(
+      ErrorCode::unsupported_format,
+      concat(where, ": ", role, " format is ", format_name(format), ", which device '", context.info().name,
+             "' cannot write as a storage image (",
+             (f & VK_FORMAT_FEATURE_2_STORAGE_IMAGE_BIT) ? "no VK_FORMAT_FEATURE_2_STORAGE_WRITE_WITHOUT_FORMAT_BIT"
+                                                         : "no VK_FORMAT_FEATURE_2_STORAGE_IMAGE_BIT",
+             " with optimal tiling)"));
 }
 
 float format_max(VkFormat format) {

@@ -1,8 +1,8 @@
 // IEEE 754 binary16 conversion (round to nearest even), for uploads and readbacks of RGBA16F.
 #pragma once
 
-#include <cstdint>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 
 namespace glint::detail {

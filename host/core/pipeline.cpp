@@ -1,15 +1,15 @@
 #include "core/pipeline.h"
 
-#include "core/barriers.h"
-#include "core/context_state.h"
-#include "core/kernel_table.h"
-
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <memory>
 #include <string>
 #include <utility>
+
+#include "core/barriers.h"
+#include "core/context_state.h"
+#include "core/kernel_table.h"
 
 namespace glint::detail {
 
@@ -168,7 +168,8 @@ VkDescriptorSet DescriptorArena::make_buffer_set(const ComputePipeline& pipeline
   return make_mixed_set(pipeline, bindings);
 }
 
-VkDescriptorSet DescriptorArena::make_mixed_set(VkDescriptorSetLayout layout, const std::vector<VkDescriptorType>& types,
+VkDescriptorSet DescriptorArena::make_mixed_set(VkDescriptorSetLayout layout,
+                                                const std::vector<VkDescriptorType>& types,
                                                 const std::vector<AnyBinding>& bindings) {
   if (bindings.size() != types.size()) {
     throw Error(ErrorCode::invalid_argument,

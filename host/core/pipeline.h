@@ -75,8 +75,8 @@ class ComputePipeline {
 
  private:
   void bind_and_push(VkCommandBuffer cmd, VkDescriptorSet set, const void* push, uint32_t bytes) const;
-  void dispatch_raw(VkCommandBuffer cmd, VkDescriptorSet set, const void* push, uint32_t bytes,
-                    uint32_t width, uint32_t height) const;
+  void dispatch_raw(VkCommandBuffer cmd, VkDescriptorSet set, const void* push, uint32_t bytes, uint32_t width,
+                    uint32_t height) const;
   const CompiledPipeline* compiled_ = nullptr;  // owned by the context
   std::string id_;
   uint32_t push_bytes_ = 0;

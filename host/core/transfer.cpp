@@ -35,8 +35,7 @@ bool is_transfer_color(VkFormat f) {
   return f == VK_FORMAT_R16G16B16A16_SFLOAT || f == VK_FORMAT_R32G32B32A32_SFLOAT ||
          f == VK_FORMAT_B10G11R11_UFLOAT_PACK32 || f == VK_FORMAT_R16G16B16_SFLOAT || f == VK_FORMAT_R32G32B32_SFLOAT;
 }
-constexpr const char* kTransferColor =
-    "RGBA16F, RGBA32F, B10G11R11_UFLOAT, RGB16F or RGB32F";
+constexpr const char* kTransferColor = "RGBA16F, RGBA32F, B10G11R11_UFLOAT, RGB16F or RGB32F";
 
 void encode(VkFormat f, const float* rgba, size_t texels, void* dst) {
   for (size_t i = 0; i < texels; ++i) {
@@ -168,7 +167,8 @@ CpuImage read_staged(const OwnedBuffer& staging, const Image& image) {
   const size_t texels = size_t(image.extent.width) * image.extent.height;
   CpuImage out(image.extent.width, image.extent.height);
   if (!is_transfer_color(image.format)) {
-    throw Error(ErrorCode::unsupported_format, concat("download: ", format_name(image.format), " is not ", kTransferColor));
+    throw Error(ErrorCode::unsupported_format,
+                concat("download: ", format_name(image.format), " is not ", kTransferColor));
   }
   decode(image.format, staging.mapped(), texels, out.rgba.data());
   return out;
@@ -181,7 +181,8 @@ void upload(const Context& context, Image& image, const CpuImage& pixels) {
 
 CpuImage download(const Context& context, Image& image) {
   if (!is_transfer_color(image.format)) {
-    throw Error(ErrorCode::unsupported_format, concat("download: ", format_name(image.format), " is not ", kTransferColor));
+    throw Error(ErrorCode::unsupported_format,
+                concat("download: ", format_name(image.format), " is not ", kTransferColor));
   }
   const OwnedBuffer staging = make_readback_staging(context, image);
   context.run_once([&](VkCommandBuffer cmd) { record_readback(cmd, image, staging); });

@@ -159,8 +159,7 @@ std::vector<std::string> AtomicOutputs::targets() const {
   return t;
 }
 
-void AtomicOutputs::write(const std::string& target,
-                          const std::function<void(const std::string& temporary)>& writer) {
+void AtomicOutputs::write(const std::string& target, const std::function<void(const std::string& temporary)>& writer) {
   if (committed_) throw Error(ErrorCode::invalid_argument, target + ": AtomicOutputs already committed");
   for (const Entry& e : entries_) {
     if (e.target == target) throw Error(ErrorCode::invalid_argument, target + ": written twice by one command");
@@ -217,8 +216,8 @@ void AtomicOutputs::commit() {
         const int err = errno;
         // The files before this one are replaced already; the rest are removed by the destructor.
         entries_.erase(entries_.begin(), entries_.begin() + static_cast<std::ptrdiff_t>(i));
-        throw Error(ErrorCode::io_failure, e.target + ": cannot rename the finished temporary over it: " +
-                                               errno_text(err));
+        throw Error(ErrorCode::io_failure,
+                    e.target + ": cannot rename the finished temporary over it: " + errno_text(err));
       }
       release_slot(e.slot);
       e.slot = -1;

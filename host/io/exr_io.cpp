@@ -342,8 +342,8 @@ void write_exr_float(const std::string& path, const CpuImage& image) {
     // Interleaved RGBA floats; OpenEXR's Slice takes a non-const pointer but only reads when writing.
     char* base = reinterpret_cast<char*>(const_cast<float*>(image.rgba.data()));
     for (size_t c = 0; c < 4; ++c)
-      fb.insert(names[c], Imf::Slice(Imf::FLOAT, base + c * sizeof(float), 4 * sizeof(float),
-                                     4 * sizeof(float) * image.width));
+      fb.insert(names[c],
+                Imf::Slice(Imf::FLOAT, base + c * sizeof(float), 4 * sizeof(float), 4 * sizeof(float) * image.width));
     file.setFrameBuffer(fb);
     file.writePixels(int(image.height));
   });

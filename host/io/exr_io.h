@@ -23,9 +23,9 @@ inline constexpr uint64_t kMaxImagePixels = uint64_t(1) << 28;
 /// The image is the file's data window (the display window is ignored), top row first. Channels:
 /// R, G and B when any of them is present (a missing one reads as 0); else a channel named Y, or
 /// the only channel of a one-channel file (Z, Y, anything), goes to R = G = B. A is read when
-/// present, else alpha is 1; a file whose only channel is A gives R = G = B = A. Half, float and uint channels are all converted to float. Scanline
-/// and tiled single-part files are read (the first part of a multi-part file); deep files are not.
-/// path: the file to read.
+/// present, else alpha is 1; a file whose only channel is A gives R = G = B = A. Half, float and uint channels are all
+/// converted to float. Scanline and tiled single-part files are read (the first part of a multi-part file); deep files
+/// are not. path: the file to read.
 CpuImage read_exr(const std::string& path);
 
 /// One channel of an OpenEXR file.

@@ -20,14 +20,14 @@
 // float and is rejected, as is 1e400, which overflows a double). Duplicate keys are rejected.
 #pragma once
 
+#include <glint/gpu/flare_types.h>
+
 #include <array>
 #include <cstddef>
 #include <cstdint>
 #include <string>
 #include <string_view>
 #include <vector>
-
-#include <glint/gpu/flare_types.h>
 
 namespace glint::io {
 

@@ -74,7 +74,8 @@ size_t split_fields(std::string_view line, std::string_view (&fields)[9]) {
   size_t start = 0;
   for (;;) {
     const size_t comma = line.find(',', start);
-    const std::string_view f = line.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start);
+    const std::string_view f =
+        line.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start);
     fields[n++] = trim(f);
     if (comma == std::string_view::npos || n == 9) return n;
     start = comma + 1;
@@ -156,7 +157,8 @@ LodCsv parse_lod_csv(std::string_view text, uint32_t atlas_width, uint32_t atlas
     check(5, q.tex_h, q.tex_h >= 1.0f && q.tex_h <= atlas_h,
           "1 to " + std::to_string(atlas_height) + " (the atlas height)");
     check(6, q.off_x, q.off_x >= 0.0f && q.off_x + q.tex_w <= atlas_w,
-          "0 to atlas width - tex_w = " + number_text(double(atlas_w - q.tex_w)) + " (the tile must lie inside the atlas)");
+          "0 to atlas width - tex_w = " + number_text(double(atlas_w - q.tex_w)) +
+              " (the tile must lie inside the atlas)");
     check(7, q.off_y, q.off_y >= 0.0f && q.off_y + q.tex_h <= atlas_h,
           "0 to atlas height - tex_h = " + number_text(double(atlas_h - q.tex_h)) +
               " (the tile must lie inside the atlas)");

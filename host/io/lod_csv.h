@@ -39,10 +39,10 @@ inline constexpr size_t kMaxLodQueries = 4'194'240;
 
 /// A parsed QUERIES.csv.
 struct LodCsv {
-  std::string header;              //!< the header line as written (trimmed), empty when none
-  std::vector<std::string> rows;   //!< each data row as written (trimmed), for the output
-  std::vector<uint32_t> lines;     //!< the 1-based line number of each data row
-  std::vector<LodQuery> queries;   //!< one per data row
+  std::string header;             //!< the header line as written (trimmed), empty when none
+  std::vector<std::string> rows;  //!< each data row as written (trimmed), for the output
+  std::vector<uint32_t> lines;    //!< the 1-based line number of each data row
+  std::vector<LodQuery> queries;  //!< one per data row
 };
 
 /// Parses the text of a QUERIES.csv for an atlas of atlas_width x atlas_height texels (the ranges

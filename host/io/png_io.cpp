@@ -4,7 +4,6 @@
 #include "io/png_io.h"
 
 #include <glint/glint.h>
-
 #include <png.h>
 
 #include <algorithm>

@@ -5,8 +5,6 @@
 // bugs.
 #include "reference/bloom_reference.h"
 
-#include "core/half.h"
-
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -14,6 +12,8 @@
 #include <stdexcept>
 #include <string>
 #include <utility>
+
+#include "core/half.h"
 
 namespace glint::reference {
 namespace {
@@ -83,8 +83,7 @@ void store_half(DoubleImage& img) {
 }
 
 void validate(const CpuImage& input, const BloomConfig& config) {
-  if (input.width == 0 || input.height == 0)
-    throw std::invalid_argument("bloom reference: empty input image");
+  if (input.width == 0 || input.height == 0) throw std::invalid_argument("bloom reference: empty input image");
   if (input.rgba.size() != size_t(input.width) * input.height * 4)
     throw std::invalid_argument("bloom reference: input pixel buffer has " + std::to_string(input.rgba.size()) +
                                 " floats, expected width * height * 4");
@@ -244,8 +243,7 @@ AxisTaps area_taps(uint32_t x, uint32_t dst, uint32_t src) {
   const auto first = int64_t(std::floor(lo));
   const auto last = int64_t(std::ceil(hi)) - 1;
   for (int64_t i = first; i <= last; ++i) {
-    if (taps.count == int(taps.index.size()))
-      throw std::logic_error("bloom reference: area downsample ratio above 3");
+    if (taps.count == int(taps.index.size())) throw std::logic_error("bloom reference: area downsample ratio above 3");
     const double overlap = std::min(double(i + 1), hi) - std::max(double(i), lo);
     if (overlap <= 0.0) continue;
     taps.index[size_t(taps.count)] = i;

@@ -6,11 +6,11 @@
 
 #include <glint/bloom.h>
 
-#include "core/cpu_image.h"
-
 #include <cstddef>
 #include <cstdint>
 #include <vector>
+
+#include "core/cpu_image.h"
 
 namespace glint::reference {
 

@@ -1,11 +1,11 @@
 // Float64 reference of the object cull (object_cull_reference.h).
 #include "reference/object_cull_reference.h"
 
-#include "object_cull_params.h"  // the kernel's rounding margin and window limit, shared with the reference
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
+
+#include "object_cull_params.h"  // the kernel's rounding margin and window limit, shared with the reference
 
 namespace glint::reference {
 

@@ -46,7 +46,6 @@ ObjectVerdict judge_object(const GlintCullObject& object, const ObjectCamera& ca
 
 /// A Vulkan perspective projection (column-major, fp32): vertical field of view fov_y (radians),
 /// aspect, near, far (far <= 0: infinite), standard or reversed Z, y flipped (P11 < 0) if flip_y.
-void perspective(double fov_y, double aspect, double near_z, double far_z, bool reversed_z, bool flip_y,
-                 float out[16]);
+void perspective(double fov_y, double aspect, double near_z, double far_z, bool reversed_z, bool flip_y, float out[16]);
 
 }  // namespace glint::reference

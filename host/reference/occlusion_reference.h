@@ -13,12 +13,12 @@
 // CPU only: no Vulkan call is made here.
 #pragma once
 
+#include <glint/gpu/flare_types.h>
+
 #include <cstddef>
 #include <cstdint>
 #include <utility>
 #include <vector>
-
-#include <glint/gpu/flare_types.h>
 
 namespace glint::reference {
 

@@ -14,8 +14,7 @@ void read_flag(const char* name, bool& value) {
   if (!v || !*v) return;
   const std::string s(v);
   if (s != "0" && s != "1") {
-    throw Error(ErrorCode::invalid_argument,
-                std::string(name) + " = '" + s + "' is not a flag: accepted 0 or 1");
+    throw Error(ErrorCode::invalid_argument, std::string(name) + " = '" + s + "' is not a flag: accepted 0 or 1");
   }
   value = s == "1";
 }

@@ -38,15 +38,15 @@ struct BloomConfig {
   float radius = 1.0f;                      //!< scales the upsample (or Gaussian) footprint (0.25 to 4)
   BloomFilter filter = BloomFilter::cod13;  //!< [shape]
   FireflyGuard firefly_guard = FireflyGuard::karis_smooth;  //!< on the first downsample [shape]
-  float max_brightness = 1000.0f;           //!< per-channel clamp of pyramid level 0 (1e-3 to 8000):
-                                            //!< bounds the light any small area adds, keeps fp16
-                                            //!< levels finite. Source texels are first clamped to
-                                            //!< 65504 (what +Inf and 1e9 become).
-  Precision precision = Precision::fp16;    //!< intermediate storage [shape]
-  /// 0: level 0 is half the input (the 1920x1080 chain of docs/BLOOM.md; the glow is a fixed size in pixels). Else level
-  /// 0 is this many rows (at most the input's height) with the input's aspect, reached through 2:1
-  /// steps and one step of ratio 1 to 2, so the glow is the same fraction of the image at every
-  /// resolution down to this height (docs/STABILITY.md "Scale"). 0 or 8 to 16384. [shape]
+  float max_brightness = 1000.0f;                           //!< per-channel clamp of pyramid level 0 (1e-3 to 8000):
+                                                            //!< bounds the light any small area adds, keeps fp16
+                                                            //!< levels finite. Source texels are first clamped to
+                                                            //!< 65504 (what +Inf and 1e9 become).
+  Precision precision = Precision::fp16;                    //!< intermediate storage [shape]
+  /// 0: level 0 is half the input (the 1920x1080 chain of docs/BLOOM.md; the glow is a fixed size in pixels). Else
+  /// level 0 is this many rows (at most the input's height) with the input's aspect, reached through 2:1 steps and one
+  /// step of ratio 1 to 2, so the glow is the same fraction of the image at every resolution down to this height
+  /// (docs/STABILITY.md "Scale"). 0 or 8 to 16384. [shape]
   uint32_t level0_height = 0;
 
   /// Throws Error(invalid_argument) naming the first field that is out of range or NaN.
@@ -72,9 +72,9 @@ std::vector<LevelSize> bloom_pre_levels(VkExtent2D input, uint32_t level0_height
 /// with STORAGE usage whose format it can store (docs/FORMATS.md: RGBA16F, RGBA32F and
 /// B10G11R11_UFLOAT on every device that stores them; RGB16F, RGB32F and E5B9G9R9 where the device
 /// stores them without a format), same extent. Formats are chosen from the device's format
-/// features; any other is refused with an Error naming it. After record(), the input is in SHADER_READ_ONLY_OPTIMAL (GENERAL if it is
-/// also the output) and the output in GENERAL, both last used by the compute shader stage.
-/// Input and output may be the same image (in place).
+/// features; any other is refused with an Error naming it. After record(), the input is in SHADER_READ_ONLY_OPTIMAL
+/// (GENERAL if it is also the output) and the output in GENERAL, both last used by the compute shader stage. Input and
+/// output may be the same image (in place).
 ///
 /// Per size and config shape, images, pipelines and descriptor sets are made once: by prepare(),
 /// or by the first record() at that size. A record() at a prepared size with seen images creates

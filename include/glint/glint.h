@@ -139,7 +139,7 @@ struct DeviceInfo {
   uint32_t max_workgroup_invocations = 0;
   uint32_t max_image_dimension_2d = 0;
   uint32_t sub_texel_precision_bits = 4;  //!< VkPhysicalDeviceLimits::subTexelPrecisionBits (at least 4)
-  float timestamp_period_ns = 0.0f;  //!< nanoseconds per timestamp tick
+  float timestamp_period_ns = 0.0f;       //!< nanoseconds per timestamp tick
   bool timestamps_supported = false;
 };
 
@@ -258,10 +258,10 @@ struct Image {
 /// A view of a caller's buffer (or a range of it), with the caller's last use, like Image.
 struct Buffer {
   VkBuffer buffer = VK_NULL_HANDLE;
-  VkDeviceSize offset = 0;             //!< a multiple of minStorageBufferOffsetAlignment
-  VkDeviceSize size = 0;               //!< bytes from offset that glint may use; required (glint cannot
-                                       //!< query a VkBuffer's size, so 0 and VK_WHOLE_SIZE are refused)
-  VkBufferUsageFlags usage = 0;        //!< the usage the buffer was created with
+  VkDeviceSize offset = 0;       //!< a multiple of minStorageBufferOffsetAlignment
+  VkDeviceSize size = 0;         //!< bytes from offset that glint may use; required (glint cannot
+                                 //!< query a VkBuffer's size, so 0 and VK_WHOLE_SIZE are refused)
+  VkBufferUsageFlags usage = 0;  //!< the usage the buffer was created with
   VkPipelineStageFlags2 stage = VK_PIPELINE_STAGE_2_NONE;
   VkAccessFlags2 access = VK_ACCESS_2_NONE;
 };

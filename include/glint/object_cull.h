@@ -27,8 +27,8 @@
 #pragma once
 
 #include <glint/glint.h>
-#include <glint/occlusion.h>
 #include <glint/gpu/object_cull.h>
+#include <glint/occlusion.h>
 
 #include <cstdint>
 #include <memory>

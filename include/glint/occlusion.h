@@ -27,15 +27,15 @@ namespace glint {
 
 /// Creation-time settings of a Hi-Z pyramid. Checked by validate().
 struct HiZConfig {
-  VkExtent2D extent{0, 0};                 //!< depth image size in pixels (1 to 16384 on a side, and at most the
-                                           //!< device's maxImageDimension2D)
+  VkExtent2D extent{0, 0};  //!< depth image size in pixels (1 to 16384 on a side, and at most the
+                            //!< device's maxImageDimension2D)
   /// The depth image's format: VK_FORMAT_D16_UNORM, X8_D24_UNORM_PACK32, D24_UNORM_S8_UINT, D32_SFLOAT,
   /// D32_SFLOAT_S8_UINT (read through a depth-aspect view; UNORM depth reads as d / (2^bits - 1)) or
   /// R32_SFLOAT. The constructor also refuses, by name, a format the device cannot sample (Vulkan
   /// guarantees only D16_UNORM and D32_SFLOAT; D24S8 is absent on some GPUs).
   VkFormat format = VK_FORMAT_D32_SFLOAT;
-  bool reversed_z = false;                 //!< true: depth 1 is near, the pyramid keeps the minimum (farthest);
-                                           //!< false: 0 is near, it keeps the maximum
+  bool reversed_z = false;  //!< true: depth 1 is near, the pyramid keeps the minimum (farthest);
+                            //!< false: 0 is near, it keeps the maximum
   /// The largest grid cell (light size_px / grid) that needs one texel per cell, in pixels
   /// (0 = no limit, else 1 to 16384). Levels coarser than ceil(log2(max_cell_px)) are not built;
   /// a larger cell reads several texels of the last level instead (still conservative).
@@ -108,12 +108,13 @@ enum class OcclusionPattern : uint32_t {
 
 /// Creation-time settings of a LightCuller. Checked by validate().
 struct LightCullConfig {
-  uint32_t capacity = 1024;        //!< GlintFlareInstance slots in the instance buffer (1 to 16777216)
-  uint32_t grid = 4;               //!< N: N x N occlusion cells per light (1 to 16)
-  float margin_ndc = 1.2f;         //!< frustum margin: lights with |ndc.x| or |ndc.y| above it are
-                                   //!< culled (1 to 8; 1.2, a margin that keeps the ghosts of lights just off screen)
-  float depth_bias = 0.0f;         //!< NDC depth tolerance: a light up to this much behind a surface
-                                   //!< still counts as visible there (0 to 0.1; 0.01 hides depth-precision noise on coplanar lights)
+  uint32_t capacity = 1024;  //!< GlintFlareInstance slots in the instance buffer (1 to 16777216)
+  uint32_t grid = 4;         //!< N: N x N occlusion cells per light (1 to 16)
+  float margin_ndc = 1.2f;   //!< frustum margin: lights with |ndc.x| or |ndc.y| above it are
+                             //!< culled (1 to 8; 1.2, a margin that keeps the ghosts of lights just off screen)
+  float depth_bias =
+      0.0f;  //!< NDC depth tolerance: a light up to this much behind a surface
+             //!< still counts as visible there (0 to 0.1; 0.01 hides depth-precision noise on coplanar lights)
   uint32_t max_lights = 1u << 20;  //!< most lights per record() (1 to 4194240 = 65535 x 64); the
                                    //!< culler keeps 16 bytes per light (and 16 per 64) for it
   OcclusionPattern pattern = OcclusionPattern::multi_jittered;  //!< where the N x N samples read

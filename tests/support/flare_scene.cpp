@@ -8,7 +8,8 @@
 
 namespace glint::test {
 
-HostBuffer::HostBuffer(VkDeviceSize bytes) : owned(context(), std::max<VkDeviceSize>(bytes, 4), kFlareBufferUsage, true) {
+HostBuffer::HostBuffer(VkDeviceSize bytes)
+    : owned(context(), std::max<VkDeviceSize>(bytes, 4), kFlareBufferUsage, true) {
   view = {owned.buffer(), 0, owned.size(), kFlareBufferUsage, VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE};
   poison();
 }
@@ -27,8 +28,9 @@ std::vector<uint8_t> HostBuffer::bytes(size_t n) const {
 }
 
 detail::OwnedImage make_depth(const reference::DepthImage& d, VkFormat format) {
-  detail::OwnedImage img(context(), {d.width, d.height}, format,
-                         VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT);
+  detail::OwnedImage img(
+      context(), {d.width, d.height}, format,
+      VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT);
   detail::upload_r32(context(), img.state, d.depth);
   return img;
 }

@@ -4,7 +4,6 @@
 #pragma once
 
 #include <glint/glint.h>
-
 #include <glint/gpu/flare_types.h>
 
 #include <array>
@@ -17,10 +16,9 @@
 
 namespace glint::test {
 
-inline constexpr VkBufferUsageFlags kFlareBufferUsage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
-                                                        VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT |
-                                                        VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
-                                                        VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+inline constexpr VkBufferUsageFlags kFlareBufferUsage =
+    VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
+    VK_BUFFER_USAGE_TRANSFER_DST_BIT;
 
 /// A host-visible buffer (at least 4 bytes) with kFlareBufferUsage; poison() fills it with 0xFF
 /// bytes (NaN as float, ~0u as uint), so data a run did not write shows. Made poisoned.

@@ -1,11 +1,11 @@
 #include "support/gpu_test.h"
 
-#include "tooling/environment.h"
-
 #include <cmath>
 #include <cstdlib>
 #include <memory>
 #include <string>
+
+#include "tooling/environment.h"
 
 namespace glint::test {
 
