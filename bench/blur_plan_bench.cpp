@@ -1,6 +1,6 @@
 // The blur planner's CPU time (host/blur_plan.h): plan_auto() runs when a GaussianBlur is made with
-// method auto, so it must stay far below a frame (docs/BLUR.md). This was a timed unit test; a
-// wall-clock bound in the suite failed on a shared, busy machine, so it is measured here instead
+// method auto, so it must stay far below a frame (docs/BLUR.md). It is measured here rather than bounded in
+// the test suite, where a wall-clock limit fails on a shared, busy machine
 // (tests/blur_plan_test.cpp keeps the functional checks of the plans). CPU time, no device.
 #include <benchmark/benchmark.h>
 

@@ -7,7 +7,7 @@
 //   (gpu_frame is unset or gpu_frame + frames_in_flight <= frame()) and run_once `once` is over.
 // A slot is stale, and destroyed by the next retire_stale(), when it is safe and either was not
 // touched (recorded or prepared) for frames_in_flight frames, or was only ever recorded inside
-// run_once() calls that are over (tools and tests then keep one size, as before sizes were cached).
+// run_once() calls that are over (tools and tests then keep only the size they use).
 // When all kMaxCachedSizes slots are taken, the least recently touched safe slot makes room; if
 // none is safe, get() throws before the caller records anything.
 //
