@@ -340,8 +340,7 @@ struct LightCuller::Impl {
   bool counters_cleared = false;
   // Descriptor sets per distinct set of caller resources, made on first use and kept.
   struct Sets {
-    VkDescriptorSet cull = VK_NULL_HANDLE, scan_tiles = VK_NULL_HANDLE, scan = VK_NULL_HANDLE,
-                    scatter = VK_NULL_HANDLE;
+    VkDescriptorSet cull = VK_NULL_HANDLE, scan_tiles = VK_NULL_HANDLE, scan = VK_NULL_HANDLE, scatter = VK_NULL_HANDLE;
   };
   // Sets by the resources they name: the depth and Hi-Z views and (buffer, offset, size) of the
   // lights, instances, results, indirect and stats buffers. A fixed-size key: no allocation.
@@ -559,8 +558,8 @@ void LightCuller::record(VkCommandBuffer cmd, HiZPyramid& hiz, Image& depth, Buf
   if (group_count > 0) {
     b.use(m.groups_state, kCompute, kStorageRead | kStorageWrite);
     b.flush(cmd);
-    m.scan_tiles.dispatch(cmd, sets.scan_tiles, cp, (group_count + m.scan_threads - 1) / m.scan_threads * m.scan_threads,
-                          1);
+    m.scan_tiles.dispatch(cmd, sets.scan_tiles, cp,
+                          (group_count + m.scan_threads - 1) / m.scan_threads * m.scan_threads, 1);
   }
   // 2b. One workgroup: the tiles' first slots, arguments, statistics.
   b.use(m.groups_state, kCompute, kStorageRead | kStorageWrite);

@@ -10,7 +10,7 @@
 layout(local_size_x_id = 0, local_size_y_id = 1) in;
 
 #include "glint/gpu/flare_types.h"
-#include "occlusion.h"
+#include "light_cull_params.h"
 
 layout(std430, binding = 0) buffer Groups {
   uint counters[GLINT_CULL_HEADER_WORDS];

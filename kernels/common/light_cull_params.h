@@ -1,8 +1,8 @@
 // Push constants and buffer layouts of the visibility stage of the lens flares: the Hi-Z build
 // (hiz_build.comp), the cull + occlusion grid test (light_cull.comp), and the order-preserving
-// compaction (the same order on every run): a single-workgroup scan of the cull's per-workgroup
-// visibility masks that also writes the indirect arguments and statistics (light_cull_scan.comp),
-// then the scatter of the visible lights into the instance buffer in light-index order
+// compaction (the same order on every run): a two-level scan of the cull's per-workgroup visibility
+// masks (light_cull_scan_tiles.comp per tile, light_cull_scan.comp over the tile totals, which also
+// writes the indirect arguments and statistics), then the scatter of the visible lights into the instance buffer in light-index order
 // (light_cull_scatter.comp). Declared once for GLSL and C++ (CONTRIBUTING.md, "Shared structs");
 // host/occlusion.cpp static_asserts the layouts. docs/OCCLUSION.md explains the algorithms. The
 // public C++ API of the same stage is include/glint/occlusion.h.
