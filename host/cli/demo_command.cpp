@@ -212,7 +212,8 @@ Command add_demo_command(CLI::App& app) {
                   "missing)");
   sub->add_option("--preset", o->preset, kFlarePresetHelp);
   sub->add_option("--exposure", o->exposure, "Linear exposure applied before the PNG tonemap (> 0)");
-  sub->add_option("--variant", o->variant, "Which random starfield (any 32-bit number; 1 by default)");
+  sub->add_option("--variant,--seed", o->variant,
+                  "Which random starfield (any 32-bit number; 1 by default; --seed is the same option)");
   add_device_option(*sub, o->device);
   return {sub, [o] { run_demo(*o); }};
 }
