@@ -156,6 +156,11 @@ for method in auto separable pyramid dual; do
   expect_file "$tmp/g_$method.exr"
   grep -q '^method: ' "$tmp/out" || fail "glint gauss --method $method printed no method"
   grep -q 'expected relative L2 error' "$tmp/out" || fail "glint gauss --method $method printed no error"
+  # The pyramid and the dual bound only the interior, and say so.
+  if [[ $method == pyramid || $method == dual ]]; then
+    grep -q 'in the interior, more than [0-9]* px from a border' "$tmp/out" ||
+      fail "glint gauss --method $method does not say its bound is for the interior"
+  fi
 done
 ok gauss "$scene" "$tmp/g_lin.exr" --sigma 1.5 --method separable --linear --fp32
 # --fp32 writes 32-bit float channels, the default half: the pixel type of each channel in the

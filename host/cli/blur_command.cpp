@@ -4,6 +4,7 @@
 // method chosen and its expected error. Ranges are checked by the configs' validate().
 #include <glint/blur.h>
 
+#include <cmath>
 #include <cstdio>
 #include <memory>
 #include <sstream>
@@ -114,8 +115,15 @@ void run_gauss(GaussOptions& o) {
     std::printf(", %u levels, sigma %.3f texels at the last", c.levels, c.level_sigma);
   if (c.method == BlurMethod::dual) std::printf(", %u levels, tap offset %.3f", c.levels, c.dual_offset);
   std::printf(", %u dispatches\n", c.dispatches);
-  std::printf("sigma: %.3f px asked, %.3f px effective; expected relative L2 error %.2e (bound %.2e)\n",
+  std::printf("sigma: %.3f px asked, %.3f px effective; expected relative L2 error %.2e (bound %.2e)",
               o.config.sigma_px, c.effective_sigma_px, c.expected_relative_error, o.config.max_relative_error);
+  if (c.method == BlurMethod::pyramid || c.method == BlurMethod::dual) {
+    // The model bounds the interior only: near a border these methods clamp at their levels'
+    // resolution, the exact Gaussian at full resolution (docs/BLUR.md, "Error model").
+    const double band = std::ceil(4.0 * o.config.sigma_px + std::ldexp(1.0, int(c.levels) + 1));
+    std::printf(" in the interior, more than %.0f px from a border (the border band is not bounded)", band);
+  }
+  std::printf("\n");
   print_stages(profiler);
   io::AtomicOutputs files;
   files.write(o.output, [&](const std::string& tmp) { write_result_exr(tmp, output, o.fp32); });
