@@ -97,7 +97,7 @@ asan_test() {
   log "ASan+UBSan: GPU tests and the CLI smoke test"
   ASAN_OPTIONS="detect_leaks=0:abort_on_error=1" UBSAN_OPTIONS="$ubsan" \
     ctest --test-dir "$dir" --output-on-failure --no-tests=error -LE cpu -j"$(nproc)" "$@"
-  ASAN_OPTIONS="detect_leaks=0:abort_on_error=1" UBSAN_OPTIONS="$ubsan" tests/cli_test.sh "$dir/host/glint"
+  ASAN_OPTIONS="detect_leaks=0:abort_on_error=1" UBSAN_OPTIONS="$ubsan" tests/cli_test.sh "$dir/tools/cli/glint"
   gpu_assisted_tests "$dir" "ASAN_OPTIONS=detect_leaks=0:abort_on_error=1" "UBSAN_OPTIONS=$ubsan"
 }
 
@@ -113,9 +113,10 @@ gpu_assisted_tests() {
 }
 
 # format_check: fails when clang-format 14 with the root .clang-format would change a C++ file.
-# Checked: every tracked *.cpp and *.h except kernels/ and include/glint/gpu/, whose headers are
-# also GLSL (shared structs with hand-aligned field comments and GLSL-only macros that clang-format
-# reflows badly); those follow the layout by hand (CONTRIBUTING.md, "Layout"). Version 14 only:
+# Checked: every tracked *.cpp and *.h except the shaders/ folders (src/<part>/shaders,
+# tools/demo/shaders) and include/glint/gpu/, whose headers are also GLSL (shared structs with
+# hand-aligned field comments and GLSL-only macros that clang-format reflows badly); those follow
+# the layout by hand (CONTRIBUTING.md, "Layout"). Version 14 only:
 # other versions lay some constructs out differently, so their verdict would not be CI's.
 format_check() {
   command -v clang-format >/dev/null || die "clang-format is missing (apt-get install clang-format)"
@@ -124,9 +125,10 @@ format_check() {
   [[ "$version" == 14 ]] || die "the format check needs clang-format 14 (Debian 12's); found ${version:-unknown}"
   local files=()
   if git rev-parse --is-inside-work-tree >/dev/null 2>&1; then
-    mapfile -t files < <(git ls-files '*.cpp' '*.h' ':!:kernels/' ':!:include/glint/gpu/')
+    mapfile -t files < <(git ls-files '*.cpp' '*.h' ':!:*/shaders/*' ':!:include/glint/gpu/')
   else
-    mapfile -t files < <(find bench fuzz host include tests -name '*.cpp' -o -name '*.h' | grep -v '^include/glint/gpu/' | sort)
+    mapfile -t files < <(find bench fuzz include src tests tools \( -name '*.cpp' -o -name '*.h' \) |
+      grep -v -e '^include/glint/gpu/' -e '/shaders/' | sort)
   fi
   log "format check: clang-format 14 over ${#files[@]} files"
   clang-format --dry-run -Werror "${files[@]}" ||
@@ -141,7 +143,7 @@ run_fuzz() {
     -DGLINT_BUILD_CLI=OFF -DGLINT_WERROR=ON
   local targets=()
   for src in fuzz/fuzz_*.cpp; do targets+=(--target "$(basename "$src" .cpp)"); done
-  cmake --build "$dir" -j"$(nproc)" "${targets[@]}"  # not the library: the targets need only host/io
+  cmake --build "$dir" -j"$(nproc)" "${targets[@]}"  # not the library: the targets need only tools/io
   mkdir -p fuzz/findings
   for src in fuzz/fuzz_*.cpp; do
     name="$(basename "$src" .cpp)"
@@ -175,7 +177,7 @@ case "$cmd" in
     install_packages
     configure GLINT_BUILD_CLI
     build --target glint_cli
-    exec "$BUILD_DIR/host/glint" demo "$@"
+    exec "$BUILD_DIR/tools/cli/glint" demo "$@"
     ;;
   test)
     install_packages
@@ -188,7 +190,7 @@ case "$cmd" in
       build
       ctest --test-dir "$BUILD_DIR" --output-on-failure --no-tests=error -j"$(nproc)" "$@"
       log "CLI smoke test"
-      tests/cli_test.sh "$BUILD_DIR/host/glint"
+      tests/cli_test.sh "$BUILD_DIR/tools/cli/glint"
       gpu_assisted_tests "$BUILD_DIR"
     else
       # Everything runs once, in the ASan+UBSan build (build-asan): the suite with validation

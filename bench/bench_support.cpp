@@ -5,7 +5,7 @@
 #include <memory>
 #include <random>
 
-#include "tooling/environment.h"
+#include "support/environment.h"
 
 namespace glint::bench {
 

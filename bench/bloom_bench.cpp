@@ -14,8 +14,8 @@
 
 #include "bench_support.h"
 #include "core/half.h"
-#include "core/transfer.h"
 #include "reference/bloom_reference.h"
+#include "support/transfer.h"
 
 namespace glint::bench {
 namespace {

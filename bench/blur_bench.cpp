@@ -24,8 +24,8 @@
 #include "bench_support.h"
 #include "core/half.h"
 #include "core/resources.h"
-#include "core/transfer.h"
 #include "reference/blur_reference.h"
+#include "support/transfer.h"
 
 namespace glint::bench {
 namespace {

@@ -1,10 +1,10 @@
-// The blur planner's CPU time (host/blur_plan.h): plan_auto() runs when a GaussianBlur is made with
+// The blur planner's CPU time (src/blur/blur_plan.h): plan_auto() runs when a GaussianBlur is made with
 // method auto, so it must stay far below a frame (docs/BLUR.md). It is measured here rather than bounded in
 // the test suite, where a wall-clock limit fails on a shared, busy machine
 // (tests/blur_plan_test.cpp keeps the functional checks of the plans). CPU time, no device.
 #include <benchmark/benchmark.h>
 
-#include "blur_plan.h"
+#include "blur/blur_plan.h"
 
 namespace glint::bench {
 namespace {

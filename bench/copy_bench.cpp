@@ -1,14 +1,14 @@
 // The copy-bandwidth floor, measured in the same run as the effects: a compute kernel that reads
-// one RGBA16F image and writes another (kernels/image_copy.comp), timed with timestamps. Effects
+// one RGBA16F image and writes another (src/bloom/shaders/image_copy.comp), timed with timestamps. Effects
 // quote their time as a ratio to this (docs/PERF.md).
 #include <benchmark/benchmark.h>
 
 #include "bench_support.h"
-#include "bloom_params.h"
+#include "bloom/shaders/bloom_params.h"
 #include "core/barriers.h"
 #include "core/pipeline.h"
 #include "core/resources.h"
-#include "core/transfer.h"
+#include "support/transfer.h"
 
 namespace glint::bench {
 namespace {

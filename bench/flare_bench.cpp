@@ -28,9 +28,9 @@
 #include "bench_support.h"
 #include "core/barriers.h"
 #include "core/resources.h"
-#include "core/transfer.h"
-#include "flare_params.h"
+#include "flare/shaders/flare_params.h"
 #include "reference/flare_reference.h"
+#include "support/transfer.h"
 
 namespace glint::bench {
 namespace {

@@ -19,8 +19,8 @@
 #include "bench_support.h"
 #include "core/barriers.h"
 #include "core/resources.h"
-#include "core/transfer.h"
 #include "reference/occlusion_reference.h"
+#include "support/transfer.h"
 
 namespace glint::bench {
 namespace {

@@ -15,8 +15,8 @@
 #include "bench_support.h"
 #include "core/barriers.h"
 #include "core/resources.h"
-#include "core/transfer.h"
 #include "reference/object_cull_reference.h"
+#include "support/transfer.h"
 
 namespace glint::bench {
 namespace {

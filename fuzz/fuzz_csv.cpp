@@ -1,4 +1,4 @@
-// libFuzzer target for the QUERIES.csv parser of `glint lod` (host/io/lod_csv.cpp): any bytes must
+// libFuzzer target for the QUERIES.csv parser of `glint lod` (tools/io/lod_csv.cpp): any bytes must
 // give a list of queries or glint::Error(invalid_argument), never a crash, a hang or an unbounded
 // allocation. Every accepted query must be one the LOD kernel treats as valid (finite numbers, a
 // tile of at least 1x1 inside the atlas), so that no accepted row silently gets level 0.

@@ -1,4 +1,4 @@
-// libFuzzer target for the OpenEXR loader (host/io/exr_io.cpp): any bytes must give an image or
+// libFuzzer target for the OpenEXR loader (tools/io/exr_io.cpp): any bytes must give an image or
 // glint::Error(io_failure), never a crash, a hang or an allocation beyond the loader's size limit.
 // The input goes through a file because read_exr takes a path (the CLI's only way in).
 #include <glint/glint.h>

@@ -1,4 +1,4 @@
-// libFuzzer target for the LIGHTS.json parser (host/io/lights_json.cpp): any bytes must give a
+// libFuzzer target for the LIGHTS.json parser (tools/io/lights_json.cpp): any bytes must give a
 // light list or glint::Error(invalid_argument), never a crash, a hang or an unbounded allocation;
 // a parsed list must survive to_lights_json and parse again to the same floats.
 #include <glint/glint.h>

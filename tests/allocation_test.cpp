@@ -19,9 +19,9 @@
 #include <string>
 
 #include "core/resources.h"
-#include "core/transfer.h"
 #include "support/flare_scene.h"
 #include "support/gpu_test.h"
+#include "support/transfer.h"
 
 // The replacements below pair operator new with malloc and operator delete with free, which is
 // correct; GCC's -Wmismatched-new-delete sees a free() of what `new` returned once they inline.

@@ -26,9 +26,9 @@
 
 #include "core/barriers.h"
 #include "core/context_state.h"
-#include "core/transfer.h"
+#include "support/environment.h"
 #include "support/gpu_test.h"
-#include "tooling/environment.h"
+#include "support/transfer.h"
 
 namespace glint::test {
 namespace {

@@ -1,7 +1,7 @@
-// Tests of the blur planner (host/blur_plan.h): Gaussian taps, the discrete variance and its
+// Tests of the blur planner (src/blur/blur_plan.h): Gaussian taps, the discrete variance and its
 // inverse, the pyramid's variance bookkeeping and the per-method plans of docs/BLUR.md. CPU only.
 // Expected values are derived here from the formulas of docs/BLUR.md, not copied from outputs.
-#include "blur_plan.h"
+#include "blur/blur_plan.h"
 
 #include <gtest/gtest.h>
 

@@ -8,11 +8,11 @@
 #include "core/context_state.h"
 #include "core/pipeline.h"
 #include "core/resources.h"
-#include "core/transfer.h"
-#include "demo_scene.h"
+#include "demo/demo_scene.h"
 #include "reference/bloom_reference.h"
+#include "support/environment.h"
 #include "support/gpu_test.h"
-#include "tooling/environment.h"
+#include "support/transfer.h"
 
 namespace glint::test {
 namespace {

@@ -32,12 +32,12 @@
 
 #include "core/barriers.h"
 #include "core/half.h"
-#include "core/transfer.h"
 #include "reference/flare_reference.h"
 #include "reference/occlusion_reference.h"
 #include "support/flare_check.h"
 #include "support/flare_scene.h"
 #include "support/gpu_test.h"
+#include "support/transfer.h"
 
 namespace glint::test {
 namespace {

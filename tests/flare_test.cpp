@@ -1,5 +1,5 @@
 // Lens flares, drawing half, on the GPU (lavapipe in CI) against the float64 reference
-// (host/reference/flare_reference.h), and the two paths against each other. The instance and
+// (tools/reference/flare_reference.h), and the two paths against each other. The instance and
 // indirect buffers are filled from the CPU through a copy, standing in for the visibility stage,
 // so the barriers from a writer to DRAW_INDIRECT / INDIRECT_COMMAND_READ are exercised. Validation
 // with synchronization validation is on for every test (support/gpu_test.h).
@@ -16,7 +16,7 @@
 
 #include "core/barriers.h"
 #include "core/half.h"
-#include "flare_params.h"
+#include "flare/shaders/flare_params.h"
 #include "reference/flare_reference.h"
 #include "reference/lod_reference.h"
 #include "support/flare_check.h"

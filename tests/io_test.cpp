@@ -1,4 +1,4 @@
-// host/io: EXR and PNG round trips, and every way a file can be bad ending in Error(io_failure),
+// tools/io: EXR and PNG round trips, and every way a file can be bad ending in Error(io_failure),
 // never a crash. No GPU. Truncation is tried at every length of a small file (as meshoptimizer's
 // tests do for buffers), so run this under GLINT_SANITIZE=ON as well.
 #include <ImfChannelList.h>
@@ -28,7 +28,7 @@
 #include "io/atomic_outputs.h"
 #include "io/exr_io.h"
 #include "io/png_io.h"
-#include "tooling/host_memory.h"
+#include "support/host_memory.h"
 
 namespace glint {
 namespace {

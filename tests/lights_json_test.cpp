@@ -1,4 +1,4 @@
-// LIGHTS.json parsing (host/io/lights_json.h), CPU only: the values and defaults that reach
+// LIGHTS.json parsing (tools/io/lights_json.h), CPU only: the values and defaults that reach
 // GlintFlareLight, a round trip through to_lights_json, and every kind of bad input, each with a
 // one-line message that names the JSON path and the accepted type or range. Hostile input (deep
 // nesting, huge arrays, every truncation of a valid file) must end in glint::Error, never a crash.

@@ -1,4 +1,4 @@
-// host/io/lod_csv: QUERIES.csv of `glint lod` read strictly: the header rule, every data row parsed
+// tools/io/lod_csv: QUERIES.csv of `glint lod` read strictly: the header rule, every data row parsed
 // or rejected with its line and field, the ranges of the tile, and the size and line caps. No GPU.
 #include "io/lod_csv.h"
 

@@ -1,9 +1,9 @@
 // Tests of glint's atlas-aware LOD on the CPU (docs/LOD.md): the C++ twin of the GLSL
-// function (host/lod_math.h, the same source as include/glint/gpu/lod.glsl) against the float64
-// reference written from the Vulkan specification (host/reference/lod_reference.h), the atlas
+// function (src/lod/lod_math.h, the same source as include/glint/gpu/lod.glsl) against the float64
+// reference written from the Vulkan specification (tools/reference/lod_reference.h), the atlas
 // cases a to g of docs/LOD.md, and the properties the specification implies. No Vulkan: the GPU's own sampler is
 // compared in tests/lod_test.cpp. Random inputs come from std::mt19937 started from fixed values.
-#include "lod_math.h"
+#include "lod/lod_math.h"
 
 #include <gtest/gtest.h>
 

@@ -11,7 +11,7 @@
 #include "core/barriers.h"
 #include "core/context_state.h"
 #include "core/pipeline.h"
-#include "lod_math.h"
+#include "lod/lod_math.h"
 #include "support/gpu_test.h"
 
 namespace glint::test {
@@ -217,7 +217,7 @@ void make_level_atlas(LevelAtlas& a, uint32_t size, uint32_t levels) {
   });
 }
 
-// Runs kernels/lod_probe.comp (`kernel`: its textureGrad or its explicit-level variant) on every
+// Runs src/lod/shaders/lod_probe.comp (`kernel`: its textureGrad or its explicit-level variant) on every
 // query against `atlas`; returns what the device's sampler read.
 std::vector<float> probe_sampler(const char* kernel, const LevelAtlas& atlas, const std::vector<LodQuery>& queries,
                                  uint32_t size, uint32_t levels) {

@@ -1,4 +1,4 @@
-// Object occlusion cull on the GPU against the float64 reference (host/reference/
+// Object occlusion cull on the GPU against the float64 reference (tools/reference/
 // object_cull_reference.h): per-object states on random scenes (standard and reversed Z, finite and
 // infinite far, y flipped or not, spheres and boxes from tiny to screen-filling, near-plane
 // crossing, off-screen, behind the camera, malformed), equal to the reference except at documented

@@ -1,4 +1,4 @@
-// Lens-flare visibility on the GPU against the float64 references (host/reference/
+// Lens-flare visibility on the GPU against the float64 references (tools/reference/
 // occlusion_reference.h): the Hi-Z pyramid bit for bit at odd, tiny and very wide sizes, the cull +
 // grid test + compaction on random scenes (exact grid result, conservative against brute force,
 // error within the bound of docs/OCCLUSION.md), monotone fading, overflow, zero lights, errors.
@@ -13,11 +13,11 @@
 #include <set>
 
 #include "core/barriers.h"
-#include "core/transfer.h"
-#include "light_cull_params.h"
 #include "reference/occlusion_reference.h"
 #include "support/flare_scene.h"
 #include "support/gpu_test.h"
+#include "support/transfer.h"
+#include "visibility/shaders/light_cull_params.h"
 
 namespace glint::test {
 namespace {

@@ -1,4 +1,4 @@
-// Tests of the float64 bloom reference (host/reference/bloom_reference.h) on its own: CPU only,
+// Tests of the float64 bloom reference (tools/reference/bloom_reference.h) on its own: CPU only,
 // no Vulkan. Hand-computed values check the formulas of docs/BLOOM.md stage by stage; property
 // tests (uniformity, symmetry, monotonicity, locality) check the assembled pipeline on random
 // inputs from generators started at fixed values.

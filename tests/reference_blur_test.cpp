@@ -1,4 +1,4 @@
-// Tests of the float64 blur reference (host/reference/blur_reference.h) on its own: CPU only, no
+// Tests of the float64 blur reference (tools/reference/blur_reference.h) on its own: CPU only, no
 // Vulkan. Properties of docs/BLUR.md (conservation, constants, symmetry, measured sigma) on random
 // inputs from generators started at fixed values, a plain gather convolution against the reference's scatter order, and
 // the planner's modelled errors against errors measured with the reference.

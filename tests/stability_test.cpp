@@ -14,10 +14,10 @@
 
 #include "analysis/light_stats.h"
 #include "core/barriers.h"
-#include "core/transfer.h"
 #include "reference/blur_reference.h"
 #include "support/effects.h"
 #include "support/gpu_test.h"
+#include "support/transfer.h"
 
 namespace glint::test {
 namespace {

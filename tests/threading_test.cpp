@@ -13,8 +13,8 @@
 
 #include "core/context_state.h"
 #include "core/resources.h"
-#include "core/transfer.h"
 #include "support/gpu_test.h"
+#include "support/transfer.h"
 
 namespace glint::test {
 namespace {

@@ -1,7 +1,7 @@
 // Draws docs/STABILITY.md's pictures and prints its tables: the flicker of a moving sub-pixel
 // firefly per filter with and without the Karis guard, and the size of a point's bloom as a
 // fraction of the image width at 720p, 1080p and 2160p. The tests (tests/stability_test.cpp)
-// check the same numbers with the same code (host/analysis/light_stats.h).
+// check the same numbers with the same code (tools/analysis/light_stats.h).
 //
 //   build/bench/glint_stability_report [--out DIR]     (DIR default docs/stability)
 #include <glint/bloom.h>
@@ -16,9 +16,9 @@
 
 #include "analysis/light_stats.h"
 #include "core/resources.h"
-#include "core/transfer.h"
 #include "io/png_io.h"
-#include "tooling/environment.h"
+#include "support/environment.h"
+#include "support/transfer.h"
 
 namespace glint {
 namespace {

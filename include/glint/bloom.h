@@ -1,6 +1,6 @@
 // HDR bloom: soft-knee bright-pass, mip-pyramid downsample, upsample with accumulation by gather,
 // composite. All compute. The exact algorithm (taps, edge rules, mapping between levels) is in
-// docs/BLOOM.md; host/reference/bloom_reference.h implements it in float64.
+// docs/BLOOM.md; tools/reference/bloom_reference.h implements it in float64.
 #pragma once
 
 #include <glint/glint.h>

@@ -1,6 +1,6 @@
 // The blur family: a three-level cumulative blur pyramid whose levels are
 // handed to the caller's shaders, and a Gaussian blur of any sigma with a choice of methods.
-// The exact algorithms are in docs/BLUR.md; host/reference/blur_reference.h implements them in
+// The exact algorithms are in docs/BLUR.md; tools/reference/blur_reference.h implements them in
 // float64.
 #pragma once
 

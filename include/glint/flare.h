@@ -4,7 +4,7 @@
 // gives the same image within a stated tolerance. The visibility half (Hi-Z, cull, occlusion,
 // compaction) writes the two buffers this class reads: GlintFlareInstance[] and GlintFlareIndirect
 // (<glint/gpu/flare_types.h>, installed). docs/FLARE.md describes the look, the atlas and the tolerance;
-// host/reference/flare_reference.h is the float64 twin.
+// tools/reference/flare_reference.h is the float64 twin.
 #pragma once
 
 #include <glint/glint.h>

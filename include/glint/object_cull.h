@@ -1,7 +1,7 @@
 // Occlusion culling of caller objects on the GPU (docs/OCCLUSION.md, "Object culling"), the way
 // GPU-driven renderers cull draws (Haar & Aaltonen, SIGGRAPH 2015; Wihlidal, GDC 2016;
 // zeux/niagara): every object is a world-space bounding sphere or box (GlintCullObject,
-// kernels/common/object_cull.h); the culler tests it against the frustum and against the Hi-Z
+// include/glint/gpu/object_cull.h); the culler tests it against the frustum and against the Hi-Z
 // pyramid (HiZPyramid, glint/occlusion.h) at the level where its screen rectangle covers at most
 // 2x2 texels, writes its state to a persistent visibility buffer, and compacts the payloads of the
 // emitted objects, in object order, into a list with a draw count and dispatch arguments. Every

@@ -3,7 +3,7 @@
 // frustum, tests their occlusion on an N x N grid read from the pyramid, and compacts the visible
 // ones, in increasing light index (so every run gives the same order), into an instance buffer for an indirect draw or
 // dispatch. docs/OCCLUSION.md derives the fold rule, the level choice, the error bound and the
-// compaction; host/reference/occlusion_reference.h holds the float64 references.
+// compaction; tools/reference/occlusion_reference.h holds the float64 references.
 //
 // Conventions (Vulkan): clip = view_proj * (position, 1); ndc = clip.xyz / clip.w;
 // pixel = (ndc.xy * 0.5 + 0.5) * depth size, so ndc.y = -1 is the first row; depth = ndc.z in

@@ -7,7 +7,7 @@
 #include <map>
 #include <utility>
 
-#include "bloom_params.h"
+#include "bloom/shaders/bloom_params.h"
 #include "core/barriers.h"
 #include "core/check.h"
 #include "core/context_state.h"
@@ -22,7 +22,7 @@ using detail::check_range;
 using detail::concat;
 
 // The GLSL push-constant block must match byte for byte (CONTRIBUTING.md, "Shared structs").
-static_assert(sizeof(BloomPush) == 48, "BloomPush layout changed: update kernels/common/bloom_params.h users");
+static_assert(sizeof(BloomPush) == 48, "BloomPush layout changed: update src/bloom/shaders/bloom_params.h users");
 static_assert(offsetof(BloomPush, threshold) == 16);
 static_assert(offsetof(BloomPush, composite_scale) == 32);
 static_assert(offsetof(BloomPush, flags) == 36);
@@ -135,8 +135,8 @@ constexpr VkAccessFlags2 kSampled = VK_ACCESS_2_SHADER_SAMPLED_READ_BIT;
 constexpr VkAccessFlags2 kStorageWrite = VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT;
 constexpr VkAccessFlags2 kStorageRead = VK_ACCESS_2_SHADER_STORAGE_READ_BIT;
 
-// Shared memory the tiled kernels declare for a workgroup (kernels/common/bloom_down_tiled.glsl,
-// bloom_up_tiled.glsl and kernels/bloom_prefilter_smooth.comp): vec4 windows of the source.
+// Shared memory the tiled kernels declare for a workgroup (src/bloom/shaders/bloom_down_tiled.glsl,
+// bloom_up_tiled.glsl and src/bloom/shaders/bloom_prefilter_smooth.comp): vec4 windows of the source.
 uint32_t bloom_shared_bytes(detail::Workgroup2D g) {
   const uint32_t down = ((2 * g.x + 4) * (2 * g.y + 4) + (2 * g.x + 3) * (2 * g.y + 3)) * 16;
   const uint32_t up = ((g.x + 10) * (g.y + 10) + g.x * (g.y + 10)) * 16;

@@ -11,8 +11,8 @@
 #include <string>
 #include <utility>
 
-#include "blur_params.h"
-#include "blur_plan.h"
+#include "blur/blur_plan.h"
+#include "blur/shaders/blur_params.h"
 #include "core/barriers.h"
 #include "core/check.h"
 #include "core/context_state.h"
@@ -26,7 +26,7 @@ namespace glint {
 using detail::check_range;
 using detail::concat;
 
-static_assert(sizeof(BlurPush) == 96, "BlurPush layout changed: update kernels/common/blur_params.h users");
+static_assert(sizeof(BlurPush) == 96, "BlurPush layout changed: update src/blur/shaders/blur_params.h users");
 static_assert(offsetof(BlurPush, max_value) == 16);
 static_assert(offsetof(BlurPush, tap_count) == 28);
 static_assert(offsetof(BlurPush, weights) == 32);
@@ -101,7 +101,7 @@ struct FusedShape {
   uint32_t rows = 1;
 };
 
-// Shared memory of kernels/blur_level.comp: the loaded tile + apron and the horizontal pass's
+// Shared memory of src/blur/shaders/blur_level.comp: the loaded tile + apron and the horizontal pass's
 // rows, 16 bytes a texel (8 packed as fp16).
 uint32_t fused_shared_bytes(FusedShape s, uint32_t radius, bool half_shared) {
   const uint32_t w = s.workgroup.x, h = s.workgroup.y * s.rows;

@@ -9,7 +9,7 @@
 // are not exact halves (odd sizes) differ from the model only by the small phase-dependent
 // differences of the area filter; the image size limits the level count k (the level must be at
 // least 1x1 without the max(1, .) of half()).
-#include "blur_plan.h"
+#include "blur/blur_plan.h"
 
 #include <algorithm>
 #include <cmath>
@@ -735,7 +735,7 @@ Plan auto_with(double sigma_px, uint32_t width, uint32_t height, double max_rela
 
 double store_unit(uint32_t mantissa_bits) { return mantissa_bits >= 23 ? 0.0 : std::ldexp(1.0, -int(mantissa_bits)); }
 
-// docs/BLUR.md "Error model": the stores and multiply-adds on each method's path (host/blur.cpp
+// docs/BLUR.md "Error model": the stores and multiply-adds on each method's path (src/blur/blur.cpp
 // GaussianBlur::Impl::make() records the same steps).
 double rounding_bound(const Plan& plan, const Storage& st) {
   const double half = store_unit(10);

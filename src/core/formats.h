@@ -23,7 +23,7 @@ bool is_float_color(VkFormat format);
 const char* float_color_formats();
 
 /// The kernel variant whose GLSL image format qualifier matches `format` ("rgba16f", "rgba32f",
-/// "r11f_g11f_b10f"; kernels/CMakeLists.txt compiles the image-writing kernels once per variant),
+/// "r11f_g11f_b10f"; each effect.cmake compiles its image-writing kernels once per variant),
 /// or null when glint compiles no qualifier for it (written through the "noformat" variant).
 const char* qualified_variant(VkFormat format);
 

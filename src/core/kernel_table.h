@@ -1,4 +1,6 @@
-// The SPIR-V of every kernel variant, embedded at build time (kernels/CMakeLists.txt).
+// The SPIR-V of every kernel variant of the library, embedded at build time (glint_add_kernels in
+// cmake/GlintKernels.cmake). The tools embed their own kernels in a second table of the same form
+// (tools/support/tool_kernels.h).
 #pragma once
 
 #include <cstddef>
@@ -12,7 +14,7 @@ struct KernelBinary {
   size_t size_bytes;
 };
 
-/// The embedded kernel with this id, or null.
+/// The library's embedded kernel with this id, or null.
 const KernelBinary* find_kernel(const char* id);
 
 }  // namespace glint::detail

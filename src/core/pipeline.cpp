@@ -89,7 +89,7 @@ ComputePipeline::ComputePipeline(const Context& context, const PipelineDesc& des
   push_bytes_ = desc.push_constant_bytes;
   workgroup_ = desc.workgroup;
   bindings_ = desc.bindings;
-  const KernelBinary* bin = find_kernel(desc.kernel_id.c_str());
+  const KernelBinary* bin = desc.binary ? desc.binary : find_kernel(desc.kernel_id.c_str());
   if (!bin)
     throw Error(ErrorCode::vulkan_failure, concat("kernel '", desc.kernel_id, "' is not embedded in this build"));
   // Everything that makes the compiled objects differ is in the key.

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/check.h"
+#include "core/kernel_table.h"
 
 namespace glint::detail {
 
@@ -23,6 +24,11 @@ struct PipelineDesc {
   uint32_t push_constant_bytes = 0;
   Workgroup2D workgroup;                 //!< constant_id 0 and 1 (local_size_x_id/y_id)
   std::vector<uint32_t> specialization;  //!< constant_id 2, 3, ...
+  /// The SPIR-V to compile when it is not the library's: a kernel of another table, such as the
+  /// tools' (tools/support/tool_kernels.h); kernel_id still names it in errors and in the
+  /// context's pipeline cache, so the ids of all tables are distinct. Null: the library's kernel
+  /// named kernel_id.
+  const KernelBinary* binary = nullptr;
 };
 
 /// The Vulkan objects of one compiled kernel variant. Owned by the context (ContextState::pipelines),

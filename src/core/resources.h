@@ -87,7 +87,7 @@ inline bool is_float_rgba(VkFormat format) {
 }
 
 /// The kernel-variant suffix of an intermediate storage format ("rgba32f" or "rgba16f";
-/// kernels/CMakeLists.txt compiles each image-writing kernel once per storage format). Caller
+/// each effect.cmake compiles its image-writing kernels once per storage format). Caller
 /// outputs pick theirs with check_color_write() (core/formats.h).
 inline const char* format_variant(VkFormat format) {
   return format == VK_FORMAT_R32G32B32A32_SFLOAT ? "rgba32f" : "rgba16f";

@@ -20,7 +20,7 @@
 #include "core/kernel_table.h"
 #include "core/pipeline.h"
 #include "core/resources.h"
-#include "flare_params.h"
+#include "flare/shaders/flare_params.h"
 
 namespace glint {
 
@@ -29,7 +29,7 @@ using detail::concat;
 
 static_assert(sizeof(GlintFlareGatherArgsPush) == 12);
 static_assert(sizeof(GlintFlarePush) == 84,
-              "GlintFlarePush layout changed: update kernels/common/flare_params.h users");
+              "GlintFlarePush layout changed: update src/flare/shaders/flare_params.h users");
 static_assert(offsetof(GlintFlarePush, ghost_pos0) == 52);
 static_assert(offsetof(GlintFlarePush, tile_w) == 72);
 static_assert(offsetof(GlintFlarePush, indirect_word) == 80);

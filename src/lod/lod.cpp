@@ -8,7 +8,7 @@
 #include "core/barriers.h"
 #include "core/check.h"
 #include "core/pipeline.h"
-#include "lod_math.h"
+#include "lod/lod_math.h"
 
 namespace glint {
 
@@ -22,7 +22,7 @@ static_assert(sizeof(GlintLodAtlas) == 32);
 
 namespace {
 
-struct LodPush {  // kernels/lod_batch.comp and lod_probe.comp push constants
+struct LodPush {  // src/lod/shaders/lod_batch.comp and lod_probe.comp push constants
   GlintLodAtlas atlas;
   uint32_t count;
 };

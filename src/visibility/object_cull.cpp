@@ -15,7 +15,7 @@
 #include "core/context_state.h"
 #include "core/pipeline.h"
 #include "core/resources.h"
-#include "object_cull_params.h"
+#include "visibility/shaders/object_cull_params.h"
 
 namespace glint {
 

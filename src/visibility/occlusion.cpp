@@ -16,7 +16,7 @@
 #include "core/formats.h"
 #include "core/pipeline.h"
 #include "core/resources.h"
-#include "light_cull_params.h"  // push constants and buffer layouts shared with the kernels
+#include "visibility/shaders/light_cull_params.h"  // push constants and buffer layouts shared with the kernels
 
 namespace glint {
 

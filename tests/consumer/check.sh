@@ -4,7 +4,9 @@
 # installs BUILD_DIR into a temporary prefix, then
 #   1. checks that the installed libraries reference no getenv (the library reads no environment;
 #      options go through ContextOptions), after proving the check finds the getenv of the tools'
-#      library, which does read GLINT_* variables;
+#      library, which does read GLINT_* variables; and that they hold none of the tools' code
+#      (demo scene and kernel, references, io, analysis, CLI), after proving that check on the
+#      tools' libraries;
 #   2. builds tests/consumer against the prefix with find_package(glint): the embedding example
 #      and a compile of every installed header on its own (C++ and GLSL);
 #   3. builds the example again with only `pkg-config --cflags --libs glint`;
@@ -33,6 +35,30 @@ fi
 found="$(getenv_symbols "$libdir"/libglint*.a)"
 [[ -z "$found" ]] || { printf '%s\n' "$found" >&2; die "the installed library references getenv"; }
 say "installed libraries reference no getenv"
+
+# 1b. Nothing of the tools in what an engine links: no symbol (defined or referenced) of the demo
+# scene and its starfield kernel, the float64 references, file io (EXR, PNG, JSON, CSV), the light
+# statistics or the CLI, and no demo kernel id in the kernel table. The patterns are proven on the
+# tools' libraries first, which hold each of them.
+tool_symbols() {
+  nm -A -C "$@" 2>/dev/null | grep -E 'glint::(demo|reference|io|analysis|cli|tools)::|[Ss]tarfield|Imf_[0-9_]*::|png_[a-z]|nlohmann::|lod_csv|lights_json'
+  grep -l -a 'demo_starfield' "$@" 2>/dev/null | sed 's/$/: holds the string demo_starfield/'
+}
+tools_kernels="$(find "$build" -name libglint_tools_kernels.a -print -quit)"
+if [[ -n "$tools" ]]; then
+  in_tools="$(tool_symbols "$tools" || true)"
+  for pattern in 'glint::demo::' 'glint::reference::' 'glint::io::' 'glint::analysis::' 'Imf_' 'png_' 'nlohmann::' \
+                 'lod_csv' 'lights_json'; do
+    grep -q -F -- "$pattern" <<<"$in_tools" ||
+      die "the tools check finds no $pattern in $tools, which holds it: the check is broken"
+  done
+  [[ -n "$tools_kernels" ]] || die "no libglint_tools_kernels.a in $build"
+  [[ "$(tool_symbols "$tools_kernels" | grep -c starfield || true)" -ge 2 ]] ||
+    die "the tools check finds no starfield kernel in $tools_kernels: the check is broken"
+fi
+found="$(tool_symbols "$libdir"/libglint*.a)" || true
+[[ -z "$found" ]] || { printf '%s\n' "$found" | head -n 40 >&2; die "the installed library holds tools' code (demo, references, io, CLI)"; }
+say "installed libraries hold no demo, reference, io or CLI code"
 
 # 2. find_package(glint): the example, and every installed header alone.
 cmake -S "$here" -B "$tmp/build" -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH="$tmp/prefix" \

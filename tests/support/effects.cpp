@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "bloom_params.h"
+#include "bloom/shaders/bloom_params.h"
 #include "reference/blur_reference.h"
 #include "support/gpu_test.h"
 

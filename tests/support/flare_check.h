@@ -1,6 +1,6 @@
 // Checks shared by the flare tests (flare_test.cpp, flare_robustness_test.cpp): the element atlas
 // as the GPU made it, the device's filtering precision, and the comparison of a drawn image with
-// the float64 composite (host/reference/flare_reference.h) within docs/FLARE.md's tolerance.
+// the float64 composite (tools/reference/flare_reference.h) within docs/FLARE.md's tolerance.
 #pragma once
 
 #include <glint/flare.h>

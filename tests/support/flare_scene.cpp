@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <cstring>
 
-#include "core/transfer.h"
 #include "support/gpu_test.h"
+#include "support/transfer.h"
 
 namespace glint::test {
 

@@ -8,7 +8,7 @@
 
 #include "core/cpu_image.h"
 #include "core/resources.h"
-#include "core/transfer.h"
+#include "support/transfer.h"
 
 namespace glint::test {
 

@@ -8,10 +8,10 @@
 
 #include "cli/commands.h"
 #include "core/resources.h"
-#include "core/transfer.h"
 #include "io/atomic_outputs.h"
 #include "io/exr_io.h"
 #include "io/png_io.h"
+#include "support/transfer.h"
 
 namespace glint::cli {
 namespace {

@@ -11,9 +11,9 @@
 
 #include "cli/commands.h"
 #include "core/resources.h"
-#include "core/transfer.h"
 #include "io/atomic_outputs.h"
 #include "io/exr_io.h"
+#include "support/transfer.h"
 
 namespace glint::cli {
 namespace {

@@ -7,9 +7,9 @@
 
 #include "cli/commands.h"
 #include "core/resources.h"
-#include "core/transfer.h"
 #include "io/exr_io.h"
-#include "tooling/environment.h"
+#include "support/environment.h"
+#include "support/transfer.h"
 
 namespace glint::cli {
 

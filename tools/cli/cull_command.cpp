@@ -26,9 +26,9 @@
 #include "cli/commands.h"
 #include "core/barriers.h"
 #include "core/resources.h"
-#include "core/transfer.h"
 #include "glint/gpu/object_cull.h"
 #include "io/atomic_outputs.h"
+#include "support/transfer.h"
 
 namespace glint::cli {
 namespace {

@@ -1,4 +1,4 @@
-// glint demo: the built-in scene (host/demo_scene.h: a GPU-generated HDR starfield and sun, and a
+// glint demo: the built-in scene (tools/demo/demo_scene.h: a GPU-generated HDR starfield and sun, and a
 // depth buffer with occluders and lights in front of and behind them), then lens flares (Hi-Z,
 // cull, raster draw: LensFlarePass), then the default bloom, then the PNG tonemap; every stage in
 // one command buffer, timed with GPU timestamps. Writes scene.exr, depth.exr (float Z),
@@ -18,13 +18,13 @@
 #include "core/barriers.h"
 #include "core/half.h"
 #include "core/resources.h"
-#include "core/transfer.h"
-#include "demo_scene.h"
+#include "demo/demo_scene.h"
 #include "io/atomic_outputs.h"
 #include "io/exr_io.h"
 #include "io/lights_json.h"
 #include "io/png_io.h"
-#include "tooling/host_memory.h"
+#include "support/host_memory.h"
+#include "support/transfer.h"
 
 namespace glint::cli {
 namespace {

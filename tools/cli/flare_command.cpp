@@ -20,10 +20,10 @@
 #include "cli/commands.h"
 #include "core/barriers.h"
 #include "core/resources.h"
-#include "core/transfer.h"
 #include "io/atomic_outputs.h"
 #include "io/exr_io.h"
 #include "io/lights_json.h"
+#include "support/transfer.h"
 
 namespace glint::cli {
 namespace {

@@ -1,6 +1,6 @@
 // glint lod: evaluates atlas-aware LOD queries from a CSV file on the GPU (LodBatch) and writes
 // them back with a `lod` column. The input format, its optional header and its bounds are those of
-// io::parse_lod_csv() (host/io/lod_csv.h, docs/LOD.md): every data row is either evaluated or
+// io::parse_lod_csv() (tools/io/lod_csv.h, docs/LOD.md): every data row is either evaluated or
 // rejected with its line number, never dropped.
 #include <glint/lod.h>
 

@@ -1,4 +1,4 @@
-#include "demo_scene.h"
+#include "demo/demo_scene.h"
 
 #include <algorithm>
 #include <cmath>
@@ -9,7 +9,8 @@
 #include "core/check.h"
 #include "core/context_state.h"
 #include "core/pipeline.h"
-#include "demo_params.h"
+#include "demo/shaders/demo_params.h"
+#include "support/tool_kernels.h"
 
 namespace glint::demo {
 
@@ -30,6 +31,10 @@ DemoPipelines& pipelines_for(const Context& context, VkFormat format) {
     auto dp = std::make_shared<DemoPipelines>();
     detail::PipelineDesc d;
     d.kernel_id = fp32 ? "demo_starfield_rgba32f" : "demo_starfield_rgba16f";
+    d.binary = tools::find_kernel(d.kernel_id.c_str());
+    if (!d.binary) {
+      throw Error(ErrorCode::vulkan_failure, detail::concat("kernel '", d.kernel_id, "' is not embedded in the tools"));
+    }
     d.bindings = {VK_DESCRIPTOR_TYPE_STORAGE_IMAGE};
     d.push_constant_bytes = sizeof(StarfieldPush);
     d.workgroup = detail::choose_workgroup_2d(context);

@@ -1,5 +1,5 @@
 // The built-in demo scene: an HDR starfield and sun generated on the GPU
-// (kernels/demo_starfield.comp), and for the lens flares a depth buffer with occluders
+// (tools/demo/shaders/demo_starfield.comp), and for the lens flares a depth buffer with occluders
 // and a light list in front of and behind them, generated on the CPU (make_flare_scene).
 #pragma once
 

@@ -1,6 +1,6 @@
 // LIGHTS.json, the light list of `glint flare`: a view-projection matrix and a
-// list of lights, parsed strictly into the GPU's GlintFlareLight layout (kernels/common/
-// flare_types.h). The parser is a pure function of the text (no file, no Vulkan), so that a fuzz
+// list of lights, parsed strictly into the GPU's GlintFlareLight layout (include/glint/
+// gpu/flare_types.h). The parser is a pure function of the text (no file, no Vulkan), so that a fuzz
 // target can call it directly.
 //
 // Format (every key below; no other key is accepted, so a typo is an error, not a silent default):

@@ -148,7 +148,7 @@ LodCsv parse_lod_csv(std::string_view text, uint32_t atlas_width, uint32_t atlas
       *out[i] = static_cast<float>(v[i]);
     }
     // The tile: at least 1x1 texel and inside the atlas, tested in float as the kernel tests it
-    // (kernels/common/lod_impl.h, glint_lod_valid), so that every accepted row is a valid query.
+    // (include/glint/gpu/lod_impl.h, glint_lod_valid), so that every accepted row is a valid query.
     const auto check = [&](size_t i, float value, bool ok, const std::string& accepted) {
       if (!ok) bad_line(line_no, field_name(i) + " = " + number_text(value) + " is out of range; accepted " + accepted);
     };

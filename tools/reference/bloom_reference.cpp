@@ -100,7 +100,7 @@ void validate(const CpuImage& input, const BloomConfig& config) {
 
 // ---------------------------------------------------------------------------------------------
 // Mip chain (docs/BLOOM.md "Mip chain"). An own copy on purpose: the reference must not share
-// code with the driver it checks (bloom_mip_chain in host/bloom.cpp).
+// code with the driver it checks (bloom_mip_chain in src/bloom/bloom.cpp).
 
 // level0_height > 0: "halve (floor) while half the height is still above the target; then one
 // step to the target height H0 = min(level0_height, input height), width round(W * H0 / H) kept

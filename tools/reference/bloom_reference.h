@@ -1,5 +1,5 @@
 // Float64 CPU reference of glint's bloom. It implements docs/BLOOM.md step by step (the same
-// contract as kernels/bloom_*.comp and kernels/common/bloom.glsl), with plain loops and no
+// contract as src/bloom/shaders/bloom_*.comp and src/bloom/shaders/bloom.glsl), with plain loops and no
 // shortcuts, so that GPU tests can measure how far the kernels are from the exact algorithm.
 // CPU only: no Vulkan call is made here.
 #pragma once

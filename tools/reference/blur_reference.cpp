@@ -277,7 +277,7 @@ DoubleImage sanitize(const CpuImage& input, double max_value) {
   return out;
 }
 
-// docs/BLUR.md "Area downsample". In integer units of 1/wd (as kernels/common/blur.glsl): texel x
+// docs/BLUR.md "Area downsample". In integer units of 1/wd (as src/blur/shaders/blur.glsl): texel x
 // covers [x ws, (x+1) ws), source texel i covers [i wd, (i+1) wd); the overlap over ws is the weight.
 DoubleImage area_downsample(const DoubleImage& src, uint32_t wd, uint32_t hd) {
   if (wd == 0 || hd == 0 || wd > src.width || hd > src.height)

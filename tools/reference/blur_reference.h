@@ -1,5 +1,5 @@
 // Float64 CPU reference of glint's blur family. It implements docs/BLUR.md step by step (the same
-// contract as kernels/blur_*.comp and kernels/common/blur.glsl): what each kernel computes, and the
+// contract as src/blur/shaders/blur_*.comp and src/blur/shaders/blur.glsl): what each kernel computes, and the
 // exact Gaussian the methods are measured against. All four channels are filtered. CPU only: no
 // Vulkan call is made here.
 //
@@ -12,7 +12,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "blur_plan.h"
+#include "blur/blur_plan.h"
 #include "core/cpu_image.h"
 #include "reference/bloom_reference.h"  // DoubleImage
 

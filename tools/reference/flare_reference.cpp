@@ -6,7 +6,7 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "flare_params.h"
+#include "flare/shaders/flare_params.h"
 #include "reference/lod_reference.h"
 
 namespace glint::reference {

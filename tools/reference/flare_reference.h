@@ -1,7 +1,7 @@
 // Float64 CPU reference of glint's lens flares (the drawing half, docs/FLARE.md): the element
 // atlas (every level) and the composite of instances into an image, written from docs/FLARE.md
-// independently of the GLSL (kernels/common/flare_elements.glsl, flare_look.glsl), sharing only
-// the constants of kernels/common/flare_params.h. The sampler is modelled as the Vulkan
+// independently of the GLSL (src/flare/shaders/flare_elements.glsl, flare_look.glsl), sharing only
+// the constants of src/flare/shaders/flare_params.h. The sampler is modelled as the Vulkan
 // specification's bilinear + linear-mipmap filter with exact weights; every sample also returns a
 // bound on how far a conformant device may be from it (docs/FLARE.md "Tolerance"). CPU only.
 #pragma once

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <limits>
 
-#include "object_cull_params.h"  // the kernel's rounding margin and window limit, shared with the reference
+#include "visibility/shaders/object_cull_params.h"  // the kernel's rounding margin and window limit, shared with the reference
 
 namespace glint::reference {
 

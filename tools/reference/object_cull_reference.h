@@ -1,5 +1,5 @@
 // Float64 reference of the object cull (include/glint/object_cull.h, docs/OCCLUSION.md "Object
-// culling"), written from the documented rules, independently of kernels/object_cull.comp:
+// culling"), written from the documented rules, independently of src/visibility/shaders/object_cull.comp:
 // - state(): the cull's decision procedure in double with the fp32 rounding margins scaled by a
 //   factor: 1 is what the GPU is designed to compute; the GPU's margins exceed its fp32 error by at
 //   least 2x, so its effective factor lies in [0.5, 1.5], and since every margin only moves a

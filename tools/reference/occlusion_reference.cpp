@@ -5,7 +5,7 @@
 #include <random>
 #include <stdexcept>
 
-#include "light_cull_params.h"
+#include "visibility/shaders/light_cull_params.h"
 
 namespace glint::reference {
 

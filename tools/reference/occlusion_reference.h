@@ -1,5 +1,6 @@
 // Float64 CPU references of the lens-flare visibility stage (docs/OCCLUSION.md), written
-// from the documented rules, independently of kernels/hiz_build.comp and kernels/light_cull.comp:
+// from the documented rules, independently of src/visibility/shaders/hiz_build.comp and
+// src/visibility/shaders/light_cull.comp:
 // - the Hi-Z pyramid, each texel computed directly as the farthest of the source pixels it covers
 //   ([c * 2^k, (c + 1) * 2^k), the last texel of a row or column up to the edge), not by the
 //   kernel's level-by-level fold;

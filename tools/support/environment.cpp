@@ -1,4 +1,4 @@
-#include "tooling/environment.h"
+#include "support/environment.h"
 
 #include <cstdio>
 #include <cstdlib>

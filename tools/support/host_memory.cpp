@@ -1,4 +1,4 @@
-#include "tooling/host_memory.h"
+#include "support/host_memory.h"
 
 #include <glint/glint.h>
 #include <unistd.h>

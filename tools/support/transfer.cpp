@@ -1,4 +1,4 @@
-#include "core/transfer.h"
+#include "support/transfer.h"
 
 #include <algorithm>
 #include <cmath>

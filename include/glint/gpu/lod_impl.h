@@ -54,7 +54,7 @@ GLINT_LOD_FN float glint_lod_rho_y(GlintLodQuery q) {
 
 // Not NaN, not +-Inf, tested on the bits: the exponent field is all ones only for those. Written as
 // a float test (x == x && x - x == 0), a compiler that assumes floats are finite folds it to true
-// (lavapipe did in a flare shader). floatBitsToUint is GLSL's; host/lod_math.h supplies it for C++.
+// (lavapipe did in a flare shader). floatBitsToUint is GLSL's; src/lod/lod_math.h supplies it for C++.
 GLINT_LOD_FN bool glint_lod_finite(float x) { return (floatBitsToUint(x) & 0x7f800000u) != 0x7f800000u; }
 
 // Valid tile and atlas: finite numbers, a tile of at least 1x1 inside the atlas, levels >= 1.

@@ -2,7 +2,7 @@
 // docs/OCCLUSION.md "Object culling"): the caller's object records, the per-object states, the
 // indirect arguments and the statistics. Installed with the library: C++ includes
 // <glint/gpu/object_cull.h>, GLSL "glint/gpu/object_cull.h"; the C++ side static_asserts the
-// layouts (host/object_cull.cpp).
+// layouts (src/visibility/object_cull.cpp).
 #ifndef GLINT_GPU_OBJECT_CULL_H
 #define GLINT_GPU_OBJECT_CULL_H
 #include "types.h"

@@ -93,7 +93,7 @@ float area_overlap(float lo, float hi, int i) { return min(float(i + 1), hi) - m
 
 // The filter's downsample of `src` to destination texel xy of a dst_size image (docs/BLOOM.md
 // "Downsample"): gauss9's area average, dual's 5 bilinear taps, or cod13's 13 (Jimenez 2014).
-// kernels/bloom_prefilter_smooth.comp repeats this arithmetic, expression for expression, on a
+// src/bloom/shaders/bloom_prefilter_smooth.comp repeats this arithmetic, expression for expression, on a
 // source held in shared memory: keep the two the same.
 vec3 downsample(texture2D src, BloomSource s, ivec2 xy, ivec2 dst_size, bool karis) {
   vec3 sum = vec3(0.0);

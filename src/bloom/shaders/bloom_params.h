@@ -1,4 +1,4 @@
-// Push constants of every bloom kernel (kernels/bloom_*.comp), shared with host/bloom.cpp.
+// Push constants of every bloom kernel (src/bloom/shaders/bloom_*.comp), shared with src/bloom/bloom.cpp.
 #ifndef GLINT_BLOOM_PARAMS_H
 #define GLINT_BLOOM_PARAMS_H
 #include "glint/gpu/types.h"

@@ -3,7 +3,7 @@
 #extension GL_EXT_samplerless_texture_functions : require
 // Bright-pass fused into the first downsample: full-resolution scene -> pyramid level 0.
 // Implements docs/BLOOM.md "Prefilter" (the soft knee) and "Downsample" with the per-box
-// Karis guard (Jimenez 2014) or none; kernels/bloom_prefilter_smooth.comp does karis_smooth. Fusing saves writing and re-reading a full-resolution bright-pass image.
+// Karis guard (Jimenez 2014) or none; src/bloom/shaders/bloom_prefilter_smooth.comp does karis_smooth. Fusing saves writing and re-reading a full-resolution bright-pass image.
 layout(local_size_x_id = 0, local_size_y_id = 1) in;
 
 layout(binding = 0) uniform texture2D scene;

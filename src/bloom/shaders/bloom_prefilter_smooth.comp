@@ -97,7 +97,7 @@ vec3 downsample_from_window(ivec2 xy, ivec2 dst_size, ivec2 src_size, ivec2 wind
   return sum / wsum;
 }
 
-// The exact 2:1 case (both sides even, the common one), as kernels/common/bloom_down_tiled.glsl
+// The exact 2:1 case (both sides even, the common one), as src/bloom/shaders/bloom_down_tiled.glsl
 // does it: every bilinear tap of cod13 and dual sits on a corner of four texels, so it is the mean
 // of that 2x2 box; the box means at every corner of the window are formed once, into s_rows (free
 // after the vertical pass), and each invocation reads its 13 (cod13) or 5 (dual) boxes

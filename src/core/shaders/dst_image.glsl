@@ -1,5 +1,5 @@
-// The binding layout of the image a kernel writes for the caller. The variants of
-// kernels/CMakeLists.txt define DST_FORMAT as the GLSL format qualifier matching the view's format
+// The binding layout of the image a kernel writes for the caller. The variants listed in
+// each effect's effect.cmake define DST_FORMAT as the GLSL format qualifier matching the view's format
 // (rgba16f, rgba32f, r11f_g11f_b10f): the compatibility table of the Vulkan spec ("Compatibility
 // Between SPIR-V Image Formats and Vulkan Formats") requires an exact match. The "noformat"
 // variant defines none: the image has format Unknown, which Vulkan 1.3 lets a kernel write where

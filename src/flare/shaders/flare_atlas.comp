@@ -2,7 +2,7 @@
 #extension GL_GOOGLE_include_directive : require
 // Builds the lens-flare element atlas (docs/FLARE.md, "Atlas layout, mips, LOD and padding": generated
 // procedurally by a compute shader at start-up). Level 0: every texel inside a tile evaluates its
-// element (kernels/common/flare_elements.glsl), every other texel (padding, unused space) is 0.
+// element (src/flare/shaders/flare_elements.glsl), every other texel (padding, unused space) is 0.
 // Level k > 0: the 2x2 box average of level k - 1 (tile offsets and sizes are multiples of 16, so
 // no box straddles two tiles). One dispatch per level, with a barrier in between.
 layout(local_size_x_id = 0, local_size_y_id = 1) in;

@@ -4,7 +4,7 @@
 // aperture ghost with a brighter rim. Every element is multiplied by a window that is 0 at the
 // tile border, so the padding (zeros) is each tile's own edge value. Only exp, smoothstep, sqrt and
 // products are used (no atan, no pow: Vulkan allows atan 4096 ulp, which would move thin spikes);
-// host/reference/flare_reference.cpp evaluates the same formulas in float64.
+// tools/reference/flare_reference.cpp evaluates the same formulas in float64.
 #include "glint/gpu/flare_types.h"
 
 float glint_flare_window(float r) {  // (1 - r^2)^2 inside the unit disc, 0 outside

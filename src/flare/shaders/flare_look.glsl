@@ -1,6 +1,6 @@
 // The look of one light's flare, shared by the raster path (flare.vert computes the sprites,
 // flare.frag shades them) and the compute gather (flare_gather.comp does both), so both paths
-// evaluate exactly the same function. docs/FLARE.md describes it; host/reference/flare_reference.cpp
+// evaluate exactly the same function. docs/FLARE.md describes it; tools/reference/flare_reference.cpp
 // is its float64 twin. `precise` keeps the compiler from contracting or reordering these
 // expressions differently in the vertex and compute stages.
 #include "glint/gpu/flare_types.h"

@@ -2,7 +2,7 @@
 // dispatches (object_cull.comp: frustum + Hi-Z test; object_cull_scan.comp: one-workgroup prefix
 // sum of the per-workgroup visibility masks, indirect arguments and statistics;
 // object_cull_scatter.comp: payloads into their slots in object order) and the group buffer.
-// Declared once for GLSL and C++; host/object_cull.cpp static_asserts the layouts.
+// Declared once for GLSL and C++; src/visibility/object_cull.cpp static_asserts the layouts.
 #ifndef GLINT_OBJECT_CULL_PARAMS_H
 #define GLINT_OBJECT_CULL_PARAMS_H
 #include "glint/gpu/object_cull.h"

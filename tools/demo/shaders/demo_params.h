@@ -1,4 +1,4 @@
-// Push constants of kernels/demo_starfield.comp, shared with host/demo_scene.cpp.
+// Push constants of tools/demo/shaders/demo_starfield.comp, shared with tools/demo/demo_scene.cpp.
 #ifndef GLINT_DEMO_PARAMS_H
 #define GLINT_DEMO_PARAMS_H
 #include "glint/gpu/types.h"
