@@ -6,7 +6,8 @@
 #                            the suite with ASan+UBSan (build-asan) and run ctest
 #                            [args] on lavapipe with validation (leak checking for the CPU-only
 #                            tests) and the CLI smoke test there; ctest's consumer_check installs into
-#                            a temporary prefix, checks the library for getenv, and builds and runs
+#                            a temporary prefix, checks the library for getenv and tools' code
+#                            (demo, references, io, CLI), and builds and runs
 #                            tests/consumer against it through find_package(glint) and pkg-config;
 #                            then each libFuzzer target for GLINT_FUZZ_SECONDS (default 10)
 #   ./glint.sh fuzz [seconds] build the libFuzzer targets (clang, build-fuzz) and run each one for
