@@ -2,10 +2,12 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <cstring>
 #include <memory>
 #include <random>
 
 #include "support/environment.h"
+#include "support/transfer.h"
 
 namespace glint::bench {
 
@@ -50,6 +52,37 @@ double median_of(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   const size_t n = v.size();
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+detail::OwnedBuffer device_buffer(const Context& ctx, const void* data, VkDeviceSize bytes, VkBufferUsageFlags usage) {
+  detail::OwnedBuffer buf(ctx, std::max<VkDeviceSize>(bytes, 16), usage | VK_BUFFER_USAGE_TRANSFER_DST_BIT, false);
+  if (data && bytes) {
+    detail::OwnedBuffer staging(ctx, bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, true);
+    std::memcpy(staging.mapped(), data, bytes);
+    staging.flush();
+    ctx.run_once([&](VkCommandBuffer cmd) {
+      VkBufferCopy region{0, 0, bytes};
+      vkCmdCopyBuffer(cmd, staging.buffer(), buf.buffer(), 1, &region);
+    });
+  }
+  return buf;
+}
+
+Buffer buffer_view(const detail::OwnedBuffer& b, VkBufferUsageFlags usage, bool after_copy) {
+  Buffer v{b.buffer(),      0, b.size(), usage | VK_BUFFER_USAGE_TRANSFER_DST_BIT, VK_PIPELINE_STAGE_2_NONE,
+           VK_ACCESS_2_NONE};
+  if (after_copy) {
+    v.stage = VK_PIPELINE_STAGE_2_COPY_BIT;
+    v.access = VK_ACCESS_2_TRANSFER_WRITE_BIT;
+  }
+  return v;
+}
+
+detail::OwnedImage depth_image(const Context& ctx, const reference::DepthImage& d) {
+  detail::OwnedImage img(ctx, {d.width, d.height}, VK_FORMAT_D32_SFLOAT,
+                         VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT);
+  detail::upload_r32(ctx, img.state, d.depth);
+  return img;
 }
 
 }  // namespace glint::bench

@@ -7,6 +7,8 @@
 #include <vector>
 
 #include "core/cpu_image.h"
+#include "core/resources.h"
+#include "reference/occlusion_reference.h"
 
 namespace glint::bench {
 
@@ -14,6 +16,16 @@ const Context& context();
 /// Random HDR RGBA: values in [0, 1.5) with 2% of pixels between 2 and 40.
 CpuImage random_hdr(uint32_t width, uint32_t height, uint32_t stream);
 double median_of(std::vector<double> values);
+
+/// A device-local buffer of max(bytes, 16) bytes with `usage` | TRANSFER_DST, holding `data` (copied
+/// through a staging buffer) when it is given.
+detail::OwnedBuffer device_buffer(const Context& context, const void* data, VkDeviceSize bytes,
+                                  VkBufferUsageFlags usage);
+/// `b` as a glint::Buffer of its whole size with `usage` | TRANSFER_DST, last used by the upload
+/// copy (after_copy) or not yet used.
+Buffer buffer_view(const detail::OwnedBuffer& b, VkBufferUsageFlags usage, bool after_copy);
+/// A sampled D32 depth image holding `depth`.
+detail::OwnedImage depth_image(const Context& context, const reference::DepthImage& depth);
 
 /// Records `frames` calls of `record_frame` in one command buffer with a timestamp after each, runs
 /// it, and returns the median GPU time of one frame in milliseconds. `profiler` needs frames + 1

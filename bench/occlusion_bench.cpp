@@ -29,13 +29,6 @@ int frames_for(const Context& ctx, uint64_t work) {
   return 16;
 }
 
-detail::OwnedImage make_depth(const Context& ctx, const reference::DepthImage& d) {
-  detail::OwnedImage img(ctx, {d.width, d.height}, VK_FORMAT_D32_SFLOAT,
-                         VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT);
-  detail::upload_r32(ctx, img.state, d.depth);
-  return img;
-}
-
 // A depth buffer of sloped boxes over the far plane (the same generator as the tests).
 reference::Scene scene_for(uint32_t w, uint32_t h, uint32_t lights, double max_size) {
   return reference::random_scene(w, h, lights, 2024, false, max_size);
@@ -46,7 +39,7 @@ void BM_HiZBuild(benchmark::State& state) {
   const auto h = static_cast<uint32_t>(state.range(1));
   const Context& ctx = context();
   const auto scene = scene_for(w, h, 0, 1);
-  auto depth = make_depth(ctx, scene.depth);
+  auto depth = depth_image(ctx, scene.depth);
   HiZConfig config;
   config.extent = {w, h};
   HiZPyramid hiz(ctx, config);
@@ -83,31 +76,6 @@ BENCHMARK(BM_HiZBuild)
     ->UseManualTime()
     ->Unit(benchmark::kMicrosecond);
 
-// Device-local copy of host data.
-detail::OwnedBuffer device_buffer(const Context& ctx, const void* data, VkDeviceSize bytes, VkBufferUsageFlags usage) {
-  detail::OwnedBuffer buf(ctx, std::max<VkDeviceSize>(bytes, 16), usage | VK_BUFFER_USAGE_TRANSFER_DST_BIT, false);
-  if (data && bytes) {
-    detail::OwnedBuffer staging(ctx, bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, true);
-    std::memcpy(staging.mapped(), data, bytes);
-    staging.flush();
-    ctx.run_once([&](VkCommandBuffer cmd) {
-      VkBufferCopy region{0, 0, bytes};
-      vkCmdCopyBuffer(cmd, staging.buffer(), buf.buffer(), 1, &region);
-    });
-  }
-  return buf;
-}
-
-Buffer view(const detail::OwnedBuffer& b, VkBufferUsageFlags usage, bool after_copy) {
-  Buffer v{b.buffer(),      0, b.size(), usage | VK_BUFFER_USAGE_TRANSFER_DST_BIT, VK_PIPELINE_STAGE_2_NONE,
-           VK_ACCESS_2_NONE};
-  if (after_copy) {
-    v.stage = VK_PIPELINE_STAGE_2_COPY_BIT;
-    v.access = VK_ACCESS_2_TRANSFER_WRITE_BIT;
-  }
-  return v;
-}
-
 // Args: lights, grid N, per-light results (0/1), and whether the Hi-Z build is timed with the
 // cull (0/1).
 void BM_LightCull(benchmark::State& state) {
@@ -119,7 +87,7 @@ void BM_LightCull(benchmark::State& state) {
   const uint32_t w = 1920, h = 1080;
   // Flares of 8 to 128 pixels (the default flare size is 100).
   const auto scene = scene_for(w, h, n, 128.0);
-  auto depth = make_depth(ctx, scene.depth);
+  auto depth = depth_image(ctx, scene.depth);
   HiZConfig hc;
   hc.extent = {w, h};
   HiZPyramid hiz(ctx, hc);
@@ -135,10 +103,11 @@ void BM_LightCull(benchmark::State& state) {
       device_buffer(ctx, nullptr, sizeof(GlintFlareIndirect), storage | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT);
   auto stats = device_buffer(ctx, nullptr, sizeof(GlintFlareStats), storage);
   auto results = device_buffer(ctx, nullptr, VkDeviceSize(n) * sizeof(GlintFlareLightResult), storage);
-  Buffer lv = view(lights, storage, true);
-  LightCullOutputs out{view(instances, storage, false),
-                       view(indirect, storage | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT, false),
-                       view(stats, storage, false), with_results ? view(results, storage, false) : Buffer{}};
+  Buffer lv = buffer_view(lights, storage, true);
+  LightCullOutputs out{buffer_view(instances, storage, false),
+                       buffer_view(indirect, storage | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT, false),
+                       buffer_view(stats, storage, false),
+                       with_results ? buffer_view(results, storage, false) : Buffer{}};
   LightCullFrame frame;
   for (int i = 0; i < 16; ++i) frame.view_proj[i] = static_cast<float>(scene.view_proj[i]);
   ctx.run_once([&](VkCommandBuffer cmd) { hiz.record(cmd, depth.state); });
@@ -157,7 +126,7 @@ void BM_LightCull(benchmark::State& state) {
 
   // Read the per-light results and statistics back (results are written in a separate frame when
   // the timed one had none).
-  Buffer rv = view(results, storage, false);
+  Buffer rv = buffer_view(results, storage, false);
   LightCullOutputs check{out.instances, out.indirect, out.stats, rv};
   detail::OwnedBuffer readback(ctx, VkDeviceSize(n) * 8 + sizeof(GlintFlareStats) + 16,
                                VK_BUFFER_USAGE_TRANSFER_DST_BIT, true);

@@ -1,15 +1,16 @@
 # Visibility (docs/OCCLUSION.md): the Hi-Z pyramid and the light cull (include/glint/occlusion.h,
 # occlusion.cpp) and the object cull (include/glint/object_cull.h, object_cull.cpp).
 set(GLINT_EFFECT_SOURCES occlusion.cpp object_cull.cpp)
+# compact_scan_tiles and compact_scatter are the ordered compaction's own kernels (both culls use
+# them through src/core/compaction.h; its shared GLSL is src/core/shaders/compact.glsl).
 set(GLINT_EFFECT_KERNELS
   "shaders/hiz_build|main|"
+  "shaders/compact_scan_tiles|main|"
+  "shaders/compact_scatter|main|"
   "shaders/light_cull|main|"
   "shaders/light_cull_scan|main|"
-  "shaders/light_cull_scan_tiles|main|"
   "shaders/light_cull_scatter|main|"
   "shaders/object_cull|main|"
   "shaders/object_cull|phase1|GLINT_OBJECT_PHASE1=1"
   "shaders/object_cull_scan|main|"
-  "shaders/object_cull_scan_tiles|main|"
-  "shaders/object_cull_scatter|main|"
 )

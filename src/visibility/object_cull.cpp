@@ -6,12 +6,14 @@
 #include <cfloat>
 #include <cmath>
 #include <cstddef>
+#include <cstring>
 #include <map>
 #include <utility>
 #include <vector>
 
 #include "core/barriers.h"
 #include "core/check.h"
+#include "core/compaction.h"
 #include "core/context_state.h"
 #include "core/pipeline.h"
 #include "core/resources.h"
@@ -28,7 +30,10 @@ static_assert(sizeof(GlintObjectCullPush) == 112);
 static_assert(offsetof(GlintObjectCullPush, proj_x) == 48);
 static_assert(offsetof(GlintObjectCullPush, width) == 84);
 static_assert(offsetof(GlintObjectCullPush, groups_x) == 104);
-static_assert(sizeof(GlintObjectCompactPush) == 32);
+static_assert(sizeof(GlintObjectCompactPush) == sizeof(GlintCompactPush));
+static_assert(offsetof(GlintObjectCompactPush, tile_groups) == offsetof(GlintCompactPush, tile_groups));
+static_assert(offsetof(GlintObjectCompactPush, groups_x) == offsetof(GlintCompactPush, groups_x));
+static_assert(offsetof(GlintObjectCompactPush, payload_words) == offsetof(GlintCompactPush, step));
 static_assert(sizeof(GlintObjectCullIndirect) == 16);
 static_assert(sizeof(GlintObjectCullStats) == 32);
 static_assert(GLINT_OBJECT_GROUP == 64, "object_cull.comp keeps a workgroup's mask in two 32-bit words");
@@ -186,30 +191,21 @@ void ObjectCullConfig::validate() const {
 struct ObjectCuller::Impl {
   const Context* context = nullptr;
   ObjectCullConfig config;
-  uint32_t max_groups_x = 65535;
-  uint32_t scan_threads = 1;
   uint64_t max_range = 1u << 27;  // the device's maxStorageBufferRange
-  detail::ComputePipeline cull, phase1, scan_tiles, scan, scatter;
-  detail::OwnedBuffer groups, dummy;
-  Buffer groups_state, dummy_state;
-  bool counters_cleared = false;
-  struct Sets {
-    VkDescriptorSet cull = VK_NULL_HANDLE, scan_tiles = VK_NULL_HANDLE, scan = VK_NULL_HANDLE, scatter = VK_NULL_HANDLE;
-  };
-  std::map<std::vector<uint64_t>, Sets> sets;
+  detail::ComputePipeline cull, phase1;
+  // The ordered compaction of the emitted objects (core/compaction.h): its group buffer holds the
+  // test's masks and counters; object_cull_scan.comp finishes the scan, compact_scatter.comp
+  // writes the payloads.
+  detail::Compaction compact;
+  detail::OwnedBuffer dummy;
+  Buffer dummy_state;
+  std::map<std::vector<uint64_t>, VkDescriptorSet> sets;  // the test's, by the resources it binds
   detail::DescriptorArena arena;
 
   static void key_add(std::vector<uint64_t>& key, const Buffer& b) {
     key.push_back(reinterpret_cast<uint64_t>(b.buffer));
     key.push_back(b.offset);
     key.push_back(b.size);
-  }
-
-  // Workgroups of the test and the scatter, as a 2D grid of at most max_groups_x per row.
-  void grid(uint32_t count, uint32_t& gx, uint32_t& gy) const {
-    const uint32_t g = std::max(1u, (count + kGroup - 1) / kGroup);
-    gx = std::min(g, max_groups_x);
-    gy = (g + gx - 1) / gx;
   }
 
   void check_common(const char* where, const ObjectCullFrame& frame, ObjectCullBuffers& in, ObjectCullOutputs& out,
@@ -270,7 +266,6 @@ ObjectCuller::ObjectCuller(const Context& context, const ObjectCullConfig& confi
   m.arena = detail::DescriptorArena(context, 16, 8);
   VkPhysicalDeviceProperties props;
   vkGetPhysicalDeviceProperties(context.physical_device(), &props);
-  m.max_groups_x = props.limits.maxComputeWorkGroupCount[0];
   m.max_range = props.limits.maxStorageBufferRange;
   // The objects, payload and list buffers are each one storage descriptor (limits come from the
   // device): their largest sizes must fit maxStorageBufferRange (2^27 bytes guaranteed, 4 M objects).
@@ -291,15 +286,12 @@ ObjectCuller::ObjectCuller(const Context& context, const ObjectCullConfig& confi
                        " bytes exceeds the device's maxStorageBufferRange = ", m.max_range));
   }
   const uint64_t groups = (uint64_t(config.max_objects) + kGroup - 1) / kGroup;
-  if ((groups + m.max_groups_x - 1) / m.max_groups_x > props.limits.maxComputeWorkGroupCount[1]) {
+  const uint32_t max_groups_x = props.limits.maxComputeWorkGroupCount[0];
+  if ((groups + max_groups_x - 1) / max_groups_x > props.limits.maxComputeWorkGroupCount[1]) {
     throw Error(ErrorCode::invalid_argument,
                 concat("ObjectCullConfig::max_objects = ", config.max_objects,
                        " needs more workgroups than the device's maxComputeWorkGroupCount allows"));
   }
-  // As LightCuller: a CPU device runs a workgroup's invocations a few at a time.
-  const uint32_t scan_cap = context.info().type == VK_PHYSICAL_DEVICE_TYPE_CPU ? 64u : GLINT_OBJECT_SCAN_MAX_THREADS;
-  m.scan_threads =
-      std::min({scan_cap, props.limits.maxComputeWorkGroupInvocations, props.limits.maxComputeWorkGroupSize[0]});
   const auto S = VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE;
   const auto B = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
   detail::PipelineDesc d;
@@ -311,22 +303,14 @@ ObjectCuller::ObjectCuller(const Context& context, const ObjectCullConfig& confi
   d.kernel_id = "object_cull_phase1";
   d.bindings = {B, B, B};
   m.phase1 = detail::ComputePipeline(context, d);
-  detail::PipelineDesc sc;
-  sc.kernel_id = "object_cull_scan_main";
-  sc.bindings = {B, B, B};
-  sc.push_constant_bytes = sizeof(GlintObjectCompactPush);
-  sc.workgroup = {m.scan_threads, 1};
-  m.scan = detail::ComputePipeline(context, sc);
-  detail::PipelineDesc st = sc;
-  st.kernel_id = "object_cull_scan_tiles_main";
-  st.bindings = {B};
-  m.scan_tiles = detail::ComputePipeline(context, st);
-  sc.kernel_id = "object_cull_scatter_main";
-  sc.workgroup = {kGroup, 1};
-  m.scatter = detail::ComputePipeline(context, sc);
-  const VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
-  m.groups = detail::OwnedBuffer(context, GLINT_OBJECT_HEADER_WORDS * 4 + groups * 16, usage, false);
-  m.groups_state = view_of(m.groups, usage);
+  detail::Compaction::Desc cd;
+  cd.max_items = config.max_objects;
+  cd.scan_kernel = "object_cull_scan_main";  // writes the indirect arguments and statistics
+  cd.scan_outputs = 2;
+  cd.scatter_kernel = "compact_scatter_main";  // payloads (or indices) into the list
+  cd.scatter_inputs = 1;
+  cd.scatter_outputs = 1;
+  m.compact = detail::Compaction(context, cd);
   m.dummy = detail::OwnedBuffer(context, 16, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, false);
   m.dummy_state = view_of(m.dummy, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
 }
@@ -340,6 +324,8 @@ const ObjectCullConfig& ObjectCuller::config() const { return impl_->config; }
 uint64_t ObjectCuller::min_bytes_moved(uint32_t count, uint32_t written) const {
   const uint64_t groups = (uint64_t(count) + kGroup - 1) / kGroup;
   const uint64_t words = std::max(1u, impl_->config.payload_words);
+  // Objects read, states written (4 + 4 bytes each); the group words written by the test, read
+  // and written by the tile scan, read by the scatter; payloads read and written.
   return uint64_t(count) * (sizeof(GlintCullObject) + 8) + groups * 16 * 3 + uint64_t(written) * words * 4 * 2;
 }
 
@@ -347,6 +333,7 @@ void ObjectCuller::Impl::run(VkCommandBuffer cmd, HiZPyramid* hiz, Image* depth,
                              GlintObjectCullPush push, uint32_t count, ObjectCullBuffers& in, ObjectCullOutputs& out,
                              Profiler* profiler) {
   Buffer& payloads = config.payload_words > 0 ? in.payloads : dummy_state;
+  Buffer& groups_state = compact.groups();
   const bool images = mode != GLINT_OBJECT_MODE_PHASE1;
   std::vector<uint64_t> key{mode == GLINT_OBJECT_MODE_PHASE1 ? 1u : 0u};
   if (images) {
@@ -354,14 +341,9 @@ void ObjectCuller::Impl::run(VkCommandBuffer cmd, HiZPyramid* hiz, Image* depth,
     key.push_back(reinterpret_cast<uint64_t>(hiz->image().view));
   }
   key_add(key, in.objects);
-  key_add(key, payloads);
   key_add(key, in.visibility);
-  key_add(key, out.list);
-  key_add(key, out.indirect);
-  key_add(key, out.stats);
   auto it = sets.find(key);
   if (it == sets.end()) {
-    Sets s;
     std::vector<detail::DescriptorArena::AnyBinding> c;
     if (images) {
       c.resize(2);
@@ -373,32 +355,14 @@ void ObjectCuller::Impl::run(VkCommandBuffer cmd, HiZPyramid* hiz, Image* depth,
       a.buffer = *b;
       c.push_back(a);
     }
-    s.cull = arena.make_mixed_set(images ? cull : phase1, c);
-    std::vector<detail::DescriptorArena::AnyBinding> n(3);
-    n[0].buffer = groups_state;
-    n[1].buffer = out.indirect;
-    n[2].buffer = out.stats;
-    s.scan = arena.make_mixed_set(scan, n);
-    s.scan_tiles = arena.make_mixed_set(scan_tiles, {n[0]});
-    std::vector<detail::DescriptorArena::AnyBinding> p(3);
-    p[0].buffer = groups_state;
-    p[1].buffer = payloads;
-    p[2].buffer = out.list;
-    s.scatter = arena.make_mixed_set(scatter, p);
-    it = sets.emplace(key, s).first;
+    it = sets.emplace(key, arena.make_mixed_set(images ? cull : phase1, c)).first;
   }
-  const Sets s = it->second;
+  const VkDescriptorSet set = it->second;
 
   detail::Barriers b;
-  if (!counters_cleared) {  // once per object: the scan resets them after every cull
-    b.use(groups_state, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);
-    b.flush(cmd);
-    vkCmdFillBuffer(cmd, groups.buffer(), 0, GLINT_OBJECT_HEADER_WORDS * 4, 0);
-    detail::count_recorded_command();
-    counters_cleared = true;
-  }
+  compact.record_clear_once(cmd, b);  // the scan resets the counters after every cull
   uint32_t gx, gy;
-  grid(count, gx, gy);
+  compact.grid(count, gx, gy);
   // 1. Test: masks, counters, states.
   if (images) {
     b.use(*depth, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, kCompute, kSampled);
@@ -417,39 +381,21 @@ void ObjectCuller::Impl::run(VkCommandBuffer cmd, HiZPyramid* hiz, Image* depth,
       push.height = static_cast<int32_t>(hiz->config().extent.height);
       push.levels = hiz->levels();
     }
-    (images ? cull : phase1).dispatch(cmd, s.cull, push, gx * kGroup, gy);
+    (images ? cull : phase1).dispatch(cmd, set, push, gx * kGroup, gy);
   }
   if (profiler) profiler->mark(cmd, "object cull");
-  // 2. Scan: slots, arguments, statistics; counters reset.
-  GlintObjectCompactPush cp{};
-  cp.count = count;
-  cp.capacity = config.capacity;
-  cp.payload_words = config.payload_words;
-  cp.objects_per_group = config.objects_per_group;
-  cp.groups_x = gx;
-  cp.tile_groups = scan_threads;
-  // 2a. Tiles of scan_threads groups in parallel: slots within each tile, tile totals.
-  const uint32_t group_count = (count + kGroup - 1) / kGroup;
-  if (group_count > 0) {
-    b.use(groups_state, kCompute, kRead | kWrite);
-    b.flush(cmd);
-    scan_tiles.dispatch(cmd, s.scan_tiles, cp, (group_count + scan_threads - 1) / scan_threads * scan_threads, 1);
-  }
-  // 2b. One workgroup: the tiles' first slots, arguments, statistics.
-  b.use(groups_state, kCompute, kRead | kWrite);
-  b.use(out.indirect, kCompute, kWrite);
-  b.use(out.stats, kCompute, kWrite);
-  b.flush(cmd);
-  scan.dispatch(cmd, s.scan, cp, scan_threads, 1);
+  // 2. Scan: slots, arguments, statistics; counters reset. 3. Scatter: payloads in object order.
+  GlintObjectCompactPush op{};
+  op.count = count;
+  op.capacity = config.capacity;
+  op.payload_words = config.payload_words;
+  op.objects_per_group = config.objects_per_group;
+  GlintCompactPush cp;
+  static_assert(sizeof(cp) == sizeof(op));
+  std::memcpy(&cp, &op, sizeof(cp));
+  compact.record_scan(cmd, b, cp, {&out.indirect, &out.stats});
   if (profiler) profiler->mark(cmd, "object cull scan");
-  // 3. Scatter: payloads in object order.
-  if (count > 0) {
-    b.use(groups_state, kCompute, kRead);
-    b.use(payloads, kCompute, kRead);
-    b.use(out.list, kCompute, kWrite);
-    b.flush(cmd);
-    scatter.dispatch(cmd, s.scatter, cp, gx * kGroup, gy);
-  }
+  compact.record_scatter(cmd, b, cp, {&payloads}, {&out.list});
   if (profiler) profiler->mark(cmd, "object cull scatter");
 }
 
@@ -495,6 +441,7 @@ void ObjectCuller::record_clear_history(VkCommandBuffer cmd, Buffer& visibility,
 void ObjectCuller::forget_caller_resources() {
   impl_->sets.clear();
   impl_->arena.reset();
+  impl_->compact.forget_caller_resources();
 }
 
 }  // namespace glint

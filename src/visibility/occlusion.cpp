@@ -6,12 +6,14 @@
 #include <array>
 #include <cmath>
 #include <cstddef>
+#include <cstring>
 #include <map>
 #include <utility>
 #include <vector>
 
 #include "core/barriers.h"
 #include "core/check.h"
+#include "core/compaction.h"
 #include "core/context_state.h"
 #include "core/formats.h"
 #include "core/pipeline.h"
@@ -30,9 +32,10 @@ static_assert(sizeof(GlintCullPush) == 112);
 static_assert(offsetof(GlintCullPush, width) == 64);
 static_assert(offsetof(GlintCullPush, flags) == 88);
 static_assert(offsetof(GlintCullPush, depth_bias) == 96);
-static_assert(sizeof(GlintCullCompactPush) == 32);
-static_assert(offsetof(GlintCullCompactPush, flags) == 16);
-static_assert(offsetof(GlintCullCompactPush, max_group_count_x) == 20);
+static_assert(sizeof(GlintCullCompactPush) == sizeof(GlintCompactPush));
+static_assert(offsetof(GlintCullCompactPush, tile_groups) == offsetof(GlintCompactPush, tile_groups));
+static_assert(offsetof(GlintCullCompactPush, groups_x) == offsetof(GlintCompactPush, groups_x));
+static_assert(offsetof(GlintCullCompactPush, vertex_count) == offsetof(GlintCompactPush, step));
 static_assert(sizeof(LightCullFrame::view_proj) == sizeof(GlintCullPush::view_proj));
 
 namespace {
@@ -331,29 +334,21 @@ struct LightCuller::Impl {
   LightCullConfig config;
   uint32_t max_groups_x = kMaxGroupsX;
   uint32_t max_groups_y = kMaxGroupsX;
-  uint32_t scan_threads = 1;  // the scan's single workgroup
-  // The three dispatches of a cull (docs/OCCLUSION.md): cull + grid test, scan, scatter.
-  detail::ComputePipeline cull, scan_tiles, scan, scatter;
-  // Header counters and one uvec4 per workgroup (occlusion.h), and one vec4 record per light.
-  detail::OwnedBuffer groups, records;
-  Buffer groups_state, records_state;
-  bool counters_cleared = false;
-  // Descriptor sets per distinct set of caller resources, made on first use and kept.
-  struct Sets {
-    VkDescriptorSet cull = VK_NULL_HANDLE, scan_tiles = VK_NULL_HANDLE, scan = VK_NULL_HANDLE, scatter = VK_NULL_HANDLE;
-  };
-  // Sets by the resources they name: the depth and Hi-Z views and (buffer, offset, size) of the
-  // lights, instances, results, indirect and stats buffers. A fixed-size key: no allocation.
-  using SetKey = std::array<uint64_t, 17>;
-  std::map<SetKey, Sets> sets;
-  detail::DescriptorArena arena;      // pools of 16 sets, 8 descriptors of a type each (the scatter binds 5 buffers)
+  // The dispatches of a cull (docs/OCCLUSION.md): cull + grid test, then the ordered compaction
+  // (core/compaction.h): its two-level scan, finished by light_cull_scan.comp (indirect arguments,
+  // statistics), and light_cull_scatter.comp (instances in light order).
+  detail::ComputePipeline cull;
+  detail::Compaction compact;
+  // One vec4 record per light.
+  detail::OwnedBuffer records;
+  Buffer records_state;
+  // The cull's descriptor sets by the resources they name: the depth and Hi-Z views and (buffer,
+  // offset, size) of the lights and results buffers. A fixed-size key: no allocation.
+  using SetKey = std::array<uint64_t, 8>;
+  std::map<SetKey, VkDescriptorSet> sets;
+  detail::DescriptorArena arena;      // pools of 16 sets, 8 descriptors of a type each
   detail::OwnedBuffer dummy_results;  // bound when the caller wants no per-light results
   Buffer dummy_state;
-
-  VkDescriptorSet allocate(const detail::ComputePipeline& p,
-                           const std::vector<detail::DescriptorArena::AnyBinding>& b) {
-    return arena.make_mixed_set(p, b);
-  }
 
   static void key_add(SetKey& key, size_t& at, const Buffer& b) {
     key[at++] = reinterpret_cast<uint64_t>(b.buffer);
@@ -373,11 +368,6 @@ LightCuller::LightCuller(const Context& context, const LightCullConfig& config) 
   vkGetPhysicalDeviceProperties(context.physical_device(), &props);
   m.max_groups_x = props.limits.maxComputeWorkGroupCount[0];
   m.max_groups_y = props.limits.maxComputeWorkGroupCount[1];
-  // CPU devices (lavapipe) run a workgroup's invocations a few at a time and pay for every barrier
-  // per invocation: 64 there, where longer serial runs of masks per invocation cost little.
-  const uint32_t scan_cap = context.info().type == VK_PHYSICAL_DEVICE_TYPE_CPU ? 64u : GLINT_CULL_SCAN_MAX_THREADS;
-  m.scan_threads =
-      std::min({scan_cap, props.limits.maxComputeWorkGroupInvocations, props.limits.maxComputeWorkGroupSize[0]});
   const auto S = VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE;
   const auto B = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
   detail::PipelineDesc d;
@@ -386,26 +376,14 @@ LightCuller::LightCuller(const Context& context, const LightCullConfig& config) 
   d.push_constant_bytes = sizeof(GlintCullPush);
   d.workgroup = {kCullGroup, 1};
   m.cull = detail::ComputePipeline(context, d);
-  detail::PipelineDesc sc;
-  sc.kernel_id = "light_cull_scan_main";
-  sc.bindings = {B, B, B};
-  sc.push_constant_bytes = sizeof(GlintCullCompactPush);
-  sc.workgroup = {m.scan_threads, 1};
-  m.scan = detail::ComputePipeline(context, sc);
-  detail::PipelineDesc st = sc;
-  st.kernel_id = "light_cull_scan_tiles_main";
-  st.bindings = {B};
-  m.scan_tiles = detail::ComputePipeline(context, st);
-  detail::PipelineDesc sp;
-  sp.kernel_id = "light_cull_scatter_main";
-  sp.bindings = {B, B, B, B, B};
-  sp.push_constant_bytes = sizeof(GlintCullCompactPush);
-  sp.workgroup = {kCullGroup, 1};
-  m.scatter = detail::ComputePipeline(context, sp);
-  const VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
-  const VkDeviceSize group_count = (VkDeviceSize(config.max_lights) + kCullGroup - 1) / kCullGroup;
-  m.groups = detail::OwnedBuffer(context, GLINT_CULL_HEADER_WORDS * 4 + group_count * 16, usage, false);
-  m.groups_state = view_of(m.groups, usage);
+  detail::Compaction::Desc cd;
+  cd.max_items = config.max_lights;
+  cd.scan_kernel = "light_cull_scan_main";  // writes the indirect arguments and statistics
+  cd.scan_outputs = 2;
+  cd.scatter_kernel = "light_cull_scatter_main";  // reads lights and records; writes instances and results
+  cd.scatter_inputs = 2;
+  cd.scatter_outputs = 2;
+  m.compact = detail::Compaction(context, cd);
   m.records =
       detail::OwnedBuffer(context, VkDeviceSize(config.max_lights) * 16, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, false);
   m.records_state = view_of(m.records, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
@@ -476,49 +454,27 @@ void LightCuller::record(VkCommandBuffer cmd, HiZPyramid& hiz, Image& depth, Buf
   }
   Buffer& results = want_results ? out.results : m.dummy_state;
 
-  // Descriptor sets for these resources (made once, then reused).
+  // The cull's descriptor set for these resources (made once, then reused).
+  Buffer& groups_state = m.compact.groups();
   Impl::SetKey key{reinterpret_cast<uint64_t>(depth.view), reinterpret_cast<uint64_t>(hiz.image().view)};
   size_t at = 2;
   Impl::key_add(key, at, lights);
-  Impl::key_add(key, at, out.instances);
   Impl::key_add(key, at, results);
-  Impl::key_add(key, at, out.indirect);
-  Impl::key_add(key, at, out.stats);
   auto it = m.sets.find(key);
   if (it == m.sets.end()) {
-    Impl::Sets s;
     std::vector<detail::DescriptorArena::AnyBinding> c(6);
     c[0].image = {depth.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
     c[1].image = {hiz.image().view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
     c[2].buffer = lights;
     c[3].buffer = m.records_state;
     c[4].buffer = results;
-    c[5].buffer = m.groups_state;
-    s.cull = m.allocate(m.cull, c);
-    std::vector<detail::DescriptorArena::AnyBinding> n(3);
-    n[0].buffer = m.groups_state;
-    n[1].buffer = out.indirect;
-    n[2].buffer = out.stats;
-    s.scan = m.allocate(m.scan, n);
-    s.scan_tiles = m.allocate(m.scan_tiles, {n[0]});
-    std::vector<detail::DescriptorArena::AnyBinding> p(5);
-    p[0].buffer = lights;
-    p[1].buffer = m.records_state;
-    p[2].buffer = m.groups_state;
-    p[3].buffer = out.instances;
-    p[4].buffer = results;
-    s.scatter = m.allocate(m.scatter, p);
-    it = m.sets.emplace(key, s).first;
+    c[5].buffer = groups_state;
+    it = m.sets.emplace(key, m.arena.make_mixed_set(m.cull, c)).first;
   }
-  const Impl::Sets sets = it->second;
+  const VkDescriptorSet set = it->second;
 
   detail::Barriers b;
-  if (!m.counters_cleared) {  // once per object: the scan kernel resets them every frame
-    b.use(m.groups_state, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);  // fill = "transfer"
-    b.flush(cmd);
-    vkCmdFillBuffer(cmd, m.groups.buffer(), 0, GLINT_CULL_HEADER_WORDS * 4, 0);
-    m.counters_cleared = true;
-  }
+  m.compact.record_clear_once(cmd, b);  // the scan kernel resets the counters every frame
   const uint32_t flags = want_results ? GLINT_CULL_WRITE_RESULTS : 0u;
   // 1. Cull + grid test: visibility masks and records, the other lights' results, the counters.
   b.use(depth, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, kCompute, kSampled);
@@ -526,7 +482,7 @@ void LightCuller::record(VkCommandBuffer cmd, HiZPyramid& hiz, Image& depth, Buf
   b.use(lights, kCompute, kStorageRead);
   b.use(m.records_state, kCompute, kStorageWrite);
   b.use(results, kCompute, kStorageWrite);
-  b.use(m.groups_state, kCompute, kStorageRead | kStorageWrite);
+  b.use(groups_state, kCompute, kStorageRead | kStorageWrite);
   b.use(out.instances, kCompute, kStorageWrite);  // written by the scatter; here after the last frame's reads
   b.flush(cmd);
   if (count > 0) {
@@ -541,41 +497,24 @@ void LightCuller::record(VkCommandBuffer cmd, HiZPyramid& hiz, Image& depth, Buf
                  (m.config.pattern == OcclusionPattern::regular ? GLINT_CULL_REGULAR_GRID : 0u);
     push.margin_ndc = m.config.margin_ndc;
     push.depth_bias = m.config.depth_bias;
-    m.cull.dispatch(cmd, sets.cull, push, count, 1);
+    m.cull.dispatch(cmd, set, push, count, 1);
   }
   if (profiler) profiler->mark(cmd, "light cull");
   // 2. Scan: the masks (and the counters' atomics) are complete; first slots, arguments, stats.
-  GlintCullCompactPush cp{};
-  cp.count = count;
-  cp.capacity = m.config.capacity;
-  cp.vertex_count = frame.vertex_count;
-  cp.groups_per_instance = frame.groups_per_instance;
-  cp.flags = flags;
-  cp.max_group_count_x = m.max_groups_x;
-  cp.tile_groups = m.scan_threads;
-  // 2a. Tiles of scan_threads groups in parallel: slots within each tile, tile totals.
-  const uint32_t group_count = (count + kCullGroup - 1) / kCullGroup;
-  if (group_count > 0) {
-    b.use(m.groups_state, kCompute, kStorageRead | kStorageWrite);
-    b.flush(cmd);
-    m.scan_tiles.dispatch(cmd, sets.scan_tiles, cp,
-                          (group_count + m.scan_threads - 1) / m.scan_threads * m.scan_threads, 1);
-  }
-  // 2b. One workgroup: the tiles' first slots, arguments, statistics.
-  b.use(m.groups_state, kCompute, kStorageRead | kStorageWrite);
-  b.use(out.indirect, kCompute, kStorageWrite);
-  b.use(out.stats, kCompute, kStorageWrite);
-  b.flush(cmd);
-  m.scan.dispatch(cmd, sets.scan, cp, m.scan_threads, 1);
+  GlintCullCompactPush lp{};
+  lp.count = count;
+  lp.capacity = m.config.capacity;
+  lp.vertex_count = frame.vertex_count;
+  lp.groups_per_instance = frame.groups_per_instance;
+  lp.flags = flags;
+  lp.max_group_count_x = m.max_groups_x;
+  GlintCompactPush cp;
+  static_assert(sizeof(cp) == sizeof(lp));
+  std::memcpy(&cp, &lp, sizeof(cp));
+  m.compact.record_scan(cmd, b, cp, {&out.indirect, &out.stats});
   if (profiler) profiler->mark(cmd, "cull scan");
   // 3. Scatter: instances in light order, the visible lights' results.
-  if (count > 0) {
-    b.use(m.records_state, kCompute, kStorageRead);
-    b.use(m.groups_state, kCompute, kStorageRead);
-    b.use(results, kCompute, kStorageWrite);
-    b.flush(cmd);
-    m.scatter.dispatch(cmd, sets.scatter, cp, count, 1);
-  }
+  m.compact.record_scatter(cmd, b, cp, {&lights, &m.records_state}, {&out.instances, &results});
   if (profiler) profiler->mark(cmd, "cull scatter");
 }
 
@@ -584,6 +523,7 @@ void HiZPyramid::forget_caller_resources() { impl_->sets.clear(); }
 void LightCuller::forget_caller_resources() {
   impl_->sets.clear();
   impl_->arena.reset();
+  impl_->compact.forget_caller_resources();
 }
 
 }  // namespace glint

@@ -34,10 +34,9 @@ layout(binding = 1) uniform texture2D hiz_tex;    // mip m = Hi-Z level m + 1
 layout(std430, binding = 2) readonly buffer Lights { GlintFlareLight lights[]; };
 layout(std430, binding = 3) writeonly buffer Records { vec4 records[]; };  // centre.xy, fraction, ndc z
 layout(std430, binding = 4) writeonly buffer Results { GlintFlareLightResult results[]; };
-layout(std430, binding = 5) buffer Groups {
-  uint counters[GLINT_CULL_HEADER_WORDS];
-  uvec4 groups[];  // visibility mask (x, y), first slot (z, the scan's), 0
-};
+#define COMPACT_GROUPS_BINDING 5  // the compaction's group buffer: this writes the masks (x, y)
+#define COMPACT_NO_SCAN
+#include "compact.glsl"
 layout(push_constant) uniform Push { GlintCullPush pc; };
 
 shared uint group_frustum;

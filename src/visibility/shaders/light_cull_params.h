@@ -1,13 +1,20 @@
 // Push constants and buffer layouts of the visibility stage of the lens flares: the Hi-Z build
-// (hiz_build.comp), the cull + occlusion grid test (light_cull.comp), and the order-preserving
-// compaction (the same order on every run): a two-level scan of the cull's per-workgroup visibility
-// masks (light_cull_scan_tiles.comp per tile, light_cull_scan.comp over the tile totals, which also
-// writes the indirect arguments and statistics), then the scatter of the visible lights into the instance buffer in light-index order
-// (light_cull_scatter.comp). Declared once for GLSL and C++ (CONTRIBUTING.md, "Shared structs");
-// src/visibility/occlusion.cpp static_asserts the layouts. docs/OCCLUSION.md explains the algorithms. The
+// (hiz_build.comp), the cull + occlusion grid test (light_cull.comp), and the ordered compaction
+// shared with the object cull (compact_params.h; the same order on every run): a two-level scan of
+// the cull's per-workgroup visibility masks (compact_scan_tiles.comp per tile, light_cull_scan.comp
+// over the tile totals, which also writes the indirect arguments and statistics), then the scatter
+// of the visible lights into the instance buffer in light-index order (light_cull_scatter.comp).
+// Declared once for GLSL and C++ (CONTRIBUTING.md, "Shared structs"); src/visibility/occlusion.cpp
+// static_asserts the layouts. docs/OCCLUSION.md explains the algorithms. The
 // public C++ API of the same stage is include/glint/occlusion.h.
 #ifndef GLINT_LIGHT_CULL_PARAMS_H
 #define GLINT_LIGHT_CULL_PARAMS_H
+// The compaction's layouts (src/core/shaders): GLSL finds them by name, C++ by their path in src/.
+#ifdef __cplusplus
+#include "core/shaders/compact_params.h"
+#else
+#include "compact_params.h"
+#endif
 #include "glint/gpu/types.h"
 
 // Hi-Z levels: level 0 is the depth image itself, level k (k >= 1) is max(1, size >> k) on a side
@@ -28,19 +35,14 @@ struct GlintHiZPush {
   GLINT_UINT reserved;
 };
 
-// Lights per workgroup of light_cull.comp: one workgroup's visibility is one 64-bit mask.
-#define GLINT_CULL_GROUP 64u
-// The cull's group buffer: GLINT_CULL_HEADER_WORDS counter words (all zero between frames: the scan
-// kernel resets them), then one uvec4 per workgroup of GLINT_CULL_GROUP lights: the visibility mask
-// of its lights 0..31 (x) and 32..63 (y), written by the cull, and the instance slot of its first
-// visible light (z), written by the scan; w is 0. Counters are integer sums, so the order of their
-// atomics does not matter; no atomic decides where an instance goes.
+// Lights per workgroup of light_cull.comp: one workgroup's visibility is one 64-bit mask of the
+// compaction's group buffer (compact_params.h), whose header words count the states. Counters are
+// integer sums, so the order of their atomics does not matter; no atomic decides where an instance
+// goes.
+#define GLINT_CULL_GROUP GLINT_COMPACT_GROUP
 #define GLINT_CULL_COUNTER_FRUSTUM 1u
 #define GLINT_CULL_COUNTER_OCCLUDED 2u
 #define GLINT_CULL_COUNTER_DISABLED 3u
-#define GLINT_CULL_HEADER_WORDS 4u
-// Most invocations of the scan's single workgroup (its shared arrays are sized for it).
-#define GLINT_CULL_SCAN_MAX_THREADS 1024u
 
 // GlintCullPush::flags
 #define GLINT_CULL_REVERSED_Z 1u     // depth 1 is near; farthest = min
@@ -67,16 +69,17 @@ struct GlintCullPush {
   GLINT_UINT reserved[3];
 };
 
-// Push constants of light_cull_scan.comp and light_cull_scatter.comp.
+// Push constants of the light cull's compaction (light_cull_scan.comp, light_cull_scatter.comp):
+// GlintCompactPush with its step words named.
 struct GlintCullCompactPush {
   GLINT_UINT count;                // lights in the list
   GLINT_UINT capacity;             // GlintFlareInstance slots in the instance buffer
+  GLINT_UINT tile_groups;          // 64-light groups per tile of the two-level scan
+  GLINT_UINT groups_x;             // scatter: workgroups per row of its 2D dispatch
   GLINT_UINT vertex_count;         // scan: GlintFlareIndirect::vertex_count
   GLINT_UINT groups_per_instance;  // scan: the dispatch arguments cover instances x this groups
   GLINT_UINT flags;                // scatter: GLINT_CULL_WRITE_RESULTS
   GLINT_UINT max_group_count_x;    // scan: the device's maxComputeWorkGroupCount[0]
-  GLINT_UINT tile_groups;          // scans and scatter: 64-light groups per tile of the two-level scan
-  GLINT_UINT reserved;
 };
 
 #endif

@@ -1,39 +1,32 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
-// The last dispatch of the order-preserving compaction: one invocation per light. A
-// visible light (its bit set in its workgroup's mask, light_cull.comp) takes the slot
-// first slot of its tile (light_cull_scan.comp) + the group's slot within the tile
-// (light_cull_scan_tiles.comp) + visible lights before it in the mask (a bit
-// count), so visible lights fill the instance buffer in increasing light index on every run: no
-// atomic decides the order. Slots at or beyond the capacity are not written; those lights become
-// GLINT_FLARE_OVERFLOW, so the instances kept are the visible lights with the smallest indices.
-// Writes the per-light result of visible lights (the cull wrote the others').
+// The last dispatch of the light cull's ordered compaction (compact.glsl): one invocation per
+// light. A visible light (its bit set in its workgroup's mask, light_cull.comp) takes the slot
+// compact_slot gives (the tile's first slot + the group's slot within the tile + visible lights
+// before it in the mask), so visible lights fill the instance buffer in increasing light index on
+// every run: no atomic decides the order. Slots at or beyond the capacity are not written; those
+// lights become GLINT_FLARE_OVERFLOW, so the instances kept are the visible lights with the
+// smallest indices. Writes the per-light result of visible lights (the cull wrote the others').
 layout(local_size_x_id = 0, local_size_y_id = 1) in;
 
 #include "glint/gpu/flare_types.h"
+#define COMPACT_GROUPS_BINDING 0
+#define COMPACT_GROUPS_READONLY
+#define COMPACT_NO_SCAN
+#include "compact.glsl"
 #include "light_cull_params.h"
 
-layout(std430, binding = 0) readonly buffer Lights { GlintFlareLight lights[]; };
-layout(std430, binding = 1) readonly buffer Records { vec4 records[]; };  // centre.xy, fraction, ndc z
-layout(std430, binding = 2) readonly buffer Groups {
-  uint counters[GLINT_CULL_HEADER_WORDS];
-  uvec4 groups[];  // visibility mask (x, y), slot within the tile (z), tile's first slot on its first group (w)
-};
+layout(std430, binding = 1) readonly buffer Lights { GlintFlareLight lights[]; };
+layout(std430, binding = 2) readonly buffer Records { vec4 records[]; };  // centre.xy, fraction, ndc z
 layout(std430, binding = 3) writeonly buffer Instances { GlintFlareInstance instances[]; };
 layout(std430, binding = 4) writeonly buffer Results { GlintFlareLightResult results[]; };
 layout(push_constant) uniform Push { GlintCullCompactPush pc; };
 
 void main() {
-  const uint i = gl_GlobalInvocationID.x;
+  const uint i = (gl_WorkGroupID.y * pc.groups_x + gl_WorkGroupID.x) * gl_WorkGroupSize.x + gl_LocalInvocationIndex;
   if (i >= pc.count) return;
-  const uvec4 g = groups[i / GLINT_CULL_GROUP];
-  const uint b = i % GLINT_CULL_GROUP;
-  const uint word = b < 32u ? g.x : g.y;
-  const uint bit = b & 31u;
-  if (((word >> bit) & 1u) == 0u) return;
-  const uint before = uint(bitCount(word & ((1u << bit) - 1u))) + (b < 32u ? 0u : uint(bitCount(g.x)));
-  // The tile's first slot (light_cull_scan.comp) + the group's within the tile + the bits before.
-  const uint slot = groups[(i / GLINT_CULL_GROUP) / pc.tile_groups * pc.tile_groups].w + g.z + before;
+  uint slot;
+  if (!compact_slot(i, pc.tile_groups, slot)) return;
   const vec4 record = records[i];
   uint state = GLINT_FLARE_VISIBLE;
   if (slot < pc.capacity) {

@@ -19,7 +19,7 @@
 // 5. Two-phase culling (niagara): phase 1 emits objects whose history (the caller's visibility
 //    buffer) is VISIBLE and that pass the frustum test; phase 2 tests every object against the new
 //    pyramid, writes its state and emits the visible ones phase 1 did not. Emission is a bit in the
-//    workgroup's mask; object_cull_scan.comp and object_cull_scatter.comp turn the masks into
+//    workgroup's mask; the ordered compaction (compact.glsl) turns the masks into
 //    slots in object order, so the list is the same bits on every run.
 // GLINT_OBJECT_PHASE1 builds the phase-1 variant, which binds no image (the depth image may be a
 // render target while phase 1 runs).
@@ -46,10 +46,9 @@ layout(std430, binding = BINDING_VISIBILITY) readonly buffer Visibility { uint v
 #else
 layout(std430, binding = BINDING_VISIBILITY) buffer Visibility { uint visibility[]; };
 #endif
-layout(std430, binding = BINDING_GROUPS) buffer Groups {
-  uint counters[GLINT_OBJECT_HEADER_WORDS];
-  uvec4 groups[];  // emitted mask (x, y), first slot (z, the scan's), 0
-};
+#define COMPACT_GROUPS_BINDING BINDING_GROUPS  // the compaction's group buffer: this writes the masks (x, y)
+#define COMPACT_NO_SCAN
+#include "compact.glsl"
 layout(push_constant) uniform Push { GlintObjectCullPush pc; };
 
 shared uint s_mask[2];

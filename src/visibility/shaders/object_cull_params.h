@@ -1,25 +1,25 @@
-// Internal layouts of the object occlusion cull (not installed): the push constants of its three
-// dispatches (object_cull.comp: frustum + Hi-Z test; object_cull_scan.comp: one-workgroup prefix
-// sum of the per-workgroup visibility masks, indirect arguments and statistics;
-// object_cull_scatter.comp: payloads into their slots in object order) and the group buffer.
+// Internal layouts of the object occlusion cull (not installed): the push constants of its
+// dispatches (object_cull.comp: frustum + Hi-Z test; then the ordered compaction of
+// compact_params.h: compact_scan_tiles.comp, object_cull_scan.comp (tile totals, indirect
+// arguments and statistics) and compact_scatter.comp (payloads into their slots in object order)).
 // Declared once for GLSL and C++; src/visibility/object_cull.cpp static_asserts the layouts.
 #ifndef GLINT_OBJECT_CULL_PARAMS_H
 #define GLINT_OBJECT_CULL_PARAMS_H
+// The compaction's layouts (src/core/shaders): GLSL finds them by name, C++ by their path in src/.
+#ifdef __cplusplus
+#include "core/shaders/compact_params.h"
+#else
+#include "compact_params.h"
+#endif
 #include "glint/gpu/object_cull.h"
 
-// Objects per workgroup of object_cull.comp: one workgroup's emitted objects are one 64-bit mask.
-#define GLINT_OBJECT_GROUP 64u
-// The internal group buffer: GLINT_OBJECT_HEADER_WORDS counter words (zero between dispatches: the
-// scan resets them), then one uvec4 per workgroup: emitted mask of objects 0..31 (x), 32..63 (y),
-// slot within the tile (z) and, on a tile's first group, the tile's total and then its first slot (w),
-// written by the two scans.
+// Objects per workgroup of object_cull.comp: one workgroup's emitted objects are one 64-bit mask
+// of the compaction's group buffer (compact_params.h), whose header words count the states.
+#define GLINT_OBJECT_GROUP GLINT_COMPACT_GROUP
 #define GLINT_OBJECT_COUNTER_FRUSTUM 1u
 #define GLINT_OBJECT_COUNTER_OCCLUDED 2u
 #define GLINT_OBJECT_COUNTER_VISIBLE 3u
 #define GLINT_OBJECT_COUNTER_INVALID 4u
-#define GLINT_OBJECT_HEADER_WORDS 8u
-// Most invocations of the scan's single workgroup.
-#define GLINT_OBJECT_SCAN_MAX_THREADS 1024u
 
 // GlintObjectCullPush::flags: the mode in the low two bits, then options.
 #define GLINT_OBJECT_MODE_MASK 3u
@@ -61,14 +61,15 @@ struct GlintObjectCullPush {
   GLINT_UINT reserved;
 };
 
-// Push constants of object_cull_scan.comp and object_cull_scatter.comp (32 bytes).
+// Push constants of the object cull's compaction (32 bytes): GlintCompactPush with its step words
+// named (compact_scatter.comp reads step[0] as the payload words).
 struct GlintObjectCompactPush {
   GLINT_UINT count;              // objects
   GLINT_UINT capacity;           // payload slots of the output list
+  GLINT_UINT tile_groups;        // 64-object groups per tile of the two-level scan
+  GLINT_UINT groups_x;           // scatter: workgroups per row of its 2D dispatch
   GLINT_UINT payload_words;      // 0: the list holds object indices (one uint); else words copied per object
   GLINT_UINT objects_per_group;  // scan: dispatch group_count_x = ceil(written / this)
-  GLINT_UINT groups_x;           // scatter: workgroups per row of its 2D dispatch
-  GLINT_UINT tile_groups;        // scans and scatter: 64-object groups per tile of the two-level scan
   GLINT_UINT reserved[2];
 };
 

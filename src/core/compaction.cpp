@@ -1,0 +1,127 @@
+// The ordered compaction's host side (core/compaction.h).
+#include "core/compaction.h"
+
+#include <algorithm>
+#include <cstddef>
+
+#include "core/check.h"
+#include "core/context_state.h"
+
+namespace glint::detail {
+
+static_assert(sizeof(GlintCompactPush) == 32);
+static_assert(offsetof(GlintCompactPush, step) == 16);
+static_assert(GLINT_COMPACT_GROUP == 64, "compact.glsl keeps a group's mask in two 32-bit words");
+
+namespace {
+constexpr VkPipelineStageFlags2 kCompute = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
+constexpr VkAccessFlags2 kRead = VK_ACCESS_2_SHADER_STORAGE_READ_BIT;
+constexpr VkAccessFlags2 kWrite = VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT;
+constexpr uint32_t kGroup = GLINT_COMPACT_GROUP;
+}  // namespace
+
+Compaction::Compaction(const Context& context, const Desc& desc) {
+  VkPhysicalDeviceProperties props;
+  vkGetPhysicalDeviceProperties(context.physical_device(), &props);
+  max_groups_x_ = props.limits.maxComputeWorkGroupCount[0];
+  // The scan's workgroup size, from the device (CONTRIBUTING.md, "Device limits"). CPU devices
+  // (lavapipe) run a workgroup's invocations a few at a time and pay for every barrier per
+  // invocation: 64 there, where longer serial runs per invocation cost little.
+  const uint32_t cap = context.info().type == VK_PHYSICAL_DEVICE_TYPE_CPU ? 64u : GLINT_COMPACT_SCAN_MAX_THREADS;
+  scan_threads_ = std::min({cap, props.limits.maxComputeWorkGroupInvocations, props.limits.maxComputeWorkGroupSize[0]});
+  const auto B = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+  PipelineDesc d;
+  d.kernel_id = "compact_scan_tiles_main";
+  d.bindings = {B};
+  d.push_constant_bytes = sizeof(GlintCompactPush);
+  d.workgroup = {scan_threads_, 1};
+  scan_tiles_ = ComputePipeline(context, d);
+  d.kernel_id = desc.scan_kernel;
+  d.bindings.assign(1 + desc.scan_outputs, B);
+  scan_ = ComputePipeline(context, d);
+  d.kernel_id = desc.scatter_kernel;
+  d.bindings.assign(1 + desc.scatter_inputs + desc.scatter_outputs, B);
+  d.workgroup = {kGroup, 1};
+  scatter_ = ComputePipeline(context, d);
+  const VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+  const VkDeviceSize group_count = (VkDeviceSize(desc.max_items) + kGroup - 1) / kGroup;
+  groups_ = OwnedBuffer(context, GLINT_COMPACT_HEADER_WORDS * 4 + group_count * 16, usage, false);
+  groups_state_.buffer = groups_.buffer();
+  groups_state_.size = groups_.size();
+  groups_state_.usage = usage;
+  // At most 5 storage buffers in a set (the light cull's scatter); pools of 16 sets.
+  arena_ = DescriptorArena(context, 16, 8);
+  tiles_set_ = arena_.make_buffer_set(scan_tiles_, {groups_state_});
+}
+
+void Compaction::grid(uint32_t count, uint32_t& gx, uint32_t& gy) const {
+  const uint32_t g = std::max(1u, (count + kGroup - 1) / kGroup);
+  gx = std::min(g, max_groups_x_);
+  gy = (g + gx - 1) / gx;
+}
+
+VkDescriptorSet Compaction::set_for(const ComputePipeline& p, const std::vector<Buffer*>& buffers) {
+  std::vector<uint64_t> key{&p == &scan_ ? 0u : 1u};
+  std::vector<Buffer> bound{groups_state_};
+  for (const Buffer* b : buffers) {
+    key.push_back(reinterpret_cast<uint64_t>(b->buffer));
+    key.push_back(b->offset);
+    key.push_back(b->size);
+    bound.push_back(*b);
+  }
+  auto it = sets_.find(key);
+  if (it == sets_.end()) it = sets_.emplace(key, arena_.make_buffer_set(p, bound)).first;
+  return it->second;
+}
+
+void Compaction::record_clear_once(VkCommandBuffer cmd, Barriers& b) {
+  if (counters_cleared_) return;
+  b.use(groups_state_, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);  // fill = "transfer"
+  b.flush(cmd);
+  vkCmdFillBuffer(cmd, groups_.buffer(), 0, GLINT_COMPACT_HEADER_WORDS * 4, 0);
+  count_recorded_command();
+  counters_cleared_ = true;
+}
+
+void Compaction::record_scan(VkCommandBuffer cmd, Barriers& b, GlintCompactPush push,
+                             const std::vector<Buffer*>& outputs) {
+  const VkDescriptorSet top = set_for(scan_, outputs);
+  push.tile_groups = scan_threads_;
+  // 1. Tiles of scan_threads groups in parallel: slots within each tile, tile totals.
+  const uint32_t group_count = (push.count + kGroup - 1) / kGroup;
+  if (group_count > 0) {
+    b.use(groups_state_, kCompute, kRead | kWrite);
+    b.flush(cmd);
+    scan_tiles_.dispatch(cmd, tiles_set_, push, (group_count + scan_threads_ - 1) / scan_threads_ * scan_threads_, 1);
+  }
+  // 2. One workgroup: the tiles' first slots, then the user's outputs.
+  b.use(groups_state_, kCompute, kRead | kWrite);
+  for (Buffer* o : outputs) b.use(*o, kCompute, kWrite);
+  b.flush(cmd);
+  scan_.dispatch(cmd, top, push, scan_threads_, 1);
+}
+
+void Compaction::record_scatter(VkCommandBuffer cmd, Barriers& b, GlintCompactPush push,
+                                const std::vector<Buffer*>& inputs, const std::vector<Buffer*>& outputs) {
+  if (push.count == 0) return;
+  std::vector<Buffer*> all(inputs);
+  all.insert(all.end(), outputs.begin(), outputs.end());
+  const VkDescriptorSet set = set_for(scatter_, all);
+  uint32_t gx, gy;
+  grid(push.count, gx, gy);
+  push.tile_groups = scan_threads_;
+  push.groups_x = gx;
+  b.use(groups_state_, kCompute, kRead);
+  for (Buffer* in : inputs) b.use(*in, kCompute, kRead);
+  for (Buffer* o : outputs) b.use(*o, kCompute, kWrite);
+  b.flush(cmd);
+  scatter_.dispatch(cmd, set, push, gx * kGroup, gy);
+}
+
+void Compaction::forget_caller_resources() {
+  sets_.clear();
+  arena_.reset();
+  tiles_set_ = arena_.make_buffer_set(scan_tiles_, {groups_state_});
+}
+
+}  // namespace glint::detail

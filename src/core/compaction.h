@@ -1,0 +1,81 @@
+// The ordered compaction shared by the object cull and the light cull (kernels/common/compact.glsl,
+// docs/OCCLUSION.md "Ordered compaction"): the user's test kernel sets one bit per emitted item in
+// its 64-item group's mask of the group buffer this owns; record_scan() runs the two-level scan
+// (compact_scan_tiles.comp, then the user's top-level scan, which writes the user's indirect
+// arguments and statistics and resets the header's counters); record_scatter() runs the user's
+// scatter (or compact_scatter.comp, fixed-size payloads), which puts every emitted item's record
+// into its slot in item order, clamped to the capacity.
+#pragma once
+
+#include <glint/glint.h>
+
+#include <array>
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "core/shaders/compact_params.h"
+#include "core/barriers.h"
+#include "core/pipeline.h"
+#include "core/resources.h"
+
+namespace glint::detail {
+
+class Compaction {
+ public:
+  struct Desc {
+    uint32_t max_items = 1;  //!< items of the largest run (a group buffer of ceil(max_items / 64) groups)
+    /// The user's top-level scan (compact_top_scan of compact.glsl, then its outputs): binding 0
+    /// the group buffer, then `scan_outputs` storage buffers it writes.
+    std::string scan_kernel;
+    uint32_t scan_outputs = 2;
+    /// The scatter: one workgroup of 64 invocations per group (a 2D grid, groups_x per row);
+    /// binding 0 the group buffer, then `scatter_inputs` storage buffers it reads and
+    /// `scatter_outputs` it writes. "compact_scatter_main" copies GlintCompactPush::step[0]
+    /// payload words per item (0: the item index) from one input into one output.
+    std::string scatter_kernel = "compact_scatter_main";
+    uint32_t scatter_inputs = 1;
+    uint32_t scatter_outputs = 1;
+  };
+
+  Compaction() = default;
+  Compaction(const Context& context, const Desc& desc);
+
+  /// The group buffer (header counters, then one uvec4 per group): the user's test kernel writes
+  /// each group's mask (x, y) and adds to the counters.
+  Buffer& groups() { return groups_state_; }
+  /// Groups per tile of the scan (the scan workgroup's size, from the device).
+  uint32_t tile_groups() const { return scan_threads_; }
+  /// 64-item workgroups covering `count` items as a 2D grid of at most maxComputeWorkGroupCount[0]
+  /// per row (the user's test and the scatter).
+  void grid(uint32_t count, uint32_t& gx, uint32_t& gy) const;
+
+  /// Zeroes the header's counters the first time (the top-level scan resets them after every run).
+  void record_clear_once(VkCommandBuffer cmd, Barriers& b);
+  /// The two-level scan of `push.count` items; `outputs` are the top-level scan's buffers (written).
+  /// Fills push.tile_groups.
+  void record_scan(VkCommandBuffer cmd, Barriers& b, GlintCompactPush push, const std::vector<Buffer*>& outputs);
+  /// The scatter of `push.count` items: `inputs` read, `outputs` written. Fills push.tile_groups and
+  /// push.groups_x.
+  void record_scatter(VkCommandBuffer cmd, Barriers& b, GlintCompactPush push, const std::vector<Buffer*>& inputs,
+                      const std::vector<Buffer*>& outputs);
+  /// Drops the descriptor sets of caller buffers.
+  void forget_caller_resources();
+
+ private:
+  VkDescriptorSet set_for(const ComputePipeline& p, const std::vector<Buffer*>& buffers);
+
+  uint32_t max_groups_x_ = 65535;
+  uint32_t scan_threads_ = 1;
+  ComputePipeline scan_tiles_, scan_, scatter_;
+  OwnedBuffer groups_;
+  Buffer groups_state_;
+  bool counters_cleared_ = false;
+  VkDescriptorSet tiles_set_ = VK_NULL_HANDLE;
+  // Sets by pipeline and the (buffer, offset, size) of each binding after the group buffer.
+  std::map<std::vector<uint64_t>, VkDescriptorSet> sets_;
+  DescriptorArena arena_;
+};
+
+}  // namespace glint::detail
