@@ -503,8 +503,8 @@ TEST_F(ObjectCullTest, PayloadsAndOverflow) {
 
 // The two-level scan over many tiles (a tile is up to 1024 groups of 64 objects, 64 groups on CPU
 // devices): the list holds exactly the objects the cull left VISIBLE, in increasing index, with
-// the count and statistics to match, for counts that end inside a group, on a tile boundary and
-// one past it. The objects repeat a random scene's, so every tile has visible and hidden ones.
+// the count and statistics (every state's count) to match, for counts that end inside a group, on
+// a tile boundary and one past it. The objects repeat a random scene's, so every tile has visible and hidden ones.
 TEST_F(ObjectCullTest, ManyTilesCompactInObjectOrder) {
   SceneSpec s;
   s.objects = 4096;
@@ -532,9 +532,17 @@ TEST_F(ObjectCullTest, ManyTilesCompactInObjectOrder) {
     });
     const auto states = g.states(count);
     std::vector<uint32_t> expected;
+    uint32_t counts[4] = {};
     for (uint32_t i = 0; i < count; ++i) {
       if (states[i] == GLINT_OBJECT_STATE_VISIBLE) expected.push_back(i);
+      ASSERT_LE(states[i], 3u) << i;
+      counts[states[i]]++;
     }
+    // The statistics sum every tile's groups (the tile scan adds the groups' counts).
+    EXPECT_EQ(out.st().visible, counts[GLINT_OBJECT_STATE_VISIBLE]) << count;
+    EXPECT_EQ(out.st().occluded, counts[GLINT_OBJECT_STATE_OCCLUDED]) << count;
+    EXPECT_EQ(out.st().frustum_culled, counts[GLINT_OBJECT_STATE_FRUSTUM]) << count;
+    EXPECT_EQ(counts[GLINT_OBJECT_STATE_NONE], 0u) << count;
     ASSERT_GT(expected.size(), count / 100) << count;
     ASSERT_LT(expected.size(), count) << count;
     EXPECT_EQ(out.args().draw_count, expected.size()) << count;

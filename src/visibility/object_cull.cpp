@@ -26,7 +26,8 @@ using detail::concat;
 static_assert(sizeof(GlintCullObject) == 32);
 static_assert(offsetof(GlintCullObject, box_max) == 16);
 static_assert(offsetof(GlintCullObject, kind) == 28);
-static_assert(sizeof(GlintObjectCullPush) == 112);
+static_assert(sizeof(GlintObjectCullPush) == 128);
+static_assert(offsetof(GlintObjectCullPush, plane_len) == 112);
 static_assert(offsetof(GlintObjectCullPush, proj_x) == 48);
 static_assert(offsetof(GlintObjectCullPush, width) == 84);
 static_assert(offsetof(GlintObjectCullPush, groups_x) == 104);
@@ -135,6 +136,14 @@ void camera_push(const ObjectCullFrame& frame, bool reversed_z, GlintObjectCullP
   push.proj_ox = static_cast<float>(double(p[8]) * s);
   push.proj_y = p[5];
   push.proj_oy = static_cast<float>(double(p[9]) * s);
+  // The side planes' normal lengths |(s, 1 + o)| and |(-s, 1 - o)| per axis, exact in double then
+  // rounded up: never below the fp32 values the test used to compute.
+  const double ax[2][2] = {{push.proj_x, push.proj_ox}, {push.proj_y, push.proj_oy}};
+  for (int k = 0; k < 2; ++k) {
+    const double sk = ax[k][0], ok = ax[k][1];
+    push.plane_len[2 * k] = round_up(std::sqrt(sk * sk + (1.0 + ok) * (1.0 + ok)));
+    push.plane_len[2 * k + 1] = round_up(std::sqrt(sk * sk + (1.0 - ok) * (1.0 - ok)));
+  }
   const double a = double(p[10]) * s, b = p[14];
   push.depth_a = static_cast<float>(a);
   push.depth_b = p[14];

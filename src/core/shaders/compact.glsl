@@ -18,11 +18,16 @@ layout(std430, binding = COMPACT_GROUPS_BINDING)
 #endif
     buffer CompactGroups {
   uint counters[GLINT_COMPACT_HEADER_WORDS];
-  uvec4 groups[];  // emitted mask (x, y), slot within the tile (z), tile total / first slot on its first group (w)
+  uvec4 groups[];  // emitted mask (x, y), counts then slot within the tile (z), tile total / first slot (w)
 };
+
+// The test's per-group counts (each at most GLINT_COMPACT_GROUP = 64) as the bytes of a group's z;
+// compact_tile_scan adds count f of every group to counters[1 + f].
+uint compact_pack_counts(uvec4 c) { return c.x | (c.y << 8u) | (c.z << 16u) | (c.w << 24u); }
 
 #ifndef COMPACT_NO_SCAN
 shared uint s_compact_sum[2][GLINT_COMPACT_SCAN_MAX_THREADS];
+shared uint s_compact_counts[4][32];  // the tile's counts, spread over 32 words each
 
 // Inclusive prefix sum of `n` over the workgroup's invocations (all must call it); returns this
 // invocation's sum, `total` the workgroup's.
@@ -48,21 +53,35 @@ uint compact_workgroup_scan(uint n, out uint total) {
 #ifndef COMPACT_GROUPS_READONLY
 // Level 1: workgroup k takes the tile of `threads` consecutive groups, invocation t group
 // k * threads + t (coalesced loads); writes each group's z and the tile total into its first
-// group's w.
+// group's w. It also adds the groups' packed counts (z, from the test) to the header: one atomic
+// per tile and counter, where one per group and counter made many workgroups contend for the same
+// few words (atomics on one address are serialised).
 void compact_tile_scan(uint count) {
   const uint threads = gl_WorkGroupSize.x * gl_WorkGroupSize.y;
   const uint t = gl_LocalInvocationIndex;
   const uint group_count = (count + GLINT_COMPACT_GROUP - 1u) / GLINT_COMPACT_GROUP;
   const uint g = gl_WorkGroupID.x * threads + t;
-  uint n = 0u;
+  for (uint k = t; k < 128u; k += threads) s_compact_counts[k >> 5u][k & 31u] = 0u;
+  uint n = 0u, packed = 0u;
   if (g < group_count) {
     const uvec4 v = groups[g];
     n = uint(bitCount(v.x) + bitCount(v.y));
+    packed = v.z;
   }
   uint total;
-  const uint sum = compact_workgroup_scan(n, total);
+  const uint sum = compact_workgroup_scan(n, total);  // its barriers order the zeroing above
   if (g < group_count) groups[g].z = sum - n;
   if (t == 0u) groups[g].w = total;
+  for (uint f = 0u; f < 4u; ++f) {
+    const uint c = (packed >> (8u * f)) & 0xffu;
+    if (c != 0u) atomicAdd(s_compact_counts[f][t & 31u], c);
+  }
+  barrier();
+  if (t < 4u) {
+    uint c = 0u;
+    for (uint k = 0u; k < 32u; ++k) c += s_compact_counts[t][k];
+    if (c != 0u) atomicAdd(counters[1u + t], c);
+  }
 }
 
 // Level 2, one workgroup: turns the tile totals into each tile's first slot, an exclusive prefix

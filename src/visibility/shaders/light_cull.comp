@@ -147,11 +147,9 @@ void main() {
   if (in_range && state == GLINT_FLARE_OCCLUDED) atomicAdd(group_occluded, 1u);
   if (in_range && state == GLINT_FLARE_DISABLED) atomicAdd(group_disabled, 1u);
   barrier();
-  if (lid == 0u) {
-    groups[gl_WorkGroupID.x] = uvec4(group_mask[0], group_mask[1], 0u, 0u);
-    if (group_frustum > 0u) atomicAdd(counters[GLINT_CULL_COUNTER_FRUSTUM], group_frustum);
-    if (group_occluded > 0u) atomicAdd(counters[GLINT_CULL_COUNTER_OCCLUDED], group_occluded);
-    if (group_disabled > 0u) atomicAdd(counters[GLINT_CULL_COUNTER_DISABLED], group_disabled);
+  if (lid == 0u) {  // the counts go to the header through the tile scan (compact.glsl)
+    groups[gl_WorkGroupID.x] =
+        uvec4(group_mask[0], group_mask[1], compact_pack_counts(uvec4(group_frustum, group_occluded, group_disabled, 0u)), 0u);
   }
   // Visible lights get their result from the scatter, which knows whether they found a slot.
   if (in_range && !visible && (pc.flags & GLINT_CULL_WRITE_RESULTS) != 0u) {

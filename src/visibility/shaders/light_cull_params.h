@@ -40,6 +40,7 @@ struct GlintHiZPush {
 // integer sums, so the order of their atomics does not matter; no atomic decides where an instance
 // goes.
 #define GLINT_CULL_GROUP GLINT_COMPACT_GROUP
+// Counter 1 + f is count f the cull packs into its group record (compact_pack_counts).
 #define GLINT_CULL_COUNTER_FRUSTUM 1u
 #define GLINT_CULL_COUNTER_OCCLUDED 2u
 #define GLINT_CULL_COUNTER_DISABLED 3u

@@ -79,10 +79,10 @@ vec3 to_view(vec3 p, out float err) {
 // Largest signed distance, over points q of a set, of q to the two side planes of one axis
 // (|s * c / w + o| <= 1, i.e. s * c + (1 + o) w >= 0 and -s * c + (1 - o) w >= 0), each widened by
 // `r` (the point's inflation) and the fp32 error of the plane evaluation. Callers take the max
-// over the set's points; the set is outside a plane when that max is negative.
-vec2 plane_margin(float c, float w, float r, float s, float o) {
+// over the set's points; the set is outside a plane when that max is negative. `len` holds the
+// normals' lengths (pc.plane_len: per frame, rounded up on the host).
+vec2 plane_margin(float c, float w, float r, float s, float o, vec2 len) {
   const vec2 nx = vec2(s, -s), nw = vec2(1.0 + o, 1.0 - o);
-  const vec2 len = sqrt(nx * nx + nw * nw);
   const vec2 d = nx * c + nw * w;
   return d + len * r * (1.0 + kEps) + kEps * (abs(nx * c) + abs(nw * w));
 }
@@ -135,6 +135,22 @@ uint hiz_test(vec2 x, vec2 y, float z, bool reversed) {
   const int k = min(span <= 2 ? 0 : findMSB(span - 2) + 1, int(pc.levels));
   const ivec2 lsize = max(ivec2(1), isize >> k);
   const ivec2 t0 = min(p0 >> k, lsize - 1), t1 = min(p1 >> k, lsize - 1);
+  // Visible where the stored (farthest) depth is not nearer than the object.
+  if (t1.x - t0.x <= 1 && t1.y - t0.y <= 1) {
+    // The usual window (the level was chosen for it): one pattern of 4 independent fetches, the
+    // corners of [t0, t1] (a 1-texel side reads its texel twice), compared texel by texel (a NaN
+    // texel passes no comparison, as in the loop below).
+    vec4 d;
+    if (k == 0) {
+      d = vec4(texelFetch(depth_tex, t0, 0).r, texelFetch(depth_tex, ivec2(t1.x, t0.y), 0).r,
+               texelFetch(depth_tex, ivec2(t0.x, t1.y), 0).r, texelFetch(depth_tex, t1, 0).r);
+    } else {
+      d = vec4(texelFetch(hiz_tex, t0, k - 1).r, texelFetch(hiz_tex, ivec2(t1.x, t0.y), k - 1).r,
+               texelFetch(hiz_tex, ivec2(t0.x, t1.y), k - 1).r, texelFetch(hiz_tex, t1, k - 1).r);
+    }
+    const bvec4 v = reversed ? lessThanEqual(d, vec4(z)) : greaterThanEqual(d, vec4(z));
+    return any(v) ? GLINT_OBJECT_STATE_VISIBLE : GLINT_OBJECT_STATE_OCCLUDED;
+  }
   if ((t1.x - t0.x + 1) * (t1.y - t0.y + 1) > GLINT_OBJECT_MAX_WINDOW) return GLINT_OBJECT_STATE_VISIBLE;
   for (int ty = t0.y; ty <= t1.y; ++ty) {
     for (int tx = t0.x; tx <= t1.x; ++tx) {
@@ -166,8 +182,8 @@ uint test_object(GlintCullObject o, bool frustum_only, out bool invalid) {
     const float r = radius * pc.radius_scale * (1.0 + kEps) + err;
     if (!finite3(c) || !finite_f(r)) return GLINT_OBJECT_STATE_VISIBLE;  // overflow: conservative
     if (c.z - r > far_hi || c.z + r < near_lo) return GLINT_OBJECT_STATE_FRUSTUM;
-    const vec2 mx = plane_margin(c.x, c.z, r, pc.proj_x, pc.proj_ox);
-    const vec2 my = plane_margin(c.y, c.z, r, pc.proj_y, pc.proj_oy);
+    const vec2 mx = plane_margin(c.x, c.z, r, pc.proj_x, pc.proj_ox, vec2(pc.plane_len[0], pc.plane_len[1]));
+    const vec2 my = plane_margin(c.y, c.z, r, pc.proj_y, pc.proj_oy, vec2(pc.plane_len[2], pc.plane_len[3]));
     if (min(min(mx.x, mx.y), min(my.x, my.y)) < 0.0) return GLINT_OBJECT_STATE_FRUSTUM;
     if (frustum_only || c.z - r < near_hi) return GLINT_OBJECT_STATE_VISIBLE;  // in, or crossing near
 #ifndef GLINT_OBJECT_PHASE1
@@ -184,32 +200,34 @@ uint test_object(GlintCullObject o, bool frustum_only, out bool invalid) {
     // The corners' error bound: the largest terms of any corner.
     float r;
     to_view(max(abs(a), abs(b)), r);
-    vec3 v[8];
     float w_min = 3.4028235e38, w_max = -3.4028235e38;
     vec4 side = vec4(-3.4028235e38);  // max over corners of the four side-plane margins
+    const vec2 len_x = vec2(pc.plane_len[0], pc.plane_len[1]), len_y = vec2(pc.plane_len[2], pc.plane_len[3]);
+    // The corners' slope intervals, in the same pass (no array of corners is kept; used only
+    // when the box is in front of the near plane, where w - r > 0). Each slope is widened by its
+    // point error r (|d(c / w)| <= r (1 + |c / w|) / (w - r)) and the rounding of the reciprocal
+    // and products (a few units in the last place of |m|, within kEps |m|).
+    vec2 sx = vec2(3.4028235e38, -3.4028235e38), sy = sx;
     for (int j = 0; j < 8; ++j) {
       float unused;
-      v[j] = to_view(vec3((j & 1) != 0 ? b.x : a.x, (j & 2) != 0 ? b.y : a.y, (j & 4) != 0 ? b.z : a.z), unused);
-      if (!finite3(v[j])) return GLINT_OBJECT_STATE_VISIBLE;
-      w_min = min(w_min, v[j].z);
-      w_max = max(w_max, v[j].z);
-      side = max(side, vec4(plane_margin(v[j].x, v[j].z, r, pc.proj_x, pc.proj_ox),
-                            plane_margin(v[j].y, v[j].z, r, pc.proj_y, pc.proj_oy)));
+      const vec3 v = to_view(vec3((j & 1) != 0 ? b.x : a.x, (j & 2) != 0 ? b.y : a.y, (j & 4) != 0 ? b.z : a.z), unused);
+      if (!finite3(v)) return GLINT_OBJECT_STATE_VISIBLE;
+      w_min = min(w_min, v.z);
+      w_max = max(w_max, v.z);
+      side = max(side, vec4(plane_margin(v.x, v.z, r, pc.proj_x, pc.proj_ox, len_x),
+                            plane_margin(v.y, v.z, r, pc.proj_y, pc.proj_oy, len_y)));
+#ifndef GLINT_OBJECT_PHASE1
+      const vec2 m = v.xy * (1.0 / v.z);
+      const vec2 e = (r * (1.0 / (v.z - r))) * (1.0 + abs(m)) + kEps * abs(m);
+      sx = vec2(min(sx.x, m.x - e.x), max(sx.y, m.x + e.x));
+      sy = vec2(min(sy.x, m.y - e.y), max(sy.y, m.y + e.y));
+#endif
     }
     if (!finite_f(r)) return GLINT_OBJECT_STATE_VISIBLE;
     if (w_min - r > far_hi || w_max + r < near_lo) return GLINT_OBJECT_STATE_FRUSTUM;
     if (min(min(side.x, side.y), min(side.z, side.w)) < 0.0) return GLINT_OBJECT_STATE_FRUSTUM;
     if (frustum_only || w_min - r < near_hi) return GLINT_OBJECT_STATE_VISIBLE;
 #ifndef GLINT_OBJECT_PHASE1
-    // Slopes of the corners, each widened by its point error r (|d(c / w)| <= r (1 + |c / w|) / (w - r))
-    // and the division's rounding.
-    vec2 sx = vec2(3.4028235e38, -3.4028235e38), sy = sx;
-    for (int j = 0; j < 8; ++j) {
-      const vec2 m = v[j].xy / v[j].z;
-      const vec2 e = r * (1.0 + abs(m)) / (v[j].z - r) + kEps * abs(m);
-      sx = vec2(min(sx.x, m.x - e.x), max(sx.y, m.x + e.x));
-      sy = vec2(min(sy.x, m.y - e.y), max(sy.y, m.y + e.y));
-    }
     const vec2 x = slopes_to_ndc(sx, pc.proj_x, pc.proj_ox);
     const vec2 y = slopes_to_ndc(sy, pc.proj_y, pc.proj_oy);
     return hiz_test(x, y, nearest_depth(w_min - r, reversed), reversed);
@@ -254,11 +272,7 @@ void main() {
   if (state == GLINT_OBJECT_STATE_VISIBLE) atomicAdd(s_visible, 1u);
   if (invalid) atomicAdd(s_invalid, 1u);
   barrier();
-  if (lid == 0u && group < group_count) {
-    groups[group] = uvec4(s_mask[0], s_mask[1], 0u, 0u);
-    if (s_frustum > 0u) atomicAdd(counters[GLINT_OBJECT_COUNTER_FRUSTUM], s_frustum);
-    if (s_occluded > 0u) atomicAdd(counters[GLINT_OBJECT_COUNTER_OCCLUDED], s_occluded);
-    if (s_visible > 0u) atomicAdd(counters[GLINT_OBJECT_COUNTER_VISIBLE], s_visible);
-    if (s_invalid > 0u) atomicAdd(counters[GLINT_OBJECT_COUNTER_INVALID], s_invalid);
+  if (lid == 0u && group < group_count) {  // the counts go to the header through the tile scan
+    groups[group] = uvec4(s_mask[0], s_mask[1], compact_pack_counts(uvec4(s_frustum, s_occluded, s_visible, s_invalid)), 0u);
   }
 }

@@ -16,6 +16,7 @@
 // Objects per workgroup of object_cull.comp: one workgroup's emitted objects are one 64-bit mask
 // of the compaction's group buffer (compact_params.h), whose header words count the states.
 #define GLINT_OBJECT_GROUP GLINT_COMPACT_GROUP
+// Counter 1 + f is count f the test packs into its group record (compact_pack_counts).
 #define GLINT_OBJECT_COUNTER_FRUSTUM 1u
 #define GLINT_OBJECT_COUNTER_OCCLUDED 2u
 #define GLINT_OBJECT_COUNTER_VISIBLE 3u
@@ -36,7 +37,7 @@
 // max_cell_px) below the level an object needs. A larger window counts as visible without reading.
 #define GLINT_OBJECT_MAX_WINDOW 64
 
-// Push constants of object_cull.comp (112 bytes). The camera in the form the test uses: view space
+// Push constants of object_cull.comp (128 bytes: the most Vulkan guarantees). The camera in the form the test uses: view space
 // with w = P32 * z_view (the clip w), and the projection's non-zero terms
 // (ndc.x = proj_x * x / w + proj_ox, ndc.y = proj_y * y / w + proj_oy, depth = depth_a + depth_b / w).
 struct GlintObjectCullPush {
@@ -59,6 +60,10 @@ struct GlintObjectCullPush {
   GLINT_UINT flags;     // GLINT_OBJECT_MODE_* | GLINT_OBJECT_REVERSED_Z
   GLINT_UINT groups_x;  // workgroups per row of the 2D dispatch (group = y * groups_x + x)
   GLINT_UINT reserved;
+  // Lengths of the side planes' normals (proj_x, 1 + proj_ox), (-proj_x, 1 - proj_ox), then the
+  // same of y, computed in double and rounded up (a per-frame constant the test would otherwise
+  // take 2 square roots per plane evaluation for).
+  GLINT_FLOAT plane_len[4];
 };
 
 // Push constants of the object cull's compaction (32 bytes): GlintCompactPush with its step words
