@@ -26,10 +26,22 @@ GPU time (x) against the mean |visible fraction - brute force| (y).
 
     python3 bench/plot.py --chart occlusion --lights 1000000 --out docs/charts/occlusion_pareto.svg \
         "H100=docs/perf/occlusion_h100.json"
+
+--chart object_cull draws the object cull's false positives against its time: one point per
+BM_ObjectCull run at --objects objects (bounds: mixed, spheres, boxes): median GPU time of the
+whole cull (x) against false_positive_share (y: of the first 4096 objects that brute force finds
+hidden, the share the cull keeps). --peer DEVICE=object_cull_torch.json adds the PyTorch peer's
+methods (bench/peers/object_cull_torch.py) to the panel of that device. The caption names each
+panel's device (from the runs' labels) and --commit (default: git rev-parse --short HEAD).
+
+    python3 bench/plot.py --chart object_cull --out docs/charts/object_cull_fp_time.svg \
+        "lavapipe=docs/perf/object_cull_lavapipe.json" "H100=docs/perf/object_cull_h100.json" \
+        --peer "H100=docs/perf/object_cull_torch_h100.json"
 """
 import argparse
 import json
 import re
+import subprocess
 
 import matplotlib
 
@@ -160,16 +172,83 @@ def main_occlusion(args):
     print("wrote", args.out)
 
 
+OBJECT_BOUNDS = {0: "mixed (1/4 boxes)", 1: "spheres", 2: "boxes"}
+
+
+def object_cull_points(path, objects):
+    """([(label, median_us, false_positive_share)], device) of the BM_ObjectCull runs at `objects`.
+
+    Medians of repetitions are used when present, else the single runs."""
+    rows = json.load(open(path))["benchmarks"]
+    has_medians = any(b.get("aggregate_name") == "median" for b in rows)
+    out, device = [], ""
+    for b in rows:
+        if not b["name"].startswith("BM_ObjectCull/") or "false_positive_share" not in b:
+            continue
+        if has_medians and b.get("aggregate_name") != "median":
+            continue
+        if not has_medians and b.get("run_type") == "aggregate":
+            continue
+        m = re.search(r"objects:(\d+)(?:/bounds:(\d+))?", b["name"])
+        if not m or int(m.group(1)) != objects:
+            continue
+        label = b.get("label", "")
+        if " on " in label:
+            device = label.split(" on ", 1)[1]
+        out.append((OBJECT_BOUNDS[int(m.group(2) or 0)], b["median_us"], b["false_positive_share"]))
+    return out, device
+
+
+def main_object_cull(args):
+    commit = args.commit
+    if commit is None:
+        commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip()
+    peers = dict(spec.split("=", 1) for spec in (args.peer or []))
+    fig, axes = plt.subplots(1, len(args.inputs), figsize=(6.0 * len(args.inputs), 4.8), squeeze=False)
+    captions = []
+    markers = "osD^vP*X"
+    for ax, spec in zip(axes[0], args.inputs):
+        name, path = spec.split("=", 1)
+        pts, device = object_cull_points(path, args.objects)
+        for i, (label, us, fp) in enumerate(pts):
+            ax.scatter(us, 100.0 * fp, s=50, marker=markers[i % len(markers)], label=f"glint: {label}")
+        if name in peers:
+            rows = json.load(open(peers[name]))
+            for j, r in enumerate(x for x in rows["object_cull"] if x["objects"] == args.objects):
+                ax.scatter(r["median_us"], 100.0 * r["false_positive_share"], s=50, marker="x",
+                           color=f"C{4 + j}", label=f"PyTorch peer: {r['method']} (spheres, own depth)")
+        times = [p[1] for p in pts]
+        if times and max(times) / min(times) > 20:
+            ax.set_xscale("log")
+        ax.set_ylim(bottom=0)
+        ax.set_xlabel("median GPU time of the cull, us")
+        ax.set_ylabel("false positives, % of brute-force-hidden objects")
+        ax.set_title(f"object cull, {args.objects:,} objects, 1920x1080, on {name}")
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize=7, loc="best")
+        captions.append(f"{name}: {device or 'device unknown'}")
+    fig.text(0.01, 0.01, "; ".join(captions) + f"; glint commit {commit}", fontsize=7, ha="left", va="bottom")
+    fig.tight_layout(rect=(0, 0.04, 1, 1))
+    fig.savefig(args.out)
+    print("wrote", args.out)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("inputs", nargs="+", help="DEVICE=results.json")
-    ap.add_argument("--chart", choices=["bloom", "blur", "occlusion"], default="bloom")
+    ap.add_argument("--chart", choices=["bloom", "blur", "occlusion", "object_cull"], default="bloom")
     ap.add_argument("--size", default=None, help="WxH (bloom default 1920x1080; blur default: all sizes)")
     ap.add_argument("--out", default=None, help="default docs/charts/<chart>_pareto.svg")
     ap.add_argument("--lights", type=int, default=1000000, help="light count of the occlusion chart")
+    ap.add_argument("--objects", type=int, default=1000000, help="object count of the object_cull chart")
+    ap.add_argument("--peer", action="append", help="DEVICE=object_cull_torch.json (object_cull chart)")
+    ap.add_argument("--commit", default=None, help="commit named in the object_cull caption")
     args = ap.parse_args()
     if args.out is None:
-        args.out = f"docs/charts/{args.chart}_pareto.svg"
+        args.out = "docs/charts/object_cull_fp_time.svg" if args.chart == "object_cull" else \
+            f"docs/charts/{args.chart}_pareto.svg"
+    if args.chart == "object_cull":
+        return main_object_cull(args)
     if args.chart == "blur":
         plot_blur(args)
         return
