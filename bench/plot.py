@@ -28,7 +28,8 @@ GPU time (x) against the mean |visible fraction - brute force| (y).
         "H100=docs/perf/occlusion_h100.json"
 
 --chart object_cull draws the object cull's false positives against its time: one point per
-BM_ObjectCull run at --objects objects (bounds: mixed, spheres, boxes): median GPU time of the
+BM_ObjectCull (mixed bounds) and BM_ObjectCullBounds (bounds:1 spheres, bounds:2 boxes) run at
+--objects objects: median GPU time of the
 whole cull (x) against false_positive_share (y: of the first 4096 objects that brute force finds
 hidden, the share the cull keeps). --peer DEVICE=object_cull_torch.json adds the PyTorch peer's
 methods (bench/peers/object_cull_torch.py) to the panel of that device. The caption names each
@@ -183,7 +184,7 @@ def object_cull_points(path, objects):
     has_medians = any(b.get("aggregate_name") == "median" for b in rows)
     out, device = [], ""
     for b in rows:
-        if not b["name"].startswith("BM_ObjectCull/") or "false_positive_share" not in b:
+        if not re.match(r"BM_ObjectCull(Bounds)?/", b["name"]) or "false_positive_share" not in b:
             continue
         if has_medians and b.get("aggregate_name") != "median":
             continue

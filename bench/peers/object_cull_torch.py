@@ -31,7 +31,7 @@ Usage: python3 bench/peers/object_cull_torch.py [--objects 1000000,10000000] [--
                                                 [--check 4096] [--out object_cull_torch.json]
 Prints a table and writes JSON:
   {"device", "torch", "width", "height",
-   "object_cull": [{"objects", "method", "median_us", "visible_share", "occluded_share",
+   "object_cull": [{"objects", "method", "peer", "median_us", "visible_share", "occluded_share",
                     "false_positive_share", "checked_hidden"}, ...]}
 Exits with status 0 and a message when PyTorch or CUDA is not available (--device cpu runs the
 same code on the CPU for a smoke test; its times mean nothing).
@@ -314,7 +314,7 @@ def main():
                 raise SystemExit(f"{label}: the list is not the visible objects in order")
             m = min(n, args.check)
             fp = int(((state[:m] == 1) & hidden).sum())
-            row = {"objects": n, "method": label, "median_us": ms * 1e3,
+            row = {"objects": n, "method": label, "peer": f"PyTorch {label}", "median_us": ms * 1e3,
                    "visible_share": float((state == 1).double().mean()),
                    "occluded_share": float((state == 2).double().mean()),
                    "false_positive_share": fp / max(1, int(hidden.sum())), "checked_hidden": int(hidden.sum())}
