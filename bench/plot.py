@@ -211,18 +211,25 @@ def main_object_cull(args):
     for ax, spec in zip(axes[0], args.inputs):
         name, path = spec.split("=", 1)
         pts, device = object_cull_points(path, args.objects)
-        for i, (label, us, fp) in enumerate(pts):
-            ax.scatter(us, 100.0 * fp, s=50, marker=markers[i % len(markers)], label=f"glint: {label}")
+        peer_rows = []
         if name in peers:
-            rows = json.load(open(peers[name]))
-            for j, r in enumerate(x for x in rows["object_cull"] if x["objects"] == args.objects):
-                ax.scatter(r["median_us"], 100.0 * r["false_positive_share"], s=50, marker="x",
-                           color=f"C{4 + j}", label=f"PyTorch peer: {r['method']} (spheres, own depth)")
-        times = [p[1] for p in pts]
+            peer_rows = [x for x in json.load(open(peers[name]))["object_cull"] if x["objects"] == args.objects]
+        times = [p[1] for p in pts] + [r["median_us"] for r in peer_rows]
+        # Milliseconds where the times are long (CPU devices), microseconds otherwise.
+        unit, scale = ("ms", 1e-3) if times and max(times) > 1e4 else ("us", 1.0)
+        for i, (label, us, fp) in enumerate(pts):
+            ax.scatter(us * scale, 100.0 * fp, s=50, marker=markers[i % len(markers)], label=f"glint: {label}")
+            ax.annotate(label.split(" ")[0], (us * scale, 100.0 * fp), textcoords="offset points", xytext=(6, 4),
+                        fontsize=8)
+        for j, r in enumerate(peer_rows):
+            ax.scatter(r["median_us"] * scale, 100.0 * r["false_positive_share"], s=50, marker="x", color=f"C{4 + j}",
+                       label=f"PyTorch peer: {r['method']} (spheres, own depth)")
         if times and max(times) / min(times) > 20:
             ax.set_xscale("log")
-        ax.set_ylim(bottom=0)
-        ax.set_xlabel("median GPU time of the cull, us")
+        shares = [100.0 * p[2] for p in pts] + [100.0 * r["false_positive_share"] for r in peer_rows]
+        ax.set_ylim(0, 1.2 * max(shares + [0.1]))
+        ax.margins(x=0.15)
+        ax.set_xlabel(f"median GPU time of the cull, {unit}")
         ax.set_ylabel("false positives, % of brute-force-hidden objects")
         ax.set_title(f"object cull, {args.objects:,} objects, 1920x1080, on {name}")
         ax.grid(True, alpha=0.3)

@@ -19,7 +19,8 @@ What it measures, on the same machine and in the same session as glint:
      cannot be captured: timed eagerly with CUDA events around each call (median of --reps).
   4. The false-positive share of the first --check objects: those hidden by brute force (the
      exact projected rectangle in float64, every pixel of the depth image under it) that the
-     test keeps, over those hidden, the quantity of BM_ObjectCull's false_positive_share.
+     test keeps, over those hidden, the quantity of BM_ObjectCull's false_positive_share; and the
+     false negatives among them (brute-force visible, culled: possible here, never in glint).
 
 The scene follows BM_ObjectCull: 1920x1080 depth, identity view, a Vulkan perspective (vertical
 field of view 1 rad, near 0.1, far 100, standard Z, y flipped), spheres at distance 0.5 to 60.5
@@ -32,7 +33,7 @@ Usage: python3 bench/peers/object_cull_torch.py [--objects 1000000,10000000] [--
 Prints a table and writes JSON:
   {"device", "torch", "width", "height",
    "object_cull": [{"objects", "method", "peer", "median_us", "visible_share", "occluded_share",
-                    "false_positive_share", "checked_hidden"}, ...]}
+                    "false_positive_share", "checked_hidden", "false_negatives"}, ...]}
 Exits with status 0 and a message when PyTorch or CUDA is not available (--device cpu runs the
 same code on the CPU for a smoke test; its times mean nothing).
 """
@@ -292,7 +293,8 @@ def main():
     depth = make_depth(gen, torch.device("cpu")).to(dev)
     levels = hiz_levels(depth)
     print(f"device: {name}  torch {torch.__version__}  {WIDTH}x{HEIGHT}, {len(levels) - 1} Hi-Z levels")
-    print(f"{'objects':>9} {'method':<26} {'median us':>10} {'visible':>8} {'occluded':>9} {'fp share':>9}")
+    print(f"{'objects':>9} {'method':<26} {'median us':>10} {'visible':>8} {'occluded':>9} {'fp share':>9} "
+          f"{'missed':>6}")
     for n in (int(v) for v in args.objects.split(",")):
         ogen = torch.Generator(device="cpu").manual_seed(7)
         objects = make_objects(n, ogen, torch.device("cpu")).to(dev)
@@ -314,13 +316,15 @@ def main():
                 raise SystemExit(f"{label}: the list is not the visible objects in order")
             m = min(n, args.check)
             fp = int(((state[:m] == 1) & hidden).sum())
+            fn = int(((state[:m] != 1) & ~hidden).sum())  # no margins: this peer may miss objects
             row = {"objects": n, "method": label, "peer": f"PyTorch {label}", "median_us": ms * 1e3,
                    "visible_share": float((state == 1).double().mean()),
                    "occluded_share": float((state == 2).double().mean()),
-                   "false_positive_share": fp / max(1, int(hidden.sum())), "checked_hidden": int(hidden.sum())}
+                   "false_positive_share": fp / max(1, int(hidden.sum())), "checked_hidden": int(hidden.sum()),
+                   "false_negatives": fn}
             results["object_cull"].append(row)
             print(f"{n:>9} {label:<26} {row['median_us']:>10.1f} {row['visible_share']:>8.3f} "
-                  f"{row['occluded_share']:>9.3f} {row['false_positive_share']:>9.4f}")
+                  f"{row['occluded_share']:>9.3f} {row['false_positive_share']:>9.4f} {fn:>6}")
     if args.out:
         with open(args.out, "w") as f:
             json.dump(results, f, indent=2)
