@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cstddef>
+#include <vector>
 
 #include "core/check.h"
 #include "core/context_state.h"
@@ -21,6 +22,9 @@ constexpr uint32_t kGroup = GLINT_COMPACT_GROUP;
 }  // namespace
 
 Compaction::Compaction(const Context& context, const Desc& desc) {
+  if (desc.scan_outputs > kMaxBuffers || desc.scatter_inputs + desc.scatter_outputs > kMaxBuffers) {
+    throw Error(ErrorCode::invalid_argument, concat("Compaction: at most ", kMaxBuffers, " buffers per kernel"));
+  }
   VkPhysicalDeviceProperties props;
   vkGetPhysicalDeviceProperties(context.physical_device(), &props);
   max_groups_x_ = props.limits.maxComputeWorkGroupCount[0];
@@ -60,17 +64,24 @@ void Compaction::grid(uint32_t count, uint32_t& gx, uint32_t& gy) const {
   gy = (g + gx - 1) / gx;
 }
 
-VkDescriptorSet Compaction::set_for(const ComputePipeline& p, const std::vector<Buffer*>& buffers) {
-  std::vector<uint64_t> key{&p == &scan_ ? 0u : 1u};
-  std::vector<Buffer> bound{groups_state_};
-  for (const Buffer* b : buffers) {
-    key.push_back(reinterpret_cast<uint64_t>(b->buffer));
-    key.push_back(b->offset);
-    key.push_back(b->size);
-    bound.push_back(*b);
+VkDescriptorSet Compaction::set_for(uint32_t which, const ComputePipeline& p, const Buffer* const* buffers,
+                                    size_t count) {
+  if (count > kMaxBuffers) {
+    throw Error(ErrorCode::invalid_argument, concat("Compaction: ", count, " buffers; at most ", kMaxBuffers));
+  }
+  SetKey key{};
+  key[0] = which;
+  for (size_t i = 0; i < count; ++i) {
+    key[1 + 3 * i] = reinterpret_cast<uint64_t>(buffers[i]->buffer);
+    key[2 + 3 * i] = buffers[i]->offset;
+    key[3 + 3 * i] = buffers[i]->size;
   }
   auto it = sets_.find(key);
-  if (it == sets_.end()) it = sets_.emplace(key, arena_.make_buffer_set(p, bound)).first;
+  if (it == sets_.end()) {
+    std::vector<Buffer> bound{groups_state_};
+    for (size_t i = 0; i < count; ++i) bound.push_back(*buffers[i]);
+    it = sets_.emplace(key, arena_.make_buffer_set(p, bound)).first;
+  }
   return it->second;
 }
 
@@ -84,8 +95,8 @@ void Compaction::record_clear_once(VkCommandBuffer cmd, Barriers& b) {
 }
 
 void Compaction::record_scan(VkCommandBuffer cmd, Barriers& b, GlintCompactPush push,
-                             const std::vector<Buffer*>& outputs) {
-  const VkDescriptorSet top = set_for(scan_, outputs);
+                             std::initializer_list<Buffer*> outputs) {
+  const VkDescriptorSet top = set_for(0, scan_, outputs.begin(), outputs.size());
   push.tile_groups = scan_threads_;
   // 1. Tiles of scan_threads groups in parallel: slots within each tile, tile totals.
   const uint32_t group_count = (push.count + kGroup - 1) / kGroup;
@@ -102,11 +113,17 @@ void Compaction::record_scan(VkCommandBuffer cmd, Barriers& b, GlintCompactPush 
 }
 
 void Compaction::record_scatter(VkCommandBuffer cmd, Barriers& b, GlintCompactPush push,
-                                const std::vector<Buffer*>& inputs, const std::vector<Buffer*>& outputs) {
+                                std::initializer_list<Buffer*> inputs, std::initializer_list<Buffer*> outputs) {
   if (push.count == 0) return;
-  std::vector<Buffer*> all(inputs);
-  all.insert(all.end(), outputs.begin(), outputs.end());
-  const VkDescriptorSet set = set_for(scatter_, all);
+  std::array<const Buffer*, kMaxBuffers> all{};
+  size_t n = 0;
+  for (const auto* list : {&inputs, &outputs}) {
+    for (Buffer* x : *list) {
+      if (n == kMaxBuffers) throw Error(ErrorCode::invalid_argument, "Compaction: too many scatter buffers");
+      all[n++] = x;
+    }
+  }
+  const VkDescriptorSet set = set_for(1, scatter_, all.data(), n);
   uint32_t gx, gy;
   grid(push.count, gx, gy);
   push.tile_groups = scan_threads_;

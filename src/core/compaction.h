@@ -11,9 +11,9 @@
 
 #include <array>
 #include <cstdint>
+#include <initializer_list>
 #include <map>
 #include <string>
-#include <vector>
 
 #include "core/shaders/compact_params.h"
 #include "core/barriers.h"
@@ -55,16 +55,20 @@ class Compaction {
   void record_clear_once(VkCommandBuffer cmd, Barriers& b);
   /// The two-level scan of `push.count` items; `outputs` are the top-level scan's buffers (written).
   /// Fills push.tile_groups.
-  void record_scan(VkCommandBuffer cmd, Barriers& b, GlintCompactPush push, const std::vector<Buffer*>& outputs);
+  void record_scan(VkCommandBuffer cmd, Barriers& b, GlintCompactPush push, std::initializer_list<Buffer*> outputs);
   /// The scatter of `push.count` items: `inputs` read, `outputs` written. Fills push.tile_groups and
   /// push.groups_x.
-  void record_scatter(VkCommandBuffer cmd, Barriers& b, GlintCompactPush push, const std::vector<Buffer*>& inputs,
-                      const std::vector<Buffer*>& outputs);
+  void record_scatter(VkCommandBuffer cmd, Barriers& b, GlintCompactPush push, std::initializer_list<Buffer*> inputs,
+                      std::initializer_list<Buffer*> outputs);
   /// Drops the descriptor sets of caller buffers.
   void forget_caller_resources();
 
  private:
-  VkDescriptorSet set_for(const ComputePipeline& p, const std::vector<Buffer*>& buffers);
+  static constexpr size_t kMaxBuffers = 6;  // user buffers of one set (after the group buffer)
+  // Sets by pipeline (0: the top-level scan, 1: the scatter) and the (buffer, offset, size) of
+  // each binding after the group buffer: a fixed-size key, so a frame allocates nothing.
+  using SetKey = std::array<uint64_t, 1 + 3 * kMaxBuffers>;
+  VkDescriptorSet set_for(uint32_t which, const ComputePipeline& p, const Buffer* const* buffers, size_t count);
 
   uint32_t max_groups_x_ = 65535;
   uint32_t scan_threads_ = 1;
@@ -73,8 +77,7 @@ class Compaction {
   Buffer groups_state_;
   bool counters_cleared_ = false;
   VkDescriptorSet tiles_set_ = VK_NULL_HANDLE;
-  // Sets by pipeline and the (buffer, offset, size) of each binding after the group buffer.
-  std::map<std::vector<uint64_t>, VkDescriptorSet> sets_;
+  std::map<SetKey, VkDescriptorSet> sets_;
   DescriptorArena arena_;
 };
 
