@@ -17,7 +17,6 @@
 #include "core/barriers.h"
 #include "core/resources.h"
 #include "reference/object_cull_reference.h"
-#include "support/transfer.h"
 
 namespace glint::bench {
 namespace {

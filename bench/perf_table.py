@@ -84,8 +84,10 @@ def peer_medians(specs):
                 c = d["compaction"]
                 out[f"compaction:{c['lights']}"] = (c["median_us"], "nonzero + gather alone")
         elif kind == "object_cull":
-            for r in d["object_cull"]:
-                out[f"object_cull:{r['objects']}"] = (r["median_us"], r.get("peer", "PyTorch"))
+            for r in d["object_cull"]:  # the fastest of the peer's methods
+                key = f"object_cull:{r['objects']}"
+                if key not in out or r["median_us"] < out[key][0]:
+                    out[key] = (r["median_us"], r.get("peer", "PyTorch"))
         else:
             raise SystemExit(f"unknown peer kind {kind!r}; accepted: bloom, blur, occlusion, object_cull")
     return out

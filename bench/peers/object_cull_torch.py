@@ -2,7 +2,7 @@
 BM_ObjectCull with bounds:1, all spheres).
 
 What it measures, on the same machine and in the same session as glint:
-  1. The same per-object test as kernels/object_cull.comp for bounding spheres, written as
+  1. The same per-object test as src/visibility/shaders/object_cull.comp for bounding spheres, written as
      elementwise PyTorch float32 on CUDA: view-space centre and distance w, near/far and the four
      side planes of the frustum, the sphere's exact projected x and y bounds from the two tangent
      lines through the eye (Mara & McGuire, JCGT 2013; zeux/niagara's projectSphere), the pixel

@@ -1,5 +1,5 @@
-// The ordered compaction shared by the object cull and the light cull (kernels/common/compact.glsl,
-// docs/OCCLUSION.md "Ordered compaction"): the user's test kernel sets one bit per emitted item in
+// The ordered compaction shared by the object cull and the light cull (src/core/shaders/compact.glsl,
+// docs/OCCLUSION.md "The shared compaction core"): the user's test kernel sets one bit per emitted item in
 // its 64-item group's mask of the group buffer this owns; record_scan() runs the two-level scan
 // (compact_scan_tiles.comp, then the user's top-level scan, which writes the user's indirect
 // arguments and statistics and resets the header's counters); record_scatter() runs the user's
@@ -15,10 +15,10 @@
 #include <map>
 #include <string>
 
-#include "core/shaders/compact_params.h"
 #include "core/barriers.h"
 #include "core/pipeline.h"
 #include "core/resources.h"
+#include "core/shaders/compact_params.h"
 
 namespace glint::detail {
 

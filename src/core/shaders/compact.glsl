@@ -1,5 +1,5 @@
 // The ordered compaction's GPU side, shared by every user (compact_params.h, docs/OCCLUSION.md
-// "Ordered compaction"). Before including, define COMPACT_GROUPS_BINDING (the group buffer's
+// "The shared compaction core"). Before including, define COMPACT_GROUPS_BINDING (the group buffer's
 // binding) and, where the including kernel only reads it, COMPACT_GROUPS_READONLY. The kernel
 // declares local_size_x_id = 0 (the tile's groups, for the scans).
 //

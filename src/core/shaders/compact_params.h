@@ -1,9 +1,9 @@
 // The ordered compaction shared by the object cull and the light cull (docs/OCCLUSION.md,
-// "Ordered compaction"): a test kernel sets one bit per emitted item in its workgroup's 64-bit
+// "The shared compaction core"): a test kernel sets one bit per emitted item in its workgroup's 64-bit
 // mask; a two-level scan (compact_scan_tiles.comp per tile of groups, then a cull's top-level scan
 // built on compact.glsl) turns the masks into slots; a scatter writes each emitted item's record
 // into its slot, so the output holds the emitted items in increasing index on every run. Declared
-// once for GLSL and C++; host/core/compaction.cpp static_asserts the layouts.
+// once for GLSL and C++; src/core/compaction.cpp static_asserts the layouts.
 #ifndef GLINT_COMPACT_PARAMS_H
 #define GLINT_COMPACT_PARAMS_H
 #include "glint/gpu/types.h"
