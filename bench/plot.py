@@ -233,7 +233,7 @@ def main_object_cull(args):
         ax.set_ylabel("false positives, % of brute-force-hidden objects")
         ax.set_title(f"object cull, {args.objects:,} objects, 1920x1080, on {name}")
         ax.grid(True, alpha=0.3)
-        ax.legend(fontsize=7, loc="best")
+        ax.legend(fontsize=7, loc="lower right")
         captions.append(f"{name}: {device or 'device unknown'}")
     fig.text(0.01, 0.01, "; ".join(captions) + f"; glint commit {commit}", fontsize=7, ha="left", va="bottom")
     fig.tight_layout(rect=(0, 0.04, 1, 1))
