@@ -63,18 +63,32 @@ void main() {
         if (b.x < tile_hi.x && b.z > tile_lo.x && b.y < tile_hi.y && b.w > tile_lo.y) hits |= 1u << slot;
       }
     }
-    // Inclusive scan of the hit counts (the previous batch's last barrier ended its reads).
+    // Inclusive scan of the hit counts (the previous batch's last barrier ended its reads), one
+    // step per power of two below the workgroup size (at most GLINT_FLARE_GATHER_MAX_THREADS =
+    // 256), written out: `threads` is a specialization constant, so the steps past it fold away
+    // and no loop is left (lavapipe ends a shader after 65535 loop iterations in all, which the
+    // loop over batches would otherwise reach with a few hundred thousand instances).
     const uint own = uint(bitCount(hits));
     s_scan[0][t] = own;
     barrier();
     uint src = 0u;
-    for (uint d = 1u; d < threads; d <<= 1u) {
-      uint v = s_scan[src][t];
-      if (t >= d) v += s_scan[src][t - d];
-      s_scan[src ^ 1u][t] = v;
-      barrier();
-      src ^= 1u;
-    }
+#define GLINT_SCAN_STEP(d)                        \
+  if ((d) < threads) {                            \
+    uint v = s_scan[src][t];                      \
+    if (t >= (d)) v += s_scan[src][t - (d)];      \
+    s_scan[src ^ 1u][t] = v;                      \
+    barrier();                                    \
+    src ^= 1u;                                    \
+  }
+    GLINT_SCAN_STEP(1u)
+    GLINT_SCAN_STEP(2u)
+    GLINT_SCAN_STEP(4u)
+    GLINT_SCAN_STEP(8u)
+    GLINT_SCAN_STEP(16u)
+    GLINT_SCAN_STEP(32u)
+    GLINT_SCAN_STEP(64u)
+    GLINT_SCAN_STEP(128u)
+#undef GLINT_SCAN_STEP
     const uint listed = s_scan[src][threads - 1u];  // the same in every invocation
     for (uint at = s_scan[src][t] - own; hits != 0u; ++at) {
       uint slot = uint(findLSB(hits));
