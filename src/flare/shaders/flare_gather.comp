@@ -146,9 +146,14 @@ void main() {
         // glint_flare_shade's own horizontal test (the same expression), once for the column.
         precise float u = (float(p0.x) + 0.5 - s.lo.x) / s.size.x;
         if (u < 0.0 || u >= 1.0) continue;
+        // Rows whose centre lies outside the sprite's conservative rectangle get 0 from
+        // glint_flare_shade, and adding 0 leaves a sum unchanged: two comparisons (the same for a
+        // whole row of the workgroup) skip its divisions and the sample. A small sprite meets one
+        // or two of the 8 rows.
+        const vec4 b = glint_flare_sprite_bounds(s);
         [[unroll]] for (uint r = 0u; r < GLINT_FLARE_GATHER_ROWS; ++r) {
           vec2 pixel = vec2(p0.x, p0.y + r * gl_WorkGroupSize.y) + 0.5;
-          sum[r] += glint_flare_shade(s, pixel, atlas).rgb;
+          if (pixel.y > b.y && pixel.y < b.w) sum[r] += glint_flare_shade(s, pixel, atlas).rgb;
         }
       }
     }
