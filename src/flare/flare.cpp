@@ -110,7 +110,7 @@ using BufferKey = std::tuple<VkBuffer, VkDeviceSize, VkDeviceSize>;
 BufferKey key_of(const Buffer& b) { return {b.buffer, b.offset, b.size}; }
 // The compute path's descriptor sets: instances, indirect arguments, colour view.
 using GatherKey = std::tuple<BufferKey, BufferKey, VkImageView>;
-// Bytes of the sprite pre-pass's block per instance (kernels/common/flare_params.h).
+// Bytes of the sprite pre-pass's block per instance (src/flare/shaders/flare_params.h).
 constexpr VkDeviceSize kBlockBytes = GLINT_FLARE_BLOCK_VEC4S * 16;
 
 }  // namespace
