@@ -553,6 +553,49 @@ TEST_F(FlareTest, ComputeGathersManyLightsInBatchesAndChunks) {
               d.worst_ratio);
 }
 
+// The sprite pre-pass stores 304 bytes per instance in one storage-buffer descriptor, fewer
+// instances than the 48-byte instances buffer may hold (maxStorageBufferRange / 304 against / 48):
+// the gather evaluates the sprites of the instances beyond the store itself. Lights at both ends of
+// such a buffer (the rest draw nothing), between draws from a small buffer with the same LensFlare
+// (its first store is kept for it, a second, larger one made): every draw matches the reference.
+TEST_F(FlareTest, ComputeDrawsInstancesBeyondItsSpriteStore) {
+  LensFlare flare(context(), kF32, {kW, kH});
+  const reference::FlareAtlas atlas = read_flare_atlas(flare);
+  VkPhysicalDeviceProperties props;
+  vkGetPhysicalDeviceProperties(context().physical_device(), &props);
+  const uint64_t stored = props.limits.maxStorageBufferRange / (GLINT_FLARE_BLOCK_VEC4S * 16);
+  const uint64_t n = stored + 6;
+  if (n * sizeof(GlintFlareInstance) > (uint64_t(64) << 20) || n > flare.max_compute_instances()) {
+    GTEST_SKIP() << "maxStorageBufferRange " << props.limits.maxStorageBufferRange
+                 << ": the instances beyond the sprite store need more than 64 MiB of instances";
+  }
+  const CpuImage background = random_hdr(kW, kH, 71);
+  const auto lights = random_instances(12, 29);
+  std::vector<GlintFlareInstance> list(n);  // zeros: size 0, nothing drawn
+  for (uint32_t k = 0; k < 6; ++k) {
+    list[k] = lights[k];              // sprites from the store
+    list[n - 6 + k] = lights[6 + k];  // sprites evaluated by the gather
+  }
+  FlareInputs big(list, uint32_t(n), flare.groups_per_instance());
+  FlareInputs small(lights, uint32_t(lights.size()), flare.groups_per_instance());
+  const FlareConfig config;
+  const auto ref_small =
+      reference::flare_composite(background, lights, uint32_t(lights.size()), config, atlas, flare_sampler_precision());
+  const auto ref_big =
+      reference::flare_composite(background, list, uint32_t(n), config, atlas, flare_sampler_precision());
+  const auto ref_front = reference::flare_composite(background, lights, 6, config, atlas, flare_sampler_precision());
+  const CpuImage a = draw(flare, Path::compute, background, kF32, small, config);
+  const CpuImage b = draw(flare, Path::compute, background, kF32, big, config);
+  const CpuImage c = draw(flare, Path::compute, background, kF32, small, config);
+  EXPECT_EQ(compare_flare(a, ref_small, kF32).outside, 0u);
+  const FlareDeviation d = compare_flare(b, ref_big, kF32);
+  EXPECT_EQ(d.outside, 0u) << d.first;
+  EXPECT_GT(compare_flare(b, ref_front, kF32).outside, 100u) << "the lights beyond the store were not drawn";
+  EXPECT_EQ(compare_flare(c, ref_small, kF32).outside, 0u);
+  std::printf("flare compute, %llu instances (%llu stored): worst |error| / tolerance %.3f\n",
+              static_cast<unsigned long long>(n), static_cast<unsigned long long>(stored), d.worst_ratio);
+}
+
 TEST_F(FlareTest, ZeroInstancesAndDisabledLeaveTheImageBitIdentical) {
   for (VkFormat format : {kF16, kF32}) {
     LensFlare flare(context(), format, {kW, kH});

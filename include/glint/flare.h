@@ -99,7 +99,10 @@ class LensFlare {
 
   /// Creates the pipelines and the atlas for drawing into `color_format` images of `extent`.
   /// Standalone contexts generate the atlas here (one submit); adopted contexts record its
-  /// generation in the first record_*() (or in record_setup()). The compute path owns no buffers.
+  /// generation in the first record_*() (or in record_setup()). The compute path owns a 32-byte
+  /// launch buffer and, made at the first record_compute() with an instances buffer larger than any
+  /// before, a sprite buffer of 304 bytes per instance (its pre-pass's output, for at most
+  /// maxStorageBufferRange / 304 instances) that lives as long as the LensFlare.
   /// Throws Error(unsupported_format) for other formats or a format the device cannot blend
   /// (raster) / store (compute), Error(unsupported_size) for a zero or too large extent.
   LensFlare(const Context& context, VkFormat color_format, VkExtent2D extent);

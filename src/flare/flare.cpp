@@ -9,6 +9,7 @@
 #include <cstddef>
 #include <cstdio>
 #include <map>
+#include <memory>
 #include <string>
 #include <tuple>
 #include <utility>
@@ -27,7 +28,7 @@ namespace glint {
 using detail::check_range;
 using detail::concat;
 
-static_assert(sizeof(GlintFlareGatherArgsPush) == 12);
+static_assert(sizeof(GlintFlareGatherArgsPush) == 20);
 static_assert(sizeof(GlintFlarePush) == 84,
               "GlintFlarePush layout changed: update src/flare/shaders/flare_params.h users");
 static_assert(offsetof(GlintFlarePush, ghost_pos0) == 52);
@@ -107,8 +108,10 @@ detail::DescriptorArena::AnyBinding buffer_binding(const Buffer& b) {
 
 using BufferKey = std::tuple<VkBuffer, VkDeviceSize, VkDeviceSize>;
 BufferKey key_of(const Buffer& b) { return {b.buffer, b.offset, b.size}; }
-// The compute path's descriptor set: instances, indirect arguments, colour view.
+// The compute path's descriptor sets: instances, indirect arguments, colour view.
 using GatherKey = std::tuple<BufferKey, BufferKey, VkImageView>;
+// Bytes of the sprite pre-pass's block per instance (src/flare/shaders/flare_params.h).
+constexpr VkDeviceSize kBlockBytes = GLINT_FLARE_BLOCK_VEC4S * 16;
 
 }  // namespace
 
@@ -118,6 +121,8 @@ struct LensFlare::Impl {
   VkFormat format = VK_FORMAT_UNDEFINED;
   VkExtent2D extent{0, 0};
   uint32_t max_compute_instances = 0;    // instances one storage-buffer descriptor can hold
+  uint32_t max_stored_instances = 0;     // instances whose sprite blocks one descriptor can hold
+  uint32_t max_groups_x = 65535;         // maxComputeWorkGroupCount[0]
   VkDeviceSize storage_alignment = 256;  // minStorageBufferOffsetAlignment
   detail::Workgroup2D workgroup;         // the gather's workgroup
   uint32_t tiles_x = 0, tiles_y = 0;     // gather tiles: workgroup x by workgroup y * GATHER_ROWS
@@ -136,16 +141,33 @@ struct LensFlare::Impl {
   VkPipelineLayout raster_layout = VK_NULL_HANDLE;
   VkPipeline raster_pipeline = VK_NULL_HANDLE;
 
-  // Compute path: the gather kernel, launched by vkCmdDispatchIndirect with arguments that
-  // flare_gather_args.comp writes from the instance count.
-  detail::ComputePipeline gather, gather_args;
-  detail::OwnedBuffer gather_args_buffer;
+  // Compute path: the sprite pre-pass and the gather, launched by vkCmdDispatchIndirect with
+  // arguments that flare_gather_args.comp writes from the instance count.
+  detail::ComputePipeline gather, gather_args, sprites;
+  // The gather for instances buffers larger than the sprite store (specialization constant 2 = 1),
+  // made at its first use.
+  detail::ComputePipeline gather_beyond;
+  bool gather_beyond_made = false;
+  detail::OwnedBuffer gather_args_buffer;  // the gather's VkDispatchIndirectCommand, then the pre-pass's
   Buffer gather_args_state;
   std::map<BufferKey, VkDescriptorSet> gather_args_sets;
+  // The pre-pass's sprite blocks, one store per size: a larger instances buffer gets a new store,
+  // and the smaller ones stay (sets made for them may still be recorded) until the LensFlare goes.
+  struct SpriteStore {
+    detail::OwnedBuffer buffer;
+    Buffer state;
+    uint32_t capacity = 0;  // instances
+  };
+  std::vector<std::unique_ptr<SpriteStore>> sprite_stores;
+  struct GatherSets {
+    VkDescriptorSet sprites = VK_NULL_HANDLE, gather = VK_NULL_HANDLE;
+    SpriteStore* store = nullptr;
+    bool beyond = false;  // the instances buffer holds more than the store: gather_beyond
+  };
 
   detail::DescriptorArena sets;  // the sets naming caller buffers and images; pools of 16
   std::map<BufferKey, VkDescriptorSet> raster_sets;
-  std::map<GatherKey, VkDescriptorSet> gather_sets;
+  std::map<GatherKey, GatherSets> gather_sets;
 
   ~Impl() {
     if (!device) return;
@@ -166,6 +188,7 @@ struct LensFlare::Impl {
   void make_atlas();
   void make_raster_pipeline();
   void make_compute_pipelines();
+  detail::ComputePipeline make_gather(uint32_t beyond_store) const;
   void record_setup(VkCommandBuffer cmd);
   GlintFlarePush push(const FlareConfig& c) const;
   void check_inputs(const char* fn, const Image& color, VkImageUsageFlags usage, const char* usage_name,
@@ -329,24 +352,36 @@ void LensFlare::Impl::make_raster_pipeline() {
   for (VkShaderModule m : modules) vkDestroyShaderModule(device, m, nullptr);
 }
 
-void LensFlare::Impl::make_compute_pipelines() {
+detail::ComputePipeline LensFlare::Impl::make_gather(uint32_t beyond_store) const {
   const auto SB = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
   detail::PipelineDesc d;
   d.kernel_id = std::string("flare_gather_") + detail::format_variant(format);
-  d.bindings = {SB, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, SB, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE};
+  d.bindings = {SB, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, SB, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, SB};
   d.push_constant_bytes = sizeof(GlintFlarePush);
   d.workgroup = workgroup;
-  gather = detail::ComputePipeline(*context, d);
+  d.specialization = {beyond_store};
+  return detail::ComputePipeline(*context, d);
+}
+
+void LensFlare::Impl::make_compute_pipelines() {
+  const auto SB = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+  gather = make_gather(0);
+  detail::PipelineDesc sp;
+  sp.kernel_id = "flare_sprites_main";
+  sp.bindings = {SB, SB, SB};
+  sp.push_constant_bytes = sizeof(GlintFlarePush);
+  sp.workgroup = {GLINT_FLARE_SPRITES_SLOTS, GLINT_FLARE_SPRITES_INSTANCES};
+  sprites = detail::ComputePipeline(*context, sp);
   detail::PipelineDesc a;
   a.kernel_id = "flare_gather_args_main";
   a.bindings = {SB, SB};
   a.push_constant_bytes = sizeof(GlintFlareGatherArgsPush);
   a.workgroup = {1, 1};
   gather_args = detail::ComputePipeline(*context, a);
-  // The gather's VkDispatchIndirectCommand, written on the GPU each frame.
+  // The gather's and the pre-pass's VkDispatchIndirectCommand, written on the GPU each frame.
   const VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT;
-  gather_args_buffer = detail::OwnedBuffer(*context, 16, usage, false);
-  gather_args_state = Buffer{gather_args_buffer.buffer(), 0, 16, usage, VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE};
+  gather_args_buffer = detail::OwnedBuffer(*context, 32, usage, false);
+  gather_args_state = Buffer{gather_args_buffer.buffer(), 0, 32, usage, VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE};
 }
 
 GlintFlarePush LensFlare::Impl::push(const FlareConfig& c) const {
@@ -416,6 +451,10 @@ LensFlare::LensFlare(const Context& context, VkFormat color_format, VkExtent2D e
   VkPhysicalDeviceProperties props;
   vkGetPhysicalDeviceProperties(context.physical_device(), &props);
   m.max_compute_instances = props.limits.maxStorageBufferRange / uint32_t(sizeof(GlintFlareInstance));
+  // The sprite blocks take 304 bytes per instance: a device at the minimum range (2^27 bytes) stores
+  // 441 k instances' sprites, and the gather evaluates those of any further instance itself.
+  m.max_stored_instances = uint32_t(props.limits.maxStorageBufferRange / kBlockBytes);
+  m.max_groups_x = props.limits.maxComputeWorkGroupCount[0];
   m.storage_alignment = std::max<VkDeviceSize>(1, props.limits.minStorageBufferOffsetAlignment);
   // The gather's workgroup: 32x8 on GPUs (a 32x64 tile; on the H100 it beat 16x8, whose tiles bin
   // every instance twice as often: docs/FLARE.md), the device's 2D choice (8x8) on CPU devices.
@@ -546,16 +585,40 @@ void LensFlare::record_compute(VkCommandBuffer cmd, Image& color, Buffer& instan
   const Buffer indirect_words{indirect.buffer, bound_offset,   args_offset - bound_offset + sizeof(uint32_t),
                               indirect.usage,  indirect.stage, indirect.access};
   const GatherKey key{key_of(instances), key_of(indirect_words), color.view};
-  VkDescriptorSet set;
+  // Instances whose sprites the pre-pass stores (all of them up to max_stored_instances).
+  const uint32_t capacity = std::min(uint32_t(instances.size / sizeof(GlintFlareInstance)), m.max_stored_instances);
+  Impl::GatherSets gs;
   if (auto it = m.gather_sets.find(key); it != m.gather_sets.end()) {
-    set = it->second;
+    gs = it->second;
   } else {
+    if (m.sprite_stores.empty() || m.sprite_stores.back()->capacity < capacity) {
+      // A new store for the larger buffer, twice the last one (at most the descriptor's limit), so
+      // that buffers growing one by one make few stores.
+      uint32_t c = m.sprite_stores.empty() ? 1u : m.sprite_stores.back()->capacity;
+      c = std::max(capacity, std::min(2 * c, m.max_stored_instances));
+      auto store = std::make_unique<Impl::SpriteStore>();
+      const VkDeviceSize bytes = VkDeviceSize(c) * kBlockBytes;
+      store->buffer = detail::OwnedBuffer(*m.context, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, false);
+      store->state =
+          Buffer{store->buffer.buffer(), 0, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, VK_PIPELINE_STAGE_2_NONE,
+                 VK_ACCESS_2_NONE};
+      store->capacity = c;
+      m.sprite_stores.push_back(std::move(store));
+    }
+    gs.store = m.sprite_stores.back().get();
+    gs.beyond = instances.size / sizeof(GlintFlareInstance) > gs.store->capacity;
+    if (gs.beyond && !m.gather_beyond_made) {
+      m.gather_beyond = m.make_gather(1);
+      m.gather_beyond_made = true;
+    }
     detail::DescriptorArena::AnyBinding dst;
     dst.image = {color.view, VK_IMAGE_LAYOUT_GENERAL};
-    set = m.sets.make_mixed_set(m.gather,
-                                {buffer_binding(instances), m.atlas_binding(), buffer_binding(indirect_words), dst});
-    m.gather_sets.emplace(key, set);
+    gs.gather = m.sets.make_mixed_set(m.gather, {buffer_binding(instances), m.atlas_binding(),
+                                                 buffer_binding(indirect_words), dst, buffer_binding(gs.store->state)});
+    gs.sprites = m.sets.make_buffer_set(m.sprites, {instances, indirect_words, gs.store->state});
+    m.gather_sets.emplace(key, gs);
   }
+  Buffer& store = gs.store->state;
 
   VkDescriptorSet args_set;
   if (auto it = m.gather_args_sets.find(key_of(indirect_words)); it != m.gather_args_sets.end()) {
@@ -567,21 +630,28 @@ void LensFlare::record_compute(VkCommandBuffer cmd, Image& color, Buffer& instan
 
   GlintFlarePush p = m.push(config);
   p.indirect_word = uint32_t((args_offset - bound_offset) / sizeof(uint32_t));
-  GlintFlareGatherArgsPush ap{p.indirect_word, m.tiles_x, m.tiles_y};
+  GlintFlareGatherArgsPush ap{p.indirect_word, m.tiles_x, m.tiles_y, std::min(capacity, gs.store->capacity),
+                              m.max_groups_x};
   detail::Barriers b;
-  // 1. The launch arguments: every tile when any instance is visible, none otherwise.
+  // 1. The launch arguments: every tile when any instance is visible, none otherwise; the
+  //    pre-pass's groups for the instances.
   b.use(indirect, kCompute, VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
   b.use(m.gather_args_state, kCompute, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
   b.flush(cmd);
   m.gather_args.dispatch(cmd, args_set, ap, 1, 1);
-  // 2. The gather, one workgroup per tile, launched with vkCmdDispatchIndirect.
+  // 2. The sprite pre-pass: every sprite of every instance, once.
   b.use(m.gather_args_state, kIndirect, VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT);
   b.use(instances, kCompute, VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
+  b.use(store, kCompute, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+  b.flush(cmd);
+  m.sprites.dispatch_indirect(cmd, gs.sprites, p, m.gather_args_buffer.buffer(), 16);
+  // 3. The gather, one workgroup per tile.
+  b.use(store, kCompute, VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
   b.use(m.atlas_image.state, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, kCompute, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT,
         GLINT_FLARE_ATLAS_LEVELS);
   b.use(color, VK_IMAGE_LAYOUT_GENERAL, kCompute, kStorageRW);
   b.flush(cmd);
-  m.gather.dispatch_indirect(cmd, set, p, m.gather_args_buffer.buffer(), 0);
+  (gs.beyond ? m.gather_beyond : m.gather).dispatch_indirect(cmd, gs.gather, p, m.gather_args_buffer.buffer(), 0);
   if (profiler) profiler->mark(cmd, "flare gather");
 }
 

@@ -3,15 +3,16 @@
 #extension GL_EXT_control_flow_attributes : require
 // Lens flares for compute-only engines (docs/FLARE.md, "The two paths": compute), accumulated by gathering: one
 // workgroup per screen tile of GLINT_FLARE_GATHER_ROWS x workgroup pixels (each invocation keeps
-// its column's pixels in registers), no atomics on the image or on any global buffer.
+// its column's pixels in registers), no atomics on the image or on any global buffer. The sprites
+// were evaluated once for the frame by flare_sprites.comp (layout in flare_params.h).
 // 1. Binning: invocation t takes instance base + t (the count is instance_count of the indirect
-//    arguments, read here; indices past the buffer are skipped) and
-//    lists each of its sprites whose conservative rectangle (glint_flare_bounds) meets the tile in
-//    a shared list, at a position given by an exclusive prefix sum of the invocations' hit counts
+//    arguments, read here; indices past the buffers are skipped), tests the union of its sprites'
+//    conservative rectangles against the tile and, when it meets the tile, each sprite's own
+//    rectangle (glint_flare_sprite_bounds). The sprites that meet the tile go into a shared list,
+//    at a position given by an exclusive prefix sum of the invocations' hit counts
 //    (Hillis & Steele 1986, in shared memory): the list is in (instance, slot) order, the order the
 //    raster path draws in, on every run: no atomic decides the order of the sums, so every run gives the same bits.
-// 2. Sprites: the list is turned into GlintFlareSprite (glint_flare_sprite, the function flare.vert
-//    evaluates) in chunks of one per invocation, kept in shared memory.
+// 2. Sprites: the listed sprites are read into shared memory in chunks of one per invocation.
 // 3. Shading: every invocation adds glint_flare_shade (the function flare.frag evaluates) of every
 //    listed sprite at each of its pixel centres, in fp32.
 // Finally a pixel that received light is read, gains the sum and is written once (alpha kept);
@@ -29,7 +30,11 @@ layout(std430, binding = 0) readonly buffer Instances { GlintFlareInstance insta
 layout(binding = 1) uniform sampler2D atlas;
 layout(std430, binding = 2) readonly buffer Indirect { uint indirect_words[]; };  // GlintFlareIndirect
 layout(binding = 3, DST_FORMAT) uniform image2D color;
+layout(std430, binding = 4) readonly buffer Sprites { vec4 blocks[]; };  // flare_sprites.comp's output
 layout(push_constant) uniform Push { GlintFlarePush pc; };
+// 1 when the instances buffer holds more instances than the sprite store (LensFlare::record_compute
+// picks this variant only then): the sprites of the instances beyond it are evaluated here.
+layout(constant_id = 2) const uint kBeyondStore = 0u;
 
 const uint kMaxThreads = GLINT_FLARE_GATHER_MAX_THREADS;
 shared uint s_scan[2][kMaxThreads];                     // hit counts, then their prefix sums
@@ -37,6 +42,21 @@ shared uint s_list[kMaxThreads * GLINT_FLARE_SPRITES];  // instance * 16 + slot
 shared vec4 s_rect[kMaxThreads];                        // lo.xy, size.xy of the listed sprites
 shared vec4 s_rgb_lod[kMaxThreads];
 shared uint s_tile[kMaxThreads];
+
+// The sprite in `slot` of instance i: read from the pre-pass's block when the instance has one,
+// else evaluated.
+GlintFlareSprite gather_sprite(uint i, uint slot, uint stored) {
+  if (kBeyondStore != 0u && i >= stored) return glint_flare_sprite(instances[i], slot, pc);
+  GlintFlareSprite s;
+  vec4 rect = blocks[i * GLINT_FLARE_BLOCK_VEC4S + 1u + 2u * slot];
+  vec4 rgb_lod = blocks[i * GLINT_FLARE_BLOCK_VEC4S + 2u + 2u * slot];
+  s.lo = rect.xy;
+  s.size = rect.zw;
+  s.rgb = rgb_lod.rgb;
+  s.lod = rgb_lod.w;
+  s.tile = glint_flare_slot_tile(slot, instances[i].element);
+  return s;
+}
 
 void main() {
   const uint threads = gl_WorkGroupSize.x * gl_WorkGroupSize.y;
@@ -48,33 +68,54 @@ void main() {
 
   uint count = indirect_words[pc.indirect_word];  // GlintFlareIndirect::instance_count
   count = min(count, uint(instances.length()));
+  // Instances below `stored` have their sprites in `blocks`; the rest (only with kBeyondStore:
+  // an instances buffer larger than one descriptor of blocks holds) are evaluated here, with the
+  // same function.
+  const uint stored = min(count, uint(blocks.length()) / GLINT_FLARE_BLOCK_VEC4S);
+  if (kBeyondStore == 0u) count = stored;
 
   vec3 sum[GLINT_FLARE_GATHER_ROWS];  // indexed by unrolled loops only, so it stays in registers
   [[unroll]] for (uint r = 0u; r < GLINT_FLARE_GATHER_ROWS; ++r) sum[r] = vec3(0.0);
 
   for (uint base = 0u; base < count; base += threads) {
-    // 1. Binning: every sprite of one instance against the tile.
+    // 1. Binning: the instance's union rectangle, then each of its sprites, against the tile.
     uint i = base + t;
     uint hits = 0u;  // bit `slot`: that sprite meets the tile
     if (i < count) {
-      GlintFlareInstance inst = instances[i];
-      for (uint slot = 0u; slot < GLINT_FLARE_SPRITES; ++slot) {
-        vec4 b = glint_flare_bounds(inst, slot, pc);
-        if (b.x < tile_hi.x && b.z > tile_lo.x && b.y < tile_hi.y && b.w > tile_lo.y) hits |= 1u << slot;
+      vec4 u = kBeyondStore != 0u && i >= stored ? vec4(tile_lo, tile_hi) : blocks[i * GLINT_FLARE_BLOCK_VEC4S];
+      if (u.x < tile_hi.x && u.z > tile_lo.x && u.y < tile_hi.y && u.w > tile_lo.y) {
+        [[unroll]] for (uint slot = 0u; slot < GLINT_FLARE_SPRITES; ++slot) {
+          vec4 b = glint_flare_sprite_bounds(gather_sprite(i, slot, stored));
+          if (b.x < tile_hi.x && b.z > tile_lo.x && b.y < tile_hi.y && b.w > tile_lo.y) hits |= 1u << slot;
+        }
       }
     }
-    // Inclusive scan of the hit counts (the previous batch's last barrier ended its reads).
+    // Inclusive scan of the hit counts (the previous batch's last barrier ended its reads), one
+    // step per power of two below the workgroup size (at most GLINT_FLARE_GATHER_MAX_THREADS =
+    // 256), written out: `threads` is a specialization constant, so the steps past it fold away
+    // and no loop is left (lavapipe ends a shader after 65535 loop iterations in all, which the
+    // loop over batches would otherwise reach with a few hundred thousand instances).
     const uint own = uint(bitCount(hits));
     s_scan[0][t] = own;
     barrier();
     uint src = 0u;
-    for (uint d = 1u; d < threads; d <<= 1u) {
-      uint v = s_scan[src][t];
-      if (t >= d) v += s_scan[src][t - d];
-      s_scan[src ^ 1u][t] = v;
-      barrier();
-      src ^= 1u;
-    }
+#define GLINT_SCAN_STEP(d)                        \
+  if ((d) < threads) {                            \
+    uint v = s_scan[src][t];                      \
+    if (t >= (d)) v += s_scan[src][t - (d)];      \
+    s_scan[src ^ 1u][t] = v;                      \
+    barrier();                                    \
+    src ^= 1u;                                    \
+  }
+    GLINT_SCAN_STEP(1u)
+    GLINT_SCAN_STEP(2u)
+    GLINT_SCAN_STEP(4u)
+    GLINT_SCAN_STEP(8u)
+    GLINT_SCAN_STEP(16u)
+    GLINT_SCAN_STEP(32u)
+    GLINT_SCAN_STEP(64u)
+    GLINT_SCAN_STEP(128u)
+#undef GLINT_SCAN_STEP
     const uint listed = s_scan[src][threads - 1u];  // the same in every invocation
     for (uint at = s_scan[src][t] - own; hits != 0u; ++at) {
       uint slot = uint(findLSB(hits));
@@ -83,10 +124,10 @@ void main() {
     }
     for (uint e0 = 0u; e0 < listed; e0 += threads) {
       barrier();  // the previous chunk's sprites have been shaded (and every invocation read `listed`)
-      // 2. Sprites: one per invocation.
+      // 2. Sprites: one per invocation, mostly as flare_sprites.comp stored it.
       if (e0 + t < listed) {
         uint packed = s_list[e0 + t];
-        GlintFlareSprite s = glint_flare_sprite(instances[packed >> 4u], packed & 15u, pc);
+        GlintFlareSprite s = gather_sprite(packed >> 4u, packed & 15u, stored);
         s_rect[t] = vec4(s.lo, s.size);
         s_rgb_lod[t] = vec4(s.rgb, s.lod);
         s_tile[t] = s.tile;
@@ -105,9 +146,14 @@ void main() {
         // glint_flare_shade's own horizontal test (the same expression), once for the column.
         precise float u = (float(p0.x) + 0.5 - s.lo.x) / s.size.x;
         if (u < 0.0 || u >= 1.0) continue;
+        // Rows whose centre lies outside the sprite's conservative rectangle get 0 from
+        // glint_flare_shade, and adding 0 leaves a sum unchanged: two comparisons (the same for a
+        // whole row of the workgroup) skip its divisions and the sample. A small sprite meets one
+        // or two of the 8 rows.
+        const vec4 b = glint_flare_sprite_bounds(s);
         [[unroll]] for (uint r = 0u; r < GLINT_FLARE_GATHER_ROWS; ++r) {
           vec2 pixel = vec2(p0.x, p0.y + r * gl_WorkGroupSize.y) + 0.5;
-          sum[r] += glint_flare_shade(s, pixel, atlas).rgb;
+          if (pixel.y > b.y && pixel.y < b.w) sum[r] += glint_flare_shade(s, pixel, atlas).rgb;
         }
       }
     }

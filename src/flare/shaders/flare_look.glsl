@@ -30,6 +30,16 @@ vec4 glint_flare_tile(uint element) {
   return vec4(GLINT_FLARE_TILE_GLOW_X, GLINT_FLARE_TILE_GLOW_Y, GLINT_FLARE_TILE_GLOW_W, GLINT_FLARE_TILE_GLOW_H);
 }
 
+// The atlas tile of the sprite in `slot`: the main sprite shows the instance's `element` (the glow
+// when it is out of range), every other slot its own element.
+uint glint_flare_slot_tile(uint slot, uint element) {
+  if (slot == GLINT_FLARE_SLOT_MAIN) return element < GLINT_FLARE_ELEMENT_COUNT ? element : GLINT_FLARE_ELEMENT_GLOW;
+  if (slot == GLINT_FLARE_SLOT_STREAK) return GLINT_FLARE_ELEMENT_STREAK;
+  if (slot == GLINT_FLARE_SLOT_HALO) return GLINT_FLARE_ELEMENT_HALO;
+  if (slot == GLINT_FLARE_SLOT_STARBURST) return GLINT_FLARE_ELEMENT_STARBURST;
+  return GLINT_FLARE_ELEMENT_GHOST;
+}
+
 // Not NaN, not +-Inf, tested on the bits: without SignedZeroInfNanPreserve a compiler may assume
 // floats are finite and fold x == x or x - x == 0 to true (lavapipe does).
 bool glint_flare_finite(float x) { return (floatBitsToUint(x) & 0x7f800000u) != 0x7f800000u; }
@@ -55,21 +65,18 @@ GlintFlareSprite glint_flare_sprite(GlintFlareInstance inst, uint slot, GlintFla
   vec2 extent;  // in units of size_px, before the anamorphic ratio
   float weight;
   bool tinted = false;
+  s.tile = glint_flare_slot_tile(slot, inst.element);
   if (slot == GLINT_FLARE_SLOT_MAIN) {
-    s.tile = inst.element < GLINT_FLARE_ELEMENT_COUNT ? inst.element : GLINT_FLARE_ELEMENT_GLOW;
     extent = vec2(GLINT_FLARE_MAIN_SCALE);
     weight = p.weight_main;
   } else if (slot == GLINT_FLARE_SLOT_STREAK) {
-    s.tile = GLINT_FLARE_ELEMENT_STREAK;
     extent = vec2(p.streak_length, GLINT_FLARE_STREAK_HEIGHT);
     weight = p.weight_streak;
     tinted = true;
   } else if (slot == GLINT_FLARE_SLOT_HALO) {
-    s.tile = GLINT_FLARE_ELEMENT_HALO;
     extent = vec2(GLINT_FLARE_HALO_SCALE);
     weight = p.weight_halo;
   } else if (slot == GLINT_FLARE_SLOT_STARBURST) {
-    s.tile = GLINT_FLARE_ELEMENT_STARBURST;
     extent = vec2(GLINT_FLARE_STARBURST_SCALE);
     weight = p.weight_starburst;
   } else {
@@ -85,7 +92,6 @@ GlintFlareSprite glint_flare_sprite(GlintFlareInstance inst, uint slot, GlintFla
                  : k == 2u ? GLINT_FLARE_GHOST_GAIN_2
                  : k == 3u ? GLINT_FLARE_GHOST_GAIN_3
                            : GLINT_FLARE_GHOST_GAIN_4;
-    s.tile = GLINT_FLARE_ELEMENT_GHOST;
     precise vec2 screen_centre = 0.5 * vec2(p.viewport_w, p.viewport_h);
     centre = light + (screen_centre - light) * t;  // Kilgard's ghost line: E = L + (C - L) * t
     extent = vec2(scale);
@@ -114,38 +120,18 @@ GlintFlareSprite glint_flare_sprite(GlintFlareInstance inst, uint slot, GlintFla
   return s;
 }
 
-// A conservative screen rectangle (x0, y0, x1, y1) around the sprite in `slot`, for binning: it
-// contains every pixel centre glint_flare_shade can light, with 2 px to spare, so it may be computed
-// without `precise` and without the level. Empty (x0 > x1) for some instances that draw nothing
-// (the rest are listed and then drawn as nothing by glint_flare_sprite).
-vec4 glint_flare_bounds(GlintFlareInstance inst, uint slot, GlintFlarePush p) {
-  const vec4 nothing = vec4(1.0, 1.0, -1.0, -1.0);
-  if (!(inst.size_px > 0.0 && inst.visible_fraction > 0.0 && inst.intensity > 0.0)) return nothing;
-  vec2 light = vec2(inst.center_x_px, inst.center_y_px);
-  vec2 centre = light;
-  vec2 extent;
-  if (slot == GLINT_FLARE_SLOT_MAIN) {
-    extent = vec2(GLINT_FLARE_MAIN_SCALE);
-  } else if (slot == GLINT_FLARE_SLOT_STREAK) {
-    extent = vec2(p.streak_length, GLINT_FLARE_STREAK_HEIGHT);
-  } else if (slot == GLINT_FLARE_SLOT_HALO) {
-    extent = vec2(GLINT_FLARE_HALO_SCALE);
-  } else if (slot == GLINT_FLARE_SLOT_STARBURST) {
-    extent = vec2(GLINT_FLARE_STARBURST_SCALE);
-  } else {
-    uint k = slot - GLINT_FLARE_SLOT_GHOST0;
-    float t = k == 0u ? p.ghost_pos0 : k == 1u ? p.ghost_pos1 : k == 2u ? p.ghost_pos2 : k == 3u ? p.ghost_pos3 : p.ghost_pos4;
-    extent = vec2(k == 0u   ? GLINT_FLARE_GHOST_SCALE_0
-                  : k == 1u ? GLINT_FLARE_GHOST_SCALE_1
-                  : k == 2u ? GLINT_FLARE_GHOST_SCALE_2
-                  : k == 3u ? GLINT_FLARE_GHOST_SCALE_3
-                            : GLINT_FLARE_GHOST_SCALE_4);
-    centre = light + (0.5 * vec2(p.viewport_w, p.viewport_h) - light) * t;
-  }
-  vec2 half_size = 0.5 * extent * inst.size_px * vec2(p.anamorphic_ratio, 1.0);
-  // 2 px, plus a few ulp of the operands for far-off lights whose large sprites reach the screen.
-  half_size += 2.0 + 1e-6 * (abs(centre) + half_size);
-  return vec4(centre - half_size, centre + half_size);
+// A conservative screen rectangle (x0, y0, x1, y1) around a sprite, for binning: it contains
+// every pixel centre c that glint_flare_shade lights, so a tile it misses needs no test. Empty
+// (x0 > x1) for a sprite that draws nothing; a rectangle that overflows fp32 gives infinite bounds
+// (the sprite is tested everywhere, as glint_flare_shade would) or NaN ones (no test passes). Why the margin m = 2 + 1e-6 (|lo| + size) suffices: glint_flare_shade lights c
+// only when u = fl(fl(c - lo) / size) is in [0, 1). For c <= lo - m, c - lo <= -m < 0 stays
+// negative after rounding. For c >= lo + size + m, fl(c - lo) / size >= 1 + (m - 2^-24 (size + m))
+// / size > 1 + 9e-7, more than the 2.5 ulp (3e-7) a Vulkan division may be off, so u >= 1. The
+// rounding of the bounds themselves, 2^-24 (|lo| + size + m) each, is far inside the rest of m.
+vec4 glint_flare_sprite_bounds(GlintFlareSprite s) {
+  if (!(s.size.x > 0.0)) return vec4(1.0, 1.0, -1.0, -1.0);
+  vec2 m = 2.0 + 1e-6 * (abs(s.lo) + s.size);
+  return vec4(s.lo - m, s.lo + s.size + m);
 }
 
 // Premultiplied light that `s` adds at the pixel whose centre is `pixel` (gl_FragCoord.xy in the

@@ -78,6 +78,19 @@
 #define GLINT_FLARE_GATHER_ROWS 8u
 #define GLINT_FLARE_GATHER_MAX_THREADS 256u
 
+// The sprite pre-pass (flare_sprites.comp) evaluates every sprite once per frame into a buffer the
+// LensFlare owns, one block of GLINT_FLARE_BLOCK_VEC4S vec4 per instance:
+//   [0]                 the union of the sprites' conservative rectangles (x0, y0, x1, y1; empty
+//                       when x0 > x1), so a tile tests one rectangle per instance;
+//   [1 + 2 slot]        lo.xy, size.xy of the sprite in `slot` (size 0: nothing to draw);
+//   [2 + 2 slot]        rgb, lod.
+// The atlas tile is not stored: it follows from the slot and the instance's element
+// (glint_flare_slot_tile). One workgroup takes GLINT_FLARE_SPRITES_INSTANCES instances, one
+// invocation per (instance, slot).
+#define GLINT_FLARE_BLOCK_VEC4S (1u + 2u * GLINT_FLARE_SPRITES)
+#define GLINT_FLARE_SPRITES_SLOTS 16u  // the pre-pass workgroup's x: slots, GLINT_FLARE_SPRITES of them used
+#define GLINT_FLARE_SPRITES_INSTANCES 4u
+
 // Push constants of every flare kernel (88 bytes; the per-frame settings of FlareConfig, already
 // combined on the host: tint is (1, 1, 1) when the tint is off).
 struct GlintFlarePush {
@@ -104,11 +117,14 @@ struct GlintFlarePush {
   GLINT_UINT indirect_word;  // compute: index of instance_count in the bound indirect words
 };
 
-// Push constants of flare_gather_args.comp (12 bytes).
+// Push constants of flare_gather_args.comp (20 bytes). It writes two VkDispatchIndirectCommand:
+// the gather's at word 0 and the sprite pre-pass's at word 4.
 struct GlintFlareGatherArgsPush {
   GLINT_UINT indirect_word;  // index of instance_count in the bound indirect words
   GLINT_UINT tiles_x;        // the gather's grid when any instance is visible
   GLINT_UINT tiles_y;
+  GLINT_UINT capacity;       // instances the bound instance and sprite buffers hold
+  GLINT_UINT max_groups_x;   // maxComputeWorkGroupCount[0]: the pre-pass's groups go in rows of it
 };
 
 // Push constants of flare_atlas.comp (12 bytes).
