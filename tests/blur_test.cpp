@@ -465,6 +465,34 @@ TEST_F(BlurTest, WholeImageErrorIsWithinTheExpectedErrorForEveryMethodAndSigma) 
   }
 }
 
+// The cost model auto ranks by is the device's: measured once per Context (the same constants
+// on a second call), or the config's when one is passed in, which then decides the choice.
+TEST_F(BlurTest, AutoRanksByTheDevicesCostModel) {
+  const BlurCostModel measured = measure_blur_cost_model(context());
+  EXPECT_GT(measured.us_per_dispatch, 0.0);
+  EXPECT_GT(measured.us_per_byte, 0.0);
+  EXPECT_GT(measured.us_per_shared_tap, 0.0);
+  EXPECT_GT(measured.us_per_fetch_tap, 0.0);
+  const BlurCostModel again = measure_blur_cost_model(context());
+  EXPECT_EQ(again.us_per_dispatch, measured.us_per_dispatch);
+  EXPECT_EQ(again.us_per_fetch_tap, measured.us_per_fetch_tap);
+  GaussianBlurConfig config;
+  config.sigma_px = 50.0f;
+  config.max_relative_error = 0.02f;
+  // Taps dear, dispatches free: the pyramid (a few fetches per texel) beats 401 taps.
+  config.cost_model = {1e-3, 1e-6, 1.0, 1.0};
+  GaussianBlur taps_dear(context(), config);
+  taps_dear.prepare({512, 512});
+  EXPECT_EQ(taps_dear.choice().method, BlurMethod::pyramid);
+  EXPECT_LE(taps_dear.choice().expected_relative_error, 0.02);
+  // Dispatches dear, taps free: the one or two dispatches of the separable blur win.
+  config.cost_model = {1e6, 1e-9, 1e-9, 1e-9};
+  GaussianBlur dispatch_dear(context(), config);
+  dispatch_dear.prepare({512, 512});
+  EXPECT_EQ(dispatch_dear.choice().method, BlurMethod::separable);
+  EXPECT_GT(dispatch_dear.choice().estimated_us, 1e6);
+}
+
 TEST_F(BlurTest, GaussRejectsBadInputAndCreatesNothingPerFrame) {
   GaussianBlurConfig bad;
   bad.sigma_px = 0.25f;
@@ -479,6 +507,13 @@ TEST_F(BlurTest, GaussRejectsBadInputAndCreatesNothingPerFrame) {
   EXPECT_THROW(GaussianBlur(context(), bad), Error);
   bad = {};
   bad.method = static_cast<BlurMethod>(9);
+  EXPECT_THROW(GaussianBlur(context(), bad), Error);
+  bad = {};
+  bad.cost_model.us_per_dispatch = 3.0;  // the others zero: neither measured nor passed in
+  EXPECT_THROW(GaussianBlur(context(), bad), Error);
+  bad.cost_model = {3.0, 1e-6, -1e-7, 1e-7};
+  EXPECT_THROW(GaussianBlur(context(), bad), Error);
+  bad.cost_model = {3.0, 1e-6, std::nan(""), 1e-7};
   EXPECT_THROW(GaussianBlur(context(), bad), Error);
 
   GaussianBlur blur(context());
