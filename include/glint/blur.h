@@ -137,8 +137,8 @@ struct BlurCostModel {
 
 /// Measures the cost model of `context`'s device: times a few small blurs of each method with
 /// timestamps (wall clock where the queue has no timestamps) and fits the constants to them; about
-/// 0.1 s on an H100, 1 s on lavapipe. Cached: later calls on the same Context return the first
-/// result. Standalone contexts only (Error(invalid_argument) for an adopted one).
+/// 1 s on lavapipe, mostly compiling pipelines. Cached: later calls on the same Context return the
+/// first result. Standalone contexts only (Error(invalid_argument) for an adopted one).
 BlurCostModel measure_blur_cost_model(const Context& context);
 
 /// Settings of a GaussianBlur. All fields are shape fields (they decide levels and taps).
