@@ -129,9 +129,13 @@ TEST(BlurPlan, PyramidPlanSolvesTheVarianceEquation) {
   EXPECT_LE(tight.levels, plan_method(Method::pyramid, 24.0, 4096, 4096, 0.5).levels);
   EXPECT_LE(tight.expected_relative_l2, 1e-2);
   EXPECT_GE(tight.level_sigma, 0.5);
-  // The image size caps k: a 16x16 image has at most 4 levels.
-  EXPECT_LE(plan_method(Method::pyramid, 64.0, 16, 16, 1.0).levels, 4u);
-  EXPECT_LE(plan_method(Method::pyramid, 64.0, 16, 16, 1.0).level_sigma, 3.0);
+  // The padded extent caps k (docs/BLUR.md "Borders"): a 16x16 image at sigma 64 may take up to
+  // floor(log2(16 + 8 x 64)) = 9 levels, enough for a level sigma in range.
+  const Plan small = plan_method(Method::pyramid, 64.0, 16, 16, 1.0);
+  EXPECT_LE(small.levels, 9u);
+  EXPECT_LE(small.level_sigma, 3.0);
+  EXPECT_GE(small.level_sigma, 0.5);
+  EXPECT_NEAR(small.effective_sigma_px, 64.0, 1e-9 * 64.0);
 }
 
 TEST(BlurPlan, DualPlanMatchesTheSigma) {
@@ -176,6 +180,89 @@ TEST(BlurPlan, AutoTakesTheCheapestPlanWithinTheBound) {
   EXPECT_EQ(plan_auto(1.2, 3840, 2160, 1e-2).method, Method::separable);
   EXPECT_THROW(plan_auto(0.0, 64, 64, 1e-2), std::invalid_argument);
   EXPECT_THROW(plan_auto(2.0, 0, 64, 1e-2), std::invalid_argument);
+}
+
+// docs/BLUR.md "Borders": the padded chain is an exact 2:1 chain (sizes multiples of 2^k, pads
+// multiples of 2^k) that extends the input by at least the reach of every level on both sides,
+// and no further than needed by one level-k block.
+TEST(BlurPlan, PaddingMakesAnExactChainBeyondTheReachOfEveryLevel) {
+  for (uint32_t w : {1u, 7u, 203u, 512u, 1921u}) {
+    for (double sigma : {1.0, 4.0, 20.0, 50.0}) {
+      for (Method m : {Method::pyramid, Method::dual}) {
+        const Plan p = plan_method(m, sigma, w, 157, 1e-2);
+        const Padding& pad = p.padding;
+        const uint32_t block = 1u << p.levels;
+        SCOPED_TRACE(testing::Message() << "w " << w << " sigma " << sigma << " method " << unsigned(m));
+        EXPECT_EQ(pad.pad_x % block, 0u);
+        EXPECT_EQ(pad.padded_width % block, 0u);
+        EXPECT_EQ(pad.padded_height % block, 0u);
+        EXPECT_GE(pad.padded_width, w + 2 * pad.pad_x) << "the right pad is at least the left one";
+        EXPECT_LT(pad.padded_width, w + 2 * pad.pad_x + block);
+        // At least the reach of the level-k filter: the pyramid's blur radius and B-spline (R + 2
+        // level texels), the dual's k up passes (o + 1 level texels each, halved per level).
+        const double reach = m == Method::pyramid ? (p.radius + 2.0) * block : (p.dual_offset + 1.0) * block;
+        EXPECT_GE(pad.pad_x, reach);
+        // The same plan's padding_of() recomputes it (the reference uses that).
+        const Padding again = padding_of(p, w, 157);
+        EXPECT_EQ(again.pad_x, pad.pad_x);
+        EXPECT_EQ(again.padded_height, pad.padded_height);
+      }
+    }
+  }
+  const Plan sep = plan_method(Method::separable, 3.0, 100, 50, 1e-2);
+  EXPECT_EQ(sep.padding.pad_x, 0u);
+  EXPECT_EQ(sep.padding.padded_width, 100u);
+}
+
+// The fit recovers the constants that generated the measurements, and keeps every constant
+// positive when the data would drive one below zero.
+TEST(BlurPlan, CostModelFitRecoversItsConstants) {
+  CostModel truth;
+  truth.us_per_dispatch = 40.0;
+  truth.us_per_byte = 2e-4;
+  truth.us_per_shared_tap = 3e-2;
+  truth.us_per_fetch_tap = 5e-3;
+  std::vector<Work> work;
+  std::vector<double> us;
+  for (Method m : {Method::separable, Method::pyramid, Method::dual}) {
+    for (double sigma : {1.5, 8.0}) {
+      for (uint32_t n : {32u, 128u}) {
+        work.push_back(plan_method(m, sigma, n, n, 1e-2).work);
+        us.push_back(truth.estimate_us(work.back()));
+      }
+    }
+  }
+  const CostModel fit = fit_cost_model(work, us);
+  EXPECT_NEAR(fit.us_per_dispatch, truth.us_per_dispatch, 1e-6 * truth.us_per_dispatch);
+  EXPECT_NEAR(fit.us_per_byte, truth.us_per_byte, 1e-6 * truth.us_per_byte);
+  EXPECT_NEAR(fit.us_per_shared_tap, truth.us_per_shared_tap, 1e-6 * truth.us_per_shared_tap);
+  EXPECT_NEAR(fit.us_per_fetch_tap, truth.us_per_fetch_tap, 1e-6 * truth.us_per_fetch_tap);
+  // Times that fall with the work: no negative constant comes out.
+  std::vector<double> falling(us.size());
+  for (size_t i = 0; i < us.size(); ++i) falling[i] = 100.0 / (1.0 + double(i));
+  const CostModel odd = fit_cost_model(work, falling);
+  EXPECT_GT(odd.us_per_dispatch, 0.0);
+  EXPECT_GT(odd.us_per_byte, 0.0);
+  EXPECT_GT(odd.us_per_shared_tap, 0.0);
+  EXPECT_GT(odd.us_per_fetch_tap, 0.0);
+  EXPECT_THROW(fit_cost_model({Work{}}, {1.0}), std::invalid_argument);
+}
+
+// auto ranks by the device's model: where taps are dear and dispatches cheap (a CPU device), a
+// 401-tap separable blur loses to the pyramid that the H100's dispatch-bound model may prefer on
+// a small image; the choice always meets the bound.
+TEST(BlurPlan, AutoFollowsTheDevicesCostModel) {
+  CostModel cpu;
+  cpu.us_per_dispatch = 50.0;
+  cpu.us_per_byte = 1e-3;
+  cpu.us_per_shared_tap = 3e-2;
+  cpu.us_per_fetch_tap = 1e-2;
+  const Plan a = plan_auto(50.0, 512, 512, 0.02, cpu);
+  EXPECT_EQ(a.method, Method::pyramid);
+  EXPECT_LE(a.expected_relative_l2, 0.02);
+  EXPECT_DOUBLE_EQ(a.cost, cpu.estimate_us(a.work));
+  const Plan sep = plan_method(Method::separable, 50.0, 512, 512, 0.02);
+  EXPECT_GT(cpu.estimate_us(sep.work), 10.0 * a.cost);
 }
 
 }  // namespace

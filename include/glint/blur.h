@@ -117,9 +117,29 @@ class BlurPyramid {
 enum class BlurMethod : uint32_t {
   automatic = 0,  //!< the fastest method whose modelled error is under max_relative_error
   separable = 1,  //!< direct separable Gaussian in shared memory (the accurate one)
-  pyramid = 2,    //!< area downsample k levels, blur there, bilinear back up
+  pyramid = 2,    //!< binomial downsample k levels, blur there, cubic B-spline back up
   dual = 3,       //!< dual filter down/up (Bjørge 2015), tap offset tuned to the sigma
 };
+
+/// The per-device constants of the cost model by which `automatic` ranks the methods that meet
+/// the error bound (docs/BLUR.md "Cost model"): estimated microseconds = us_per_dispatch x
+/// dispatches + us_per_byte x image bytes + us_per_shared_tap x taps read from shared memory +
+/// us_per_fetch_tap x taps fetched from images. All zero (the default) means "this device's":
+/// measured once per standalone Context at the first automatic plan (measure_blur_cost_model()),
+/// and built-in constants fitted on an H100 for an adopted Context, which never submits; an engine
+/// can measure on a standalone Context of the same device once and pass the result here.
+struct BlurCostModel {
+  double us_per_dispatch = 0;
+  double us_per_byte = 0;
+  double us_per_shared_tap = 0;
+  double us_per_fetch_tap = 0;
+};
+
+/// Measures the cost model of `context`'s device: times a few small blurs of each method with
+/// timestamps (wall clock where the queue has no timestamps) and fits the constants to them; about
+/// 1 s on lavapipe, mostly compiling pipelines. Cached: later calls on the same Context return the
+/// first result. Standalone contexts only (Error(invalid_argument) for an adopted one).
+BlurCostModel measure_blur_cost_model(const Context& context);
 
 /// Settings of a GaussianBlur. All fields are shape fields (they decide levels and taps).
 struct GaussianBlurConfig {
@@ -130,6 +150,9 @@ struct GaussianBlurConfig {
   bool linear_sampling = false;               //!< separable only: two passes that pair taps into bilinear
                                               //!< fetches through the sampler (9 taps in 5 fetches)
   Precision precision = Precision::fp16;      //!< intermediate images
+  /// automatic: the device's cost constants; all zero = measured (see BlurCostModel). Each is
+  /// finite and >= 0, and all are zero or all > 0.
+  BlurCostModel cost_model{};
 
   /// Throws Error(invalid_argument) naming the first field that is out of range or NaN.
   void validate() const;
@@ -144,8 +167,10 @@ struct BlurChoice {
   double level_sigma = 0;              //!< pyramid: sigma in texels of the smallest level
   double dual_offset = 0;              //!< dual: tap offset o in texels
   double effective_sigma_px = 0;       //!< sigma of the method's impulse response, input pixels
-  double expected_relative_error = 0;  //!< modelled relative L2 against the exact Gaussian, storage rounding included
+  double expected_relative_error = 0;  //!< modelled relative L2 against the exact Gaussian over the whole
+                                       //!< image (borders included), storage rounding included
   uint32_t dispatches = 0;
+  double estimated_us = 0;  //!< the cost model's estimate for this plan (what automatic compared)
 };
 
 /// A same-size Gaussian blur of input into output.

@@ -26,10 +26,12 @@ namespace glint {
 using detail::check_range;
 using detail::concat;
 
-static_assert(sizeof(BlurPush) == 96, "BlurPush layout changed: update src/blur/shaders/blur_params.h users");
+static_assert(sizeof(BlurPush) == 120, "BlurPush layout changed: update src/blur/shaders/blur_params.h users");
 static_assert(offsetof(BlurPush, max_value) == 16);
 static_assert(offsetof(BlurPush, tap_count) == 28);
 static_assert(offsetof(BlurPush, weights) == 32);
+static_assert(offsetof(BlurPush, src_origin_x) == 96);
+static_assert(offsetof(BlurPush, ratio_y) == 116);
 static_assert(static_cast<uint32_t>(BlurMethod::separable) - 1 == static_cast<uint32_t>(blur_plan::Method::separable));
 static_assert(static_cast<uint32_t>(BlurMethod::pyramid) == static_cast<uint32_t>(blur_plan::Method::pyramid));
 static_assert(static_cast<uint32_t>(BlurMethod::dual) == static_cast<uint32_t>(blur_plan::Method::dual));
@@ -74,6 +76,22 @@ void GaussianBlurConfig::validate() const {
   if (p > 1) {
     throw Error(ErrorCode::invalid_argument,
                 concat("GaussianBlurConfig::precision = ", p, " is not a Precision: accepted fp16, fp32"));
+  }
+  const double costs[4] = {cost_model.us_per_dispatch, cost_model.us_per_byte, cost_model.us_per_shared_tap,
+                           cost_model.us_per_fetch_tap};
+  const char* cost_names[4] = {"us_per_dispatch", "us_per_byte", "us_per_shared_tap", "us_per_fetch_tap"};
+  int zeros = 0;
+  for (int i = 0; i < 4; ++i) {
+    if (!(costs[i] >= 0.0) || !std::isfinite(costs[i])) {
+      throw Error(ErrorCode::invalid_argument, concat("GaussianBlurConfig::cost_model.", cost_names[i], " = ", costs[i],
+                                                      " is out of range: accepted finite and >= 0"));
+    }
+    zeros += costs[i] == 0.0;
+  }
+  if (zeros != 0 && zeros != 4) {
+    throw Error(ErrorCode::invalid_argument,
+                concat("GaussianBlurConfig::cost_model has ", zeros,
+                       " zero fields: accepted all zero (measure on the device) or all > 0"));
   }
   if (linear_sampling && method != BlurMethod::separable) {
     throw Error(
@@ -318,7 +336,30 @@ BlurPush make_push(VkExtent2D src, VkExtent2D dst, uint32_t flags, float max_val
   p.max_value = max_value;
   p.flags = flags;
   p.offset = 1.0f;
+  p.ratio_x = static_cast<float>(src.width) / static_cast<float>(dst.width);
+  p.ratio_y = static_cast<float>(src.height) / static_cast<float>(dst.height);
   return p;
+}
+
+// A padded chain's first step (docs/BLUR.md "Borders"): it reads the caller's input, `input`
+// texels, as the virtual padded level 0 whose texel u is the input's clamp(u - pad). The step's
+// ratio stays that of the virtual sizes.
+void read_padded_input(Step& s, VkExtent2D input, const blur_plan::Padding& pad) {
+  s.push.src_width = static_cast<int32_t>(input.width);
+  s.push.src_height = static_cast<int32_t>(input.height);
+  s.push.src_origin_x = static_cast<int32_t>(pad.pad_x);
+  s.push.src_origin_y = static_cast<int32_t>(pad.pad_y);
+}
+
+// A padded chain's last step: it writes only the input's extent of the virtual padded output,
+// texel xy of the caller's output being the virtual texel xy + pad.
+void write_padded_output(Step& s, VkExtent2D output, const blur_plan::Padding& pad) {
+  s.push.dst_width = static_cast<int32_t>(output.width);
+  s.push.dst_height = static_cast<int32_t>(output.height);
+  s.push.dst_origin_x = static_cast<int32_t>(pad.pad_x);
+  s.push.dst_origin_y = static_cast<int32_t>(pad.pad_y);
+  s.invocations_x = output.width;
+  s.invocations_y = output.height;
 }
 
 VkExtent2D half_extent(VkExtent2D e) { return {blur_plan::half_size(e.width), blur_plan::half_size(e.height)}; }
@@ -547,13 +588,27 @@ struct GaussianBlur::Impl {
     return st;
   }
 
-  BlurChoice plan(VkExtent2D size, VkFormat out_format) const {
+  // The cost model automatic ranks plans by: the config's, else the device's (docs/BLUR.md "Cost
+  // model").
+  blur_plan::CostModel cost_model() const {
+    BlurCostModel c = config.cost_model;
+    if (c.us_per_dispatch == 0.0) c = context->is_adopted() ? BlurCostModel{} : measure_blur_cost_model(*context);
+    blur_plan::CostModel m;
+    if (c.us_per_dispatch == 0.0) return m;  // adopted, nothing passed in: the built-in constants
+    m.us_per_dispatch = c.us_per_dispatch;
+    m.us_per_byte = c.us_per_byte;
+    m.us_per_shared_tap = c.us_per_shared_tap;
+    m.us_per_fetch_tap = c.us_per_fetch_tap;
+    return m;
+  }
+
+  blur_plan::Plan plan(VkExtent2D size, VkFormat out_format, BlurChoice& choice) const {
     const double bound = config.max_relative_error;
     const blur_plan::Storage st = storage(out_format);
     blur_plan::Plan p;
     switch (config.method) {
       case BlurMethod::automatic:
-        p = blur_plan::plan_auto(config.sigma_px, size.width, size.height, bound, st);
+        p = blur_plan::plan_auto(config.sigma_px, size.width, size.height, bound, st, cost_model());
         break;
       case BlurMethod::separable:
         p = blur_plan::plan_method(
@@ -567,7 +622,7 @@ struct GaussianBlur::Impl {
         p = blur_plan::plan_method(blur_plan::Method::dual, config.sigma_px, size.width, size.height, bound, st);
         break;
     }
-    BlurChoice choice;
+    choice = BlurChoice{};
     choice.linear_sampling = p.method == blur_plan::Method::separable_linear;
     choice.method = (p.method == blur_plan::Method::separable || choice.linear_sampling) ? BlurMethod::separable
                     : p.method == blur_plan::Method::pyramid                             ? BlurMethod::pyramid
@@ -578,7 +633,8 @@ struct GaussianBlur::Impl {
     choice.dual_offset = p.dual_offset;
     choice.effective_sigma_px = p.effective_sigma_px;
     choice.expected_relative_error = p.expected_relative_l2;
-    return choice;
+    choice.estimated_us = p.cost;
+    return p;
   }
 
   std::unique_ptr<Size> make(VkExtent2D size, VkFormat out_format) {
@@ -588,7 +644,9 @@ struct GaussianBlur::Impl {
     prog.pipelines = &pipelines;
     made->extent = size;
     made->output_format = out_format;
-    made->choice = plan(size, out_format);
+    const blur_plan::Plan plan_made = plan(size, out_format, made->choice);
+    const blur_plan::Padding& pad = plan_made.padding;
+    const VkExtent2D padded{pad.padded_width, pad.padded_height};  // the virtual level 0
     BlurChoice& choice = made->choice;
     std::vector<std::pair<VkExtent2D, VkFormat>>& intermediates = made->intermediates;
     const DeviceInfo& info = context->info();
@@ -649,22 +707,27 @@ struct GaussianBlur::Impl {
         prog.steps.push_back(std::move(s));
       }
     } else if (choice.method == BlurMethod::pyramid) {
-      VkExtent2D prev = size;
+      // The chain runs on the padded extent (docs/BLUR.md "Borders"): exact halves down to level k.
+      VkExtent2D prev = padded;
       int src = kInput;
       for (uint32_t j = 1; j <= choice.levels; ++j) {
         const VkExtent2D e = half_extent(prev);
         const int dst = add(e);
         const bool last = j == choice.levels;
-        prog.steps.push_back(fused_step(prog, info, src, dst, prev, e, lf, last ? choice.level_sigma : 0.0,
-                                        blur_plan::kGaussTruncation, true, src == kInput ? sanitize : 0u, max_value,
-                                        concat("gauss pyramid level ", j, last ? " (blur)" : " (down)")));
+        Step s = fused_step(prog, info, src, dst, prev, e, lf, last ? choice.level_sigma : 0.0,
+                            blur_plan::kGaussTruncation, true, src == kInput ? sanitize : 0u, max_value,
+                            concat("gauss pyramid level ", j, last ? " (blur)" : " (down)"));
+        if (src == kInput) read_padded_input(s, size, pad);
+        prog.steps.push_back(std::move(s));
         src = dst;
         prev = e;
       }
-      prog.steps.push_back(simple_step(prog, "blur_upsample", src, kOutput, prev, size, out_format, 0u, max_value,
-                                       "gauss pyramid upsample"));
-    } else {  // dual
-      std::vector<VkExtent2D> sizes = {size};
+      Step up = simple_step(prog, "blur_upsample", src, kOutput, prev, padded, out_format, 0u, max_value,
+                            "gauss pyramid upsample");
+      write_padded_output(up, size, pad);
+      prog.steps.push_back(std::move(up));
+    } else {  // dual, on the padded extent as the pyramid
+      std::vector<VkExtent2D> sizes = {padded};
       std::vector<int> ids = {kInput};
       for (uint32_t j = 1; j <= choice.levels; ++j) {
         const VkExtent2D e = half_extent(sizes.back());
@@ -672,6 +735,7 @@ struct GaussianBlur::Impl {
         Step s = simple_step(prog, "blur_dual_down", ids.back(), dst, sizes.back(), e, lf,
                              ids.back() == kInput ? sanitize : 0u, max_value, concat("gauss dual down ", j));
         s.push.offset = static_cast<float>(choice.dual_offset);
+        if (ids.back() == kInput) read_padded_input(s, size, pad);
         prog.steps.push_back(std::move(s));
         sizes.push_back(e);
         ids.push_back(dst);
@@ -682,6 +746,7 @@ struct GaussianBlur::Impl {
         Step s = simple_step(prog, "blur_dual_up", ids[j + 1], last ? kOutput : ids[j], sizes[j + 1], sizes[j],
                              last ? out_format : lf, 0u, max_value, concat("gauss dual up ", j));
         s.push.offset = static_cast<float>(choice.dual_offset);
+        if (last) write_padded_output(s, size, pad);
         prog.steps.push_back(std::move(s));
       }
     }

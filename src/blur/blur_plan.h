@@ -1,6 +1,9 @@
 // Planning of the blur family (docs/BLUR.md): Gaussian taps from sigma, level sizes, the
 // variance bookkeeping of the pyramid, the parameters of each GaussianBlur method for a
-// requested sigma, and the modelled error that `auto` uses. Pure float64 CPU code, no Vulkan.
+// requested sigma, the border padding of the pyramid and dual chains, the modelled error and the
+// cost model that `auto` uses. Pure float64 CPU code, no Vulkan. Implemented by concern:
+// blur_taps.cpp (taps and variances), blur_error_model.cpp (modelled and rounding error),
+// blur_cost_model.cpp (work and cost), blur_border.cpp (padding), blur_plan.cpp (the plans).
 #pragma once
 
 #include <cstdint>
@@ -39,6 +42,45 @@ std::vector<double> pyramid_effective_sigma(uint32_t size, const std::vector<dou
 
 enum class Method : uint32_t { separable = 0, separable_linear = 1, pyramid = 2, dual = 3 };
 
+/// The border padding of a pyramid or dual chain (docs/BLUR.md "Borders"): the chain runs on a
+/// virtual padded input of padded_width x padded_height (multiples of 2^levels, so every level is
+/// an exact half) whose texel (u, v) is the input's texel (u - pad_x, v - pad_y) clamped to the
+/// input, i.e. the clamp-to-edge extension at full resolution. The pads are large enough that no
+/// output texel of the input's extent reads a clamped texel of levels 1..k, so the output equals
+/// the chain on the infinite clamp-to-edge extension: the exact Gaussian's own border rule.
+struct Padding {
+  uint32_t pad_x = 0, pad_y = 0;                 //!< left / top pad (input pixels, multiples of 2^levels)
+  uint32_t padded_width = 0, padded_height = 0;  //!< the virtual level-0 size
+};
+
+/// What a plan's dispatches do, the features of the cost model (docs/BLUR.md "Cost model").
+struct Work {
+  double dispatches = 0;   //!< dispatches (each followed by a barrier)
+  double bytes = 0;        //!< image bytes read and written, 8 a texel (RGBA16F)
+  double shared_taps = 0;  //!< texel-taps read from shared memory (fused and line kernels)
+  double fetch_taps = 0;   //!< texel-taps fetched from images (binomial, B-spline, dual)
+};
+
+/// Microseconds per unit of Work on one device: estimate_us(w) = the dot product. The defaults
+/// were fitted on an H100; GaussianBlur measures a device's own at first use (docs/BLUR.md "Cost
+/// model").
+struct CostModel {
+  double us_per_dispatch = 3.0;
+  double us_per_byte = 1.0 / 2.5e6;
+  double us_per_shared_tap = 1.0 / 2.0e7;
+  double us_per_fetch_tap = 1.0 / 2.0e7;
+  double estimate_us(const Work& w) const {
+    return us_per_dispatch * w.dispatches + us_per_byte * w.bytes + us_per_shared_tap * w.shared_taps +
+           us_per_fetch_tap * w.fetch_taps;
+  }
+};
+
+/// Fits a CostModel to measured runs (microseconds each) of the given work by least squares on the
+/// relative residuals, every coefficient kept positive (a coefficient the fit drives below zero is
+/// held at 1e-3 of its default, so no feature is ever free). Throws std::invalid_argument when
+/// the sizes differ or fewer than 4 runs are given.
+CostModel fit_cost_model(const std::vector<Work>& work, const std::vector<double>& measured_us);
+
 /// The parameters of one method for one sigma (input pixels) at one image size.
 struct Plan {
   Method method = Method::separable;
@@ -49,8 +91,14 @@ struct Plan {
   double dual_offset = 1;           //!< dual: o
   double effective_sigma_px = 0;    //!< sigma of the method's impulse response (input pixels)
   double expected_relative_l2 = 0;  //!< modelled error against the exact Gaussian (docs/BLUR.md)
-  double cost = 0;                  //!< relative cost estimate used by auto (full-resolution texel passes)
+  Padding padding;                  //!< pyramid / dual: the padded chain (padding_of())
+  Work work;                        //!< what the plan's dispatches do
+  double cost = 0;                  //!< estimated microseconds (CostModel::estimate_us(work))
 };
+
+/// The border padding of a pyramid (levels, radius) or dual (levels, dual_offset) plan on an input
+/// of width x height (zero pads, the input size, for separable). See Padding.
+Padding padding_of(const Plan& plan, uint32_t width, uint32_t height);
 
 /// How the GPU stores and samples what a plan computes, for the rounding part of the expected
 /// error (docs/BLUR.md "Error model"). A unit is the largest relative error one store into that
@@ -84,14 +132,16 @@ Plan plan_method(Method method, double sigma_px, uint32_t width, uint32_t height
 
 /// The cheapest plan among separable, pyramid and dual whose expected error is <= max_relative_l2
 /// (separable always qualifies: it is the reference up to truncation at 4 sigma; if even it misses
-/// a very small bound it is returned with its error).
-Plan plan_auto(double sigma_px, uint32_t width, uint32_t height, double max_relative_l2);
+/// a very small bound it is returned with its error). Costs by `model` (default: the H100's).
+Plan plan_auto(double sigma_px, uint32_t width, uint32_t height, double max_relative_l2,
+               const CostModel& model = CostModel{});
 
 /// plan_method() and plan_auto() with the rounding of `storage` added to expected_relative_l2
 /// (rounding_bound()), which is then what the bound is compared with: the error of what the
 /// caller's output holds, not only of the algorithm.
 Plan plan_method(Method method, double sigma_px, uint32_t width, uint32_t height, double max_relative_l2,
                  const Storage& storage);
-Plan plan_auto(double sigma_px, uint32_t width, uint32_t height, double max_relative_l2, const Storage& storage);
+Plan plan_auto(double sigma_px, uint32_t width, uint32_t height, double max_relative_l2, const Storage& storage,
+               const CostModel& model = CostModel{});
 
 }  // namespace glint::blur_plan

@@ -59,6 +59,12 @@ struct ContextState {
   /// Whether the run_once() call of `serial` (non-zero) is still recording or executing.
   bool once_pending(uint64_t serial) const;
 
+  // GaussianBlur's measured cost model (measure_blur_cost_model(), docs/BLUR.md "Cost model"):
+  // us per dispatch, byte, shared tap, fetch tap; measured once, under blur_cost_mutex.
+  std::mutex blur_cost_mutex;
+  bool blur_cost_measured = false;
+  double blur_cost[4] = {0, 0, 0, 0};
+
   VkDebugUtilsMessengerEXT messenger = VK_NULL_HANDLE;
   mutable std::mutex log_mutex;
   std::vector<std::string> validation_log;

@@ -4,7 +4,6 @@
 // method chosen and its expected error. Ranges are checked by the configs' validate().
 #include <glint/blur.h>
 
-#include <cmath>
 #include <cstdio>
 #include <memory>
 #include <sstream>
@@ -115,15 +114,14 @@ void run_gauss(GaussOptions& o) {
     std::printf(", %u levels, sigma %.3f texels at the last", c.levels, c.level_sigma);
   if (c.method == BlurMethod::dual) std::printf(", %u levels, tap offset %.3f", c.levels, c.dual_offset);
   std::printf(", %u dispatches\n", c.dispatches);
-  std::printf("sigma: %.3f px asked, %.3f px effective; expected relative L2 error %.2e (bound %.2e)",
-              o.config.sigma_px, c.effective_sigma_px, c.expected_relative_error, o.config.max_relative_error);
-  if (c.method == BlurMethod::pyramid || c.method == BlurMethod::dual) {
-    // The model bounds the interior only: near a border these methods clamp at their levels'
-    // resolution, the exact Gaussian at full resolution (docs/BLUR.md, "Error model").
-    const double band = std::ceil(4.0 * o.config.sigma_px + std::ldexp(1.0, int(c.levels) + 1));
-    std::printf(" in the interior, more than %.0f px from a border (the border band is not bounded)", band);
-  }
-  std::printf("\n");
+  // Over the whole image, borders included: the pyramid and dual run on chains padded by the
+  // clamp-to-edge extension at full resolution, the exact Gaussian's border rule (docs/BLUR.md,
+  // "Borders").
+  std::printf(
+      "sigma: %.3f px asked, %.3f px effective; expected relative L2 error %.2e over the whole image "
+      "(bound %.2e)\n",
+      o.config.sigma_px, c.effective_sigma_px, c.expected_relative_error, o.config.max_relative_error);
+  if (o.config.method == BlurMethod::automatic) std::printf("cost model estimate: %.3g us\n", c.estimated_us);
   print_stages(profiler);
   io::AtomicOutputs files;
   files.write(o.output, [&](const std::string& tmp) { write_result_exr(tmp, output, o.fp32); });
@@ -156,7 +154,7 @@ Command add_gauss_command(CLI::App& app) {
   sub->add_option("--method", o->method, "auto, separable, pyramid or dual")
       ->check(CLI::IsMember({"auto", "separable", "pyramid", "dual"}));
   sub->add_option("--max-error", o->config.max_relative_error,
-                  "auto/pyramid: bound on the modelled relative L2 error (1e-4 to 1)");
+                  "auto/pyramid: bound on the expected relative L2 error over the whole image (1e-4 to 1)");
   sub->add_flag("--linear", o->linear, "separable: pair taps into bilinear sampler fetches (9 taps in 5)");
   sub->add_flag("--fp32", o->fp32,
                 "RGBA32F intermediates and output, written as 32-bit float EXR (default: RGBA16F, half EXR)");

@@ -370,25 +370,54 @@ DoubleImage gaussian_separable_linear(const CpuImage& input, double sigma_px, in
   return linear_pass(h, half, subtexel_bits, /*vertical=*/true);
 }
 
-// docs/BLUR.md "pyramid".
+namespace {
+
+// docs/BLUR.md "Borders": the padded level 0 of a pyramid or dual chain, whose texel (u, v) is
+// src's texel (u - pad_x, v - pad_y) clamped (the clamp-to-edge extension at full resolution).
+DoubleImage pad_clamped(const DoubleImage& src, const blur_plan::Padding& pad) {
+  DoubleImage dst = make_image(pad.padded_width, pad.padded_height);
+  for (uint32_t v = 0; v < dst.height; ++v)
+    for (uint32_t u = 0; u < dst.width; ++u) {
+      const double* t = fetch(src, int64_t(u) - pad.pad_x, int64_t(v) - pad.pad_y);
+      std::copy(t, t + 4, dst.at(u, v));
+    }
+  return dst;
+}
+
+// The input's extent of a padded chain's full-resolution output.
+DoubleImage crop(const DoubleImage& src, const blur_plan::Padding& pad, uint32_t width, uint32_t height) {
+  DoubleImage dst = make_image(width, height);
+  for (uint32_t y = 0; y < height; ++y)
+    for (uint32_t x = 0; x < width; ++x) {
+      const double* t = src.at(x + pad.pad_x, y + pad.pad_y);
+      std::copy(t, t + 4, dst.at(x, y));
+    }
+  return dst;
+}
+
+}  // namespace
+
+// docs/BLUR.md "pyramid", on the padded chain of "Borders".
 DoubleImage gaussian_pyramid(const CpuImage& input, const blur_plan::Plan& plan, bool round_half, double max_value) {
   if (plan.levels == 0) throw std::invalid_argument("gaussian_pyramid: plan.levels must be >= 1");
-  DoubleImage level = sanitize(input, max_value);
+  const blur_plan::Padding pad = blur_plan::padding_of(plan, input.width, input.height);
+  DoubleImage level = pad_clamped(sanitize(input, max_value), pad);
   for (uint32_t j = 1; j <= plan.levels; ++j) {
     const uint32_t w = blur_plan::half_size(level.width), h = blur_plan::half_size(level.height);
     level = j < plan.levels ? binomial_downsample(level, w, h)
                             : fused_level_blur(level, w, h, plan.level_sigma, blur_plan::kGaussTruncation, true);
     if (round_half) store_half(level);
   }
-  // Cubic B-spline at (map(x, W, wk), map(y, H, hk)): texels floor - 1 .. floor + 2 per axis, clamped.
+  // Cubic B-spline at (map(x + pad_x, W', wk), map(y + pad_y, H', hk)): texels floor - 1 .. floor + 2
+  // per axis, clamped; only the input's extent of the padded output.
   DoubleImage out = make_image(input.width, input.height);
   for (uint32_t y = 0; y < out.height; ++y) {
-    const double py = map_coord(y, out.height, level.height);
+    const double py = map_coord(y + pad.pad_y, pad.padded_height, level.height);
     const double fy = std::floor(py);
     double wy[4];
     bspline_weights(py - fy, wy);
     for (uint32_t x = 0; x < out.width; ++x) {
-      const double px = map_coord(x, out.width, level.width);
+      const double px = map_coord(x + pad.pad_x, pad.padded_width, level.width);
       const double fx = std::floor(px);
       double wx[4];
       bspline_weights(px - fx, wx);
@@ -411,8 +440,9 @@ DoubleImage gaussian_dual(const CpuImage& input, const blur_plan::Plan& plan, bo
   const std::vector<Tap> down = {{0, 0, 0.5}, {-o, -o, 0.125}, {o, -o, 0.125}, {-o, o, 0.125}, {o, o, 0.125}};
   const std::vector<Tap> up = {{-o, 0, 1.0 / 12},  {o, 0, 1.0 / 12},  {0, -o, 1.0 / 12}, {0, o, 1.0 / 12},
                                {-h, -h, 2.0 / 12}, {h, -h, 2.0 / 12}, {-h, h, 2.0 / 12}, {h, h, 2.0 / 12}};
+  const blur_plan::Padding pad = blur_plan::padding_of(plan, input.width, input.height);
   std::vector<DoubleImage> d;
-  d.push_back(sanitize(input, max_value));
+  d.push_back(pad_clamped(sanitize(input, max_value), pad));
   for (uint32_t j = 1; j <= plan.levels; ++j) {
     const DoubleImage& prev = d.back();
     d.push_back(dual_pass(prev, blur_plan::half_size(prev.width), blur_plan::half_size(prev.height), down));
@@ -423,7 +453,7 @@ DoubleImage gaussian_dual(const CpuImage& input, const blur_plan::Plan& plan, bo
     u = dual_pass(u, d[j].width, d[j].height, up);
     if (round_half && j > 0) store_half(u);
   }
-  return u;
+  return crop(u, pad, input.width, input.height);
 }
 
 // docs/BLUR.md "Error model and metrics".

@@ -19,7 +19,7 @@ void main() {
   ivec2 xy = ivec2(gl_GlobalInvocationID.xy);
   ivec2 size = ivec2(p.dst_width, p.dst_height);
   if (any(greaterThanEqual(xy, size))) return;
-  vec2 c = map_position(xy, size, ivec2(p.src_width, p.src_height));
+  vec2 c = source_position(xy);
   float o = p.offset;
   float h = 0.5 * o;
   vec4 edges = src_bilinear(c + vec2(-o, 0.0)) + src_bilinear(c + vec2(o, 0.0)) +

@@ -21,6 +21,17 @@ struct BlurPush {
   GLINT_FLOAT offset;    // dual: tap offset o
   GLINT_UINT tap_count;  // line: radius R (weights in the tap buffer); linear: fetches per side
   GLINT_FLOAT weights[GLINT_BLUR_PUSH_TAPS];  // fused: w[0..R]
+  // Where a destination texel reads the source (docs/BLUR.md "Borders"): destination texel xy is
+  // texel xy + dst_origin of a virtual destination, whose position maps to the virtual source at
+  // (xy + dst_origin + 0.5) * ratio - 0.5 (ratio = virtual source size / virtual destination
+  // size), which is the real source's texel position minus src_origin. All zero origins and
+  // ratio = src size / dst size unless the step reads or writes a padded chain's caller image.
+  GLINT_INT src_origin_x;
+  GLINT_INT src_origin_y;
+  GLINT_INT dst_origin_x;
+  GLINT_INT dst_origin_y;
+  GLINT_FLOAT ratio_x;
+  GLINT_FLOAT ratio_y;
 };
 
 #endif

@@ -20,7 +20,7 @@ void main() {
   ivec2 xy = ivec2(gl_GlobalInvocationID.xy);
   ivec2 size = ivec2(p.dst_width, p.dst_height);
   if (any(greaterThanEqual(xy, size))) return;
-  vec2 q = map_position(xy, size, ivec2(p.src_width, p.src_height));
+  vec2 q = source_position(xy);
   vec2 f = floor(q);
   vec4 wx = bspline_weights(q.x - f.x);
   vec4 wy = bspline_weights(q.y - f.y);
