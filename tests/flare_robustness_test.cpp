@@ -670,7 +670,7 @@ TEST_F(FlareRobustnessTest, FlarePassHandlesDegenerateAndThinSizes) {
 
 // 1x1 (no level), 1xN and Nx1 (one side stays 1 at every level), 4097x3 (a 64-wide edge tile plus
 // one column, odd folds on the short side) and the device's largest side as a 2-pixel-thin image,
-// both ways (two passes; 16384x2 and 2x16384 on lavapipe): bit-identical to the float64 reference,
+// both ways (16384x2 and 2x16384 on lavapipe): bit-identical to the float64 reference,
 // D32 / R32 and both Z conventions in turn.
 TEST_F(FlareRobustnessTest, HiZMatchesTheReferenceAtDegenerateAndThinSizes) {
   const uint32_t max_side = std::min(16384u, context().info().max_image_dimension_2d);

@@ -4,6 +4,7 @@ set(GLINT_EFFECT_SOURCES occlusion.cpp object_cull.cpp)
 # compact_scan_tiles and compact_scatter are the ordered compaction's own kernels (both culls use
 # them through src/core/compaction.h; its shared GLSL is src/core/shaders/compact.glsl).
 set(GLINT_EFFECT_KERNELS
+  "shaders/hiz_stream|main|"
   "shaders/hiz_build|main|"
   "shaders/compact_scan_tiles|main|"
   "shaders/compact_scatter|main|"

@@ -110,31 +110,35 @@ struct HiZPyramid::Impl {
   // The pyramid: one R32F image with max(1, levels) mips, a sampling view of all mips and a storage
   // view per mip.
   detail::OwnedImage pyramid;
-  detail::OwnedBuffer counters;  // one word per dispatch
+  detail::OwnedBuffer counters;  // the counter word of the tile dispatch (16 bytes)
   Buffer counter_state;
   bool counters_cleared = false;
-  // Nearest, clamp-to-edge: the kernel gathers 2x2 depth texels per fetch (hiz_build.comp).
+  // Nearest, clamp-to-edge: hiz_stream.comp gathers 2x2 depth texels per fetch.
   VkSampler sampler = VK_NULL_HANDLE;  // owned by the context
-  // One pipeline per base level a pass reads (specialization constant 2): [0] reads the depth
-  // image, [1] level GLINT_HIZ_TILE_LEVELS (made only when a second pass is planned, above 4096).
-  detail::ComputePipeline pipelines[2];
-  // Descriptor sets per caller depth view, one per pipeline (each holds 14 storage images).
+  // The two dispatches (docs/OCCLUSION.md, "Hi-Z pyramid"): hiz_stream.comp writes levels 1 and 2
+  // from the depth image, hiz_build.comp the levels above 2 (made only when there are any).
+  detail::ComputePipeline stream_pipeline;
+  detail::ComputePipeline tile_pipeline;
+  // Descriptor sets per caller depth view: the stream pass's (depth, levels 1 and 2); the tile
+  // pass's set holds no caller resource and is made once.
   struct Sets {
     detail::DescriptorArena arena;
-    VkDescriptorSet set[2] = {VK_NULL_HANDLE, VK_NULL_HANDLE};
+    VkDescriptorSet stream = VK_NULL_HANDLE;
   };
   std::map<VkImageView, Sets> sets;
+  detail::DescriptorArena tile_arena;
+  VkDescriptorSet tile_set = VK_NULL_HANDLE;
 
-  struct Pass {
-    GlintHiZPush push;
-    uint32_t groups_x, groups_y;
-  };
-  std::vector<Pass> passes;
+  GlintHiZPush stream_push{};  // base = the depth image; tile_levels = levels it writes (1 or 2)
+  GlintHiZPush tile_push{};    // base = level 2
+  uint32_t tile_groups_x = 0, tile_groups_y = 0;
 
   ~Impl() { release(); }
 
   void release() {
     sets.clear();
+    tile_arena.reset();
+    tile_set = VK_NULL_HANDLE;
     VkDevice device = context ? context->device() : VK_NULL_HANDLE;
     if (!device) return;
     pyramid.reset();
@@ -149,56 +153,64 @@ struct HiZPyramid::Impl {
                                  std::max(1u, levels));
   }
 
-  // The dispatches that build `levels` levels: each reduces its base through up to 6 levels by
-  // tiles, and its last workgroup through up to 6 more when the tile result fits 64x64.
+  // The two dispatches that build `levels` (>= 1) levels: the stream pass writes levels 1 and 2;
+  // the tile pass reduces level 2 by 64x64 tiles through up to 6 levels, and its last workgroup
+  // the rest. Level 2 is at most 16384 / 4 = 4096 = 64 tiles wide, so the tail always fits one
+  // workgroup, and 2 + 6 + 6 = 14 levels cover the largest pyramid.
   void plan() {
-    uint32_t base = 0;
-    uint32_t counter = 0;
-    while (base < levels) {
-      const uint32_t bw = std::max(1u, config.extent.width >> base);
-      const uint32_t bh = std::max(1u, config.extent.height >> base);
-      Pass p{};
-      p.push.base_width = static_cast<int32_t>(bw);
-      p.push.base_height = static_cast<int32_t>(bh);
-      p.push.base_level = base;  // 0, then GLINT_HIZ_TILE_LEVELS above 4096: one pipeline each
-      if (base != 0 && base != GLINT_HIZ_TILE_LEVELS) {
-        throw Error(ErrorCode::vulkan_failure, concat("HiZPyramid: pass from level ", base, " has no pipeline"));
-      }
-      p.push.tile_levels = std::min(GLINT_HIZ_TILE_LEVELS, levels - base);
-      p.groups_x = std::max(1u, bw >> 6);
-      p.groups_y = std::max(1u, bh >> 6);
-      const uint32_t after_tiles = base + p.push.tile_levels;
-      const bool tail_fits = p.groups_x <= GLINT_HIZ_TILE && p.groups_y <= GLINT_HIZ_TILE;
-      p.push.tail_levels = tail_fits ? std::min(GLINT_HIZ_TILE_LEVELS, levels - after_tiles) : 0u;
-      p.push.reversed_z = config.reversed_z ? 1u : 0u;
-      p.push.counter_index = counter++;
-      passes.push_back(p);
-      base = after_tiles + p.push.tail_levels;
+    const uint32_t reversed = config.reversed_z ? 1u : 0u;
+    stream_push.base_width = static_cast<int32_t>(config.extent.width);
+    stream_push.base_height = static_cast<int32_t>(config.extent.height);
+    stream_push.base_level = 0;
+    stream_push.tile_levels = std::min(2u, levels);
+    stream_push.reversed_z = reversed;
+    if (levels <= 2) return;
+    const uint32_t bw = std::max(1u, config.extent.width >> 2);
+    const uint32_t bh = std::max(1u, config.extent.height >> 2);
+    tile_push.base_width = static_cast<int32_t>(bw);
+    tile_push.base_height = static_cast<int32_t>(bh);
+    tile_push.base_level = 2;
+    tile_push.tile_levels = std::min(GLINT_HIZ_TILE_LEVELS, levels - 2);
+    tile_groups_x = std::max(1u, bw >> 6);
+    tile_groups_y = std::max(1u, bh >> 6);
+    if (tile_groups_x > GLINT_HIZ_TILE || tile_groups_y > GLINT_HIZ_TILE || levels > 2 + 2 * GLINT_HIZ_TILE_LEVELS) {
+      throw Error(ErrorCode::vulkan_failure, concat("HiZPyramid: ", config.extent.width, "x", config.extent.height,
+                                                    " does not fit the tile pass's tail"));
     }
+    tile_push.tail_levels = levels - 2 - tile_push.tile_levels;
+    tile_push.reversed_z = reversed;
+    tile_push.counter_index = 0;
   }
 
-  // The descriptor set of `depth` for pipeline `which` (0: base level 0, 1: the second pass).
-  VkDescriptorSet set_for(const Image& depth, uint32_t which) {
+  // Level k's storage view (k >= 1); levels not built alias the last built one: never accessed,
+  // but every binding needs a view.
+  VkImageView level_view(uint32_t k) const { return pyramid.level_view(std::min(k, std::max(1u, levels)) - 1); }
+
+  VkDescriptorSet stream_set_for(const Image& depth) {
     auto it = sets.find(depth.view);
     if (it == sets.end()) {
       Sets s;
-      // Two sets (one per pass), each with GLINT_HIZ_MAX_LEVELS storage images.
-      s.arena = detail::DescriptorArena(*context, 2, GLINT_HIZ_MAX_LEVELS);
-      std::vector<detail::DescriptorArena::AnyBinding> b(GLINT_HIZ_MAX_LEVELS + 2);
+      s.arena = detail::DescriptorArena(*context, 1, 2);
+      std::vector<detail::DescriptorArena::AnyBinding> b(3);
       b[0].image = {depth.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
       b[0].sampler = sampler;
-      for (uint32_t k = 1; k <= GLINT_HIZ_MAX_LEVELS; ++k) {
-        // Levels not built bind the last built one: never accessed, but every binding needs a view.
-        const uint32_t m = std::min(k, std::max(1u, levels)) - 1;
-        b[k].image = {pyramid.level_view(m), VK_IMAGE_LAYOUT_GENERAL};
-      }
-      b[GLINT_HIZ_MAX_LEVELS + 1].buffer = counter_state;
-      for (uint32_t i = 0; i < 2; ++i) {
-        if (pipelines[i].set_layout()) s.set[i] = s.arena.make_mixed_set(pipelines[i], b);
-      }
+      b[1].image = {level_view(1), VK_IMAGE_LAYOUT_GENERAL};
+      b[2].image = {level_view(2), VK_IMAGE_LAYOUT_GENERAL};
+      s.stream = s.arena.make_mixed_set(stream_pipeline, b);
       it = sets.emplace(depth.view, std::move(s)).first;
     }
-    return it->second.set[which];
+    return it->second.stream;
+  }
+
+  VkDescriptorSet tile_set_once() {
+    if (tile_set == VK_NULL_HANDLE) {
+      tile_arena = detail::DescriptorArena(*context, 1, GLINT_HIZ_MAX_LEVELS);
+      std::vector<detail::DescriptorArena::AnyBinding> b(GLINT_HIZ_MAX_LEVELS + 1);
+      for (uint32_t k = 1; k <= GLINT_HIZ_MAX_LEVELS; ++k) b[k - 1].image = {level_view(k), VK_IMAGE_LAYOUT_GENERAL};
+      b[GLINT_HIZ_MAX_LEVELS].buffer = counter_state;
+      tile_set = tile_arena.make_mixed_set(tile_pipeline, b);
+    }
+    return tile_set;
   }
 };
 
@@ -227,21 +239,22 @@ HiZPyramid::HiZPyramid(const Context& context, const HiZConfig& config) : impl_(
   m.counters = detail::OwnedBuffer(context, 16, usage, false);
   m.counter_state = view_of(m.counters, usage);
   m.sampler = detail::clamp_sampler(context, VK_FILTER_NEAREST, VK_SAMPLER_MIPMAP_MODE_NEAREST, 0.0f);
+  if (m.levels == 0) return;  // 1x1: nothing to build
+  detail::PipelineDesc s;
+  s.kernel_id = "hiz_stream_main";
+  s.bindings = {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
+                VK_DESCRIPTOR_TYPE_STORAGE_IMAGE};
+  s.push_constant_bytes = sizeof(GlintHiZPush);
+  s.workgroup = {32, 4};  // the kernel's fixed local size
+  m.stream_pipeline = detail::ComputePipeline(context, s);
+  if (m.levels <= 2) return;
   detail::PipelineDesc d;
   d.kernel_id = "hiz_build_main";
-  d.bindings.push_back(VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER);
   for (uint32_t k = 0; k < GLINT_HIZ_MAX_LEVELS; ++k) d.bindings.push_back(VK_DESCRIPTOR_TYPE_STORAGE_IMAGE);
   d.bindings.push_back(VK_DESCRIPTOR_TYPE_STORAGE_BUFFER);
   d.push_constant_bytes = sizeof(GlintHiZPush);
   d.workgroup = {256, 1};  // the kernel's local size is fixed at 256 (64x64 tiles)
-  for (uint32_t i = 0; i < 2; ++i) {
-    const uint32_t base = i == 0 ? 0u : GLINT_HIZ_TILE_LEVELS;
-    const bool used =
-        std::any_of(m.passes.begin(), m.passes.end(), [&](const Impl::Pass& p) { return p.push.base_level == base; });
-    if (!used) continue;
-    d.specialization = {base};  // constant_id 2
-    m.pipelines[i] = detail::ComputePipeline(context, d);
-  }
+  m.tile_pipeline = detail::ComputePipeline(context, d);
 }
 
 HiZPyramid::HiZPyramid(HiZPyramid&&) noexcept = default;
@@ -291,7 +304,8 @@ void HiZPyramid::record(VkCommandBuffer cmd, Image& depth, Profiler* profiler) {
     return;
   }
   detail::Barriers b;
-  if (!m.counters_cleared) {  // once per object: the kernel resets the counter after each use
+  const bool tile_pass = m.levels > 2;
+  if (tile_pass && !m.counters_cleared) {  // once per object: the kernel resets the counter after each use
     b.use(m.counter_state, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);  // fill = "transfer"
     b.flush(cmd);
     vkCmdFillBuffer(cmd, m.counters.buffer(), 0, VK_WHOLE_SIZE, 0);
@@ -299,16 +313,15 @@ void HiZPyramid::record(VkCommandBuffer cmd, Image& depth, Profiler* profiler) {
   }
   b.use(depth, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, kCompute, kSampled);
   b.use(m.pyramid.state, VK_IMAGE_LAYOUT_GENERAL, kCompute, kStorageRead | kStorageWrite, std::max(1u, m.levels));
-  b.use(m.counter_state, kCompute, kStorageRead | kStorageWrite);
+  if (tile_pass) b.use(m.counter_state, kCompute, kStorageRead | kStorageWrite);
   b.flush(cmd);
-  for (size_t i = 0; i < m.passes.size(); ++i) {
-    if (i > 0) {  // the next pass reads the level the previous one wrote
-      b.use(m.pyramid.state, VK_IMAGE_LAYOUT_GENERAL, kCompute, kStorageRead | kStorageWrite, std::max(1u, m.levels));
-      b.flush(cmd);
-    }
-    const auto& p = m.passes[i];
-    const uint32_t which = p.push.base_level == 0 ? 0 : 1;
-    m.pipelines[which].dispatch(cmd, m.set_for(depth, which), p.push, p.groups_x * 256, p.groups_y);
+  // Stream pass: one invocation per level-2 texel (level 2's size even when only level 1 is built).
+  const uint32_t n2x = std::max(1u, m.config.extent.width >> 2), n2y = std::max(1u, m.config.extent.height >> 2);
+  m.stream_pipeline.dispatch(cmd, m.stream_set_for(depth), m.stream_push, n2x, n2y);
+  if (tile_pass) {  // the tile pass reads level 2, which the stream pass wrote
+    b.use(m.pyramid.state, VK_IMAGE_LAYOUT_GENERAL, kCompute, kStorageRead | kStorageWrite, std::max(1u, m.levels));
+    b.flush(cmd);
+    m.tile_pipeline.dispatch(cmd, m.tile_set_once(), m.tile_push, m.tile_groups_x * 256, m.tile_groups_y);
   }
   if (profiler) profiler->mark(cmd, "hi-z");
 }

@@ -1,46 +1,47 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
-// Hi-Z depth pyramid in one dispatch, in the manner of AMD FidelityFX SPD (docs/OCCLUSION.md,
-// "Hi-Z pyramid"): every workgroup reduces a 64x64 tile of the base level through up to six levels in
-// shared memory; the last workgroup to finish (found with an atomic counter after a memory barrier
-// on the images) reduces the remaining levels from the 64x64-or-smaller level it can then see.
+// Hi-Z levels 3 and up, in one dispatch in the manner of AMD FidelityFX SPD (docs/OCCLUSION.md,
+// "Hi-Z pyramid"): the second of the pyramid's two dispatches. hiz_stream.comp has written levels
+// 1 and 2 from the depth image; this kernel takes level 2 as its base. Every workgroup reduces a
+// 64x64 tile of level 2 through up to six levels in shared memory; the last workgroup to finish
+// (found with an atomic counter after a memory barrier on the images) reduces the remaining levels
+// from the 64x64-or-smaller level it can then see. Level 2 is at most 4096 texels wide (the depth
+// image at most 16384), so the tail always fits one workgroup and 2 + 6 + 6 levels cover the
+// largest pyramid (14 levels).
 // Each texel holds the farthest depth it covers (max for standard Z, min for reversed Z).
 // Fold rule (docs/OCCLUSION.md): level sizes are max(1, size >> k) like Vulkan mips; child c of a
 // parent of width w covers parents 2c and 2c + 1, and the last child also covers parent w - 1 when
 // w is odd (the 3-wide case; 3x3 at the corner), so no source texel is ever dropped. Equivalently,
 // texel c of level k covers source pixels [c * 2^k, (c + 1) * 2^k), the last one up to the edge.
 // Tiles: the last tile of a row or column extends to the edge (64 to 127 wide), so every fold stays
-// inside one workgroup. Above 4096 texels the host runs a second dispatch from level 6.
+// inside one workgroup.
 // Speed (docs/OCCLUSION.md, "Speed"): interior tiles, where no fold applies, take a fast path in
-// which each invocation reduces a 4x4 block of the base with four textureGather (2x2 texels each)
-// and keeps levels 1 and 2 in registers; only edge tiles and the last workgroup run the general
-// loops. Every store names its level with a constant, so no switch is left in the fast path.
+// which each invocation reduces a 4x4 block of the base and keeps levels 1 and 2 above it in
+// registers; only edge tiles and the last workgroup run the general loops. Every store names its
+// level with a constant, so no switch is left in the fast path.
 layout(local_size_x = 256) in;
 
 #include "light_cull_params.h"
 
-// The level this pipeline reads as its base: 0 (the depth image) or GLINT_HIZ_TILE_LEVELS (the
-// second pass above 4096); the host makes one pipeline per value it needs.
-layout(constant_id = 2) const uint kBaseLevel = 0u;
+// The level this kernel reads as its base (written by hiz_stream.comp before it).
+const uint kBaseLevel = 2u;
 
-// Nearest, clamp-to-edge sampler: a gather that reaches past the edge repeats the edge texel,
-// which leaves a max or min unchanged.
-layout(binding = 0) uniform sampler2D depth_tex;
-layout(binding = 1, r32f) uniform coherent image2D hiz1;
-layout(binding = 2, r32f) uniform coherent image2D hiz2;
-layout(binding = 3, r32f) uniform coherent image2D hiz3;
-layout(binding = 4, r32f) uniform coherent image2D hiz4;
-layout(binding = 5, r32f) uniform coherent image2D hiz5;
-layout(binding = 6, r32f) uniform coherent image2D hiz6;
-layout(binding = 7, r32f) uniform coherent image2D hiz7;
-layout(binding = 8, r32f) uniform coherent image2D hiz8;
-layout(binding = 9, r32f) uniform coherent image2D hiz9;
-layout(binding = 10, r32f) uniform coherent image2D hiz10;
-layout(binding = 11, r32f) uniform coherent image2D hiz11;
-layout(binding = 12, r32f) uniform coherent image2D hiz12;
-layout(binding = 13, r32f) uniform coherent image2D hiz13;
-layout(binding = 14, r32f) uniform coherent image2D hiz14;
-layout(std430, binding = 15) coherent buffer Counters { uint counters[]; };
+// Binding k - 1 is level k (level 1 is not accessed here: kept so that the numbering stays plain).
+layout(binding = 0, r32f) uniform coherent image2D hiz1;
+layout(binding = 1, r32f) uniform coherent image2D hiz2;
+layout(binding = 2, r32f) uniform coherent image2D hiz3;
+layout(binding = 3, r32f) uniform coherent image2D hiz4;
+layout(binding = 4, r32f) uniform coherent image2D hiz5;
+layout(binding = 5, r32f) uniform coherent image2D hiz6;
+layout(binding = 6, r32f) uniform coherent image2D hiz7;
+layout(binding = 7, r32f) uniform coherent image2D hiz8;
+layout(binding = 8, r32f) uniform coherent image2D hiz9;
+layout(binding = 9, r32f) uniform coherent image2D hiz10;
+layout(binding = 10, r32f) uniform coherent image2D hiz11;
+layout(binding = 11, r32f) uniform coherent image2D hiz12;
+layout(binding = 12, r32f) uniform coherent image2D hiz13;
+layout(binding = 13, r32f) uniform coherent image2D hiz14;
+layout(std430, binding = 14) coherent buffer Counters { uint counters[]; };
 layout(push_constant) uniform Push { GlintHiZPush pc; };
 
 // Ping-pong tiles: A holds up to 64x64 texels (level 1 of an edge tile, or the tail's start level),
@@ -75,7 +76,6 @@ void store_level(uint level, ivec2 p, float v) {
 
 float load_level(uint level, ivec2 p) {
   switch (level) {
-    case 0: return texelFetch(depth_tex, p, 0).r;
     case 1: return imageLoad(hiz1, p).r;
     case 2: return imageLoad(hiz2, p).r;
     case 3: return imageLoad(hiz3, p).r;
@@ -99,14 +99,8 @@ float farther4(float a, float b, float c, float d) { return farther(farther(a, b
 float load_base(ivec2 p) { return load_level(kBaseLevel, p); }
 
 // Farthest of the base texels p, p + (1, 0), p + (0, 1), p + (1, 1), each coordinate clamped to the
-// base (a repeated texel changes nothing). From the depth image, one textureGather at the corner of
-// the four texels: u * size - 0.5 = p + 0.5 exactly enough that the 2x2 footprint is p .. p + 1.
-// (On the H100 this beat four texelFetch by 13 us at 3840x2160: docs/OCCLUSION.md.)
+// base (a repeated texel changes nothing).
 float load_base_2x2(ivec2 p, ivec2 base) {
-  if (kBaseLevel == 0u) {
-    const vec4 g = textureGather(depth_tex, vec2(p + 1) / vec2(base), 0);
-    return farther4(g.x, g.y, g.z, g.w);
-  }
   const ivec2 q = min(p + 1, base - 1);
   return farther4(load_base(p), load_base(ivec2(q.x, p.y)), load_base(ivec2(p.x, q.y)), load_base(q));
 }
@@ -161,6 +155,7 @@ void reduce_levels(uint j0, uint n, ivec2 begin, ivec2 region, bvec2 edge) {
   }
 }
 
+// Levels j are counted from the base level below (j = 1 is pyramid level kBaseLevel + 1).
 // Child c of level 1 (the general rule: 2x2, plus the folded column, row or corner at an odd edge).
 // The 2x2 core comes first so that two children's core reads can be in flight together.
 float fold_level1(ivec2 c, float core, ivec2 child, ivec2 base) {
@@ -198,8 +193,9 @@ void level1_general(ivec2 begin, ivec2 region, bvec2 edge, ivec2 base) {
 }
 
 // An interior 64x64 tile (no fold, no clamp: its children are never the last of their level).
-// Invocation t owns the 4x4 base block b = (t % 16, t / 16): four gathers give its 2x2 texels of
-// level 1 and its texel of level 2 in registers. Level 2 (16x16) goes through shared memory once;
+// Invocation t owns the 4x4 base block b = (t % 16, t / 16): four 2x2 reads (16 loads, all issued
+// before the first use) give its 2x2 texels of level 1 and its texel of level 2 (counted from the
+// base) in registers. Level 2 (16x16) goes through shared memory once;
 // 16 invocations then reduce 4x4 blocks of it to 2x2 texels of level 3 and one of level 4, and one
 // invocation reduces the 4x4 of level 4 to levels 5 and 6. Two barriers in all.
 void interior_tile(ivec2 begin, ivec2 base) {

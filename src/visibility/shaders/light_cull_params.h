@@ -1,5 +1,5 @@
 // Push constants and buffer layouts of the visibility stage of the lens flares: the Hi-Z build
-// (hiz_build.comp), the cull + occlusion grid test (light_cull.comp), and the ordered compaction
+// (hiz_stream.comp, hiz_build.comp), the cull + occlusion grid test (light_cull.comp), and the ordered compaction
 // shared with the object cull (compact_params.h; the same order on every run): a two-level scan of
 // the cull's per-workgroup visibility masks (compact_scan_tiles.comp per tile, light_cull_scan.comp
 // over the tile totals, which also writes the indirect arguments and statistics), then the scatter
@@ -27,8 +27,8 @@
 struct GlintHiZPush {
   GLINT_INT base_width;  // size of the base level this dispatch reads
   GLINT_INT base_height;
-  GLINT_UINT base_level;     // 0: the depth image; k >= 1: Hi-Z level k (pyramid mip k - 1)
-  GLINT_UINT tile_levels;    // levels every workgroup builds from its tile (1 to 6)
+  GLINT_UINT base_level;     // 0: the depth image (stream pass); 2: Hi-Z level 2 (tile pass)
+  GLINT_UINT tile_levels;    // levels every workgroup builds from its tile (1 to 6; stream pass: 1 or 2)
   GLINT_UINT tail_levels;    // levels the last workgroup then builds (0 to 6)
   GLINT_UINT reversed_z;     // 0: farthest = max (standard Z); 1: farthest = min (reversed Z)
   GLINT_UINT counter_index;  // which word of the counter buffer counts finished workgroups
