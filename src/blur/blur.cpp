@@ -382,7 +382,7 @@ Step fused_step(StepProgram& prog, const DeviceInfo& info, int src, int dst, VkE
   const bool exact_half = src_size.width == 2 * dst_size.width && src_size.height == 2 * dst_size.height;
   const uint32_t mode = binomial ? 3u : same ? 0u : exact_half ? 1u : 2u;
   Step s;
-  // Prefetching the load step (kernels/blur_level.comp, PREFETCH) pays on GPUs only.
+  // Prefetching the load step (shaders/blur_level.comp, PREFETCH) pays on GPUs only.
   const uint32_t prefetch = info.type == VK_PHYSICAL_DEVICE_TYPE_CPU ? 0u : 1u;
   s.pipeline = &prog.pipeline("blur_level", dst_format, shape.workgroup,
                               {shape.rows, radius, mode, half_shared ? 1u : 0u, prefetch},

@@ -147,7 +147,7 @@ void main() {
   ivec2 raw_origin = window - kRadius;
 
   // Every fetch is issued before the first shared store, so their latencies overlap.
-  if (PREFETCH) {  // (kernels/common/bloom.glsl)
+  if (PREFETCH) {  // (bloom.glsl)
     vec3 fetched[kLoadsPerInvocation];
     [[unroll]] for (uint n = 0u; n < kLoadsPerInvocation; ++n) {
       uint i = min(gl_LocalInvocationIndex + n * kGroupSize, kRawW * kRawH - 1u);
