@@ -114,8 +114,9 @@ gpu_assisted_tests() {
   local programs=()
   mapfile -t programs < <(ctest --test-dir "$dir" -N -L gpu | sed -n 's/^ *Test *#[0-9]*: \([a-z0-9_]*_test\)$/\1/p')
   ((${#programs[@]} > 0)) || die "no GPU test programs found in $dir"
-  printf '%s\n' "${programs[@]}" | env "$@" GLINT_GPU_AV=1 xargs -P"$(nproc)" -I{} \
-    "$dir/tests/{}" --gtest_filter="$GPU_AV_FILTER" --gtest_brief=1 ||
+  # xargs replaces {} in arguments only, not in the command: env runs the program.
+  printf '%s\n' "${programs[@]}" | xargs -P"$(nproc)" -I{} env "$@" GLINT_GPU_AV=1 "$dir/tests/{}" \
+    --gtest_filter="$GPU_AV_FILTER" --gtest_brief=1 ||
     die "GPU-assisted validation failed (output above)"
 }
 
