@@ -620,6 +620,34 @@ TEST(ApiMemory, AThousandResizesDoNotGrowMemory) {
   EXPECT_EQ(detail::validation_messages_all_contexts(), messages) << "objects left behind (see the log above)";
 }
 
+// An image larger than the device's maxResourceSize for its format is refused before
+// vkCreateImage (creating it is invalid usage; lavapipe's 16384x16384 RGBA32F, 2^32 bytes, is one
+// byte over its 2^32 - 1), with the bytes needed and the limit in the message.
+TEST_F(ApiErrorsTest, AnImageOverMaxResourceSizeIsRefusedBeforeItIsCreated) {
+  const uint32_t max_dim = context().info().max_image_dimension_2d;
+  const VkFormat format = VK_FORMAT_R32G32B32A32_SFLOAT;
+  VkImageFormatProperties props{};
+  ASSERT_EQ(vkGetPhysicalDeviceImageFormatProperties(context().physical_device(), format, VK_IMAGE_TYPE_2D,
+                                                     VK_IMAGE_TILING_OPTIMAL, detail::kToolImageUsage, 0, &props),
+            VK_SUCCESS);
+  const uint64_t bytes = uint64_t(max_dim) * max_dim * 16;
+  if (bytes <= props.maxResourceSize) {
+    GTEST_SKIP() << "the largest RGBA32F image (" << bytes << " bytes) fits maxResourceSize (" << props.maxResourceSize
+                 << ") on this device";
+  }
+  const uint64_t objects = context().objects_created();
+  try {
+    detail::OwnedImage image(context(), {max_dim, max_dim}, format, detail::kToolImageUsage);
+    FAIL() << "a " << bytes << "-byte image was made";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::unsupported_size);
+    const std::string text = e.what();
+    EXPECT_NE(text.find(std::to_string(bytes) + " bytes"), std::string::npos) << text;
+    EXPECT_NE(text.find("maxResourceSize) is " + std::to_string(props.maxResourceSize)), std::string::npos) << text;
+  }
+  EXPECT_EQ(context().objects_created(), objects);
+}
+
 // Contexts made and destroyed over and over, each running a bloom and a LOD batch.
 TEST(ApiMemory, RecreatingContextsDoesNotGrowMemory) {
   const uint64_t messages = detail::validation_messages_all_contexts();

@@ -209,7 +209,9 @@ struct Bloom::Impl {
     d.bindings = std::move(bindings);
     d.push_constant_bytes = sizeof(BloomPush);
     d.workgroup = workgroup;
-    d.specialization = {static_cast<uint32_t>(config.filter)};
+    // Constant 3: prefetch the tiled loads on GPUs only (src/bloom/shaders/bloom.glsl, PREFETCH).
+    const uint32_t prefetch = context->info().type == VK_PHYSICAL_DEVICE_TYPE_CPU ? 0u : 1u;
+    d.specialization = {static_cast<uint32_t>(config.filter), prefetch};
     return d;
   }
 

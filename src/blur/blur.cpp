@@ -382,9 +382,11 @@ Step fused_step(StepProgram& prog, const DeviceInfo& info, int src, int dst, VkE
   const bool exact_half = src_size.width == 2 * dst_size.width && src_size.height == 2 * dst_size.height;
   const uint32_t mode = binomial ? 3u : same ? 0u : exact_half ? 1u : 2u;
   Step s;
-  s.pipeline =
-      &prog.pipeline("blur_level", dst_format, shape.workgroup, {shape.rows, radius, mode, half_shared ? 1u : 0u},
-                     {VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
+  // Prefetching the load step (shaders/blur_level.comp, PREFETCH) pays on GPUs only.
+  const uint32_t prefetch = info.type == VK_PHYSICAL_DEVICE_TYPE_CPU ? 0u : 1u;
+  s.pipeline = &prog.pipeline("blur_level", dst_format, shape.workgroup,
+                              {shape.rows, radius, mode, half_shared ? 1u : 0u, prefetch},
+                              {VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
   s.src = src;
   s.dst = dst;
   s.push = make_push(src_size, dst_size, flags, max_value);

@@ -1,5 +1,6 @@
 #include "core/resources.h"
 
+#include <algorithm>
 #include <mutex>
 #include <utility>
 
@@ -54,6 +55,43 @@ uint32_t texel_bytes(VkFormat format) {
   }
 }
 
+namespace {
+
+// An image larger than VkImageFormatProperties::maxResourceSize may not be created (Vulkan,
+// "vkGetPhysicalDeviceImageFormatProperties": at least 2^31 bytes; lavapipe's is 2^32 - 1, so a
+// 16384x16384 RGBA32F image is over it): refused with Error(unsupported_size) before vkCreateImage.
+// The bytes are the texels of every layer and level (each level a quarter of the one above), a
+// lower bound on what the driver needs. Formats whose texel size is not known here, and format
+// and usage pairs the query does not support, are left to vkCreateImage.
+void check_resource_size(const ContextState& s, const VkImageCreateInfo& info) {
+  VkImageFormatProperties props{};
+  if (vkGetPhysicalDeviceImageFormatProperties(s.physical_device, info.format, info.imageType, info.tiling, info.usage,
+                                               info.flags, &props) != VK_SUCCESS) {
+    return;
+  }
+  uint64_t texel = 0;
+  try {
+    texel = texel_bytes(info.format);
+  } catch (const Error&) {
+    return;
+  }
+  uint64_t bytes = 0;
+  uint64_t w = info.extent.width, h = info.extent.height;
+  for (uint32_t l = 0; l < info.mipLevels; ++l) {
+    bytes += w * h * texel * info.arrayLayers;
+    w = std::max<uint64_t>(1, w / 2);
+    h = std::max<uint64_t>(1, h / 2);
+  }
+  if (bytes > props.maxResourceSize) {
+    throw Error(ErrorCode::unsupported_size,
+                concat("a ", info.extent.width, "x", info.extent.height, " ", format_name(info.format), " image needs ",
+                       bytes, " bytes; the device's largest image of this format and usage (maxResourceSize) is ",
+                       props.maxResourceSize, " bytes: make it smaller"));
+  }
+}
+
+}  // namespace
+
 OwnedImage::OwnedImage(const Context& context, VkExtent2D extent, VkFormat format, VkImageUsageFlags usage,
                        uint32_t levels, uint32_t layers) {
   device_ = context.device();
@@ -68,6 +106,7 @@ OwnedImage::OwnedImage(const Context& context, VkExtent2D extent, VkFormat forma
   info.tiling = VK_IMAGE_TILING_OPTIMAL;
   info.usage = usage;
   info.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+  check_resource_size(s, info);
   vk_check(vkCreateImage(device_, &info, nullptr, &state.image), "vkCreateImage");
   s.count_object();
   state.format = format;

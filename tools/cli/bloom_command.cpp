@@ -7,10 +7,12 @@
 #include <memory>
 
 #include "cli/commands.h"
+#include "core/check.h"
 #include "core/resources.h"
 #include "io/atomic_outputs.h"
 #include "io/exr_io.h"
 #include "io/png_io.h"
+#include "support/host_memory.h"
 #include "support/transfer.h"
 
 namespace glint::cli {
@@ -52,17 +54,24 @@ void run_bloom(BloomOptions& o) {
     check_distinct_outputs({"OUT", "--png"}, {o.output, o.png});
   }
 
-  const CpuImage input = io::read_exr(o.input);
-  const VkExtent2D extent{input.width, input.height};
-
+  // Everything the run holds is checked from the file's header, before its pixels are decoded
+  // (seconds rather than minutes at 16384x16384): host memory for the input and the result as
+  // RGBA float, then the device memory of the pyramid, the float input image and the result.
+  const io::ExrExtent size = io::read_exr_extent(o.input);
+  const VkExtent2D extent{size.width, size.height};
+  const VkFormat output_format = o.fp32 ? VK_FORMAT_R32G32B32A32_SFLOAT : VK_FORMAT_R16G16B16A16_SFLOAT;
+  tools::check_host_memory(detail::concat("glint bloom of a ", extent.width, "x", extent.height, " image"),
+                           2 * uint64_t(extent.width) * extent.height * 4 * sizeof(float));
   const Context context = make_context(o.device);
   Bloom bloom(context, o.config);
   bloom.prepare(extent);  // throws unsupported_size before any image is made for a too-large input
+  check_device_images(context, extent, output_format);
+
+  const CpuImage input = io::read_exr(o.input);
   Profiler profiler(context);
   const CpuImage output = run_image_effect(
       context, input, profiler,
-      [&](VkCommandBuffer cmd, Image& in, Image& out, Profiler* p) { bloom.record(cmd, in, out, p); },
-      o.fp32 ? VK_FORMAT_R32G32B32A32_SFLOAT : VK_FORMAT_R16G16B16A16_SFLOAT);
+      [&](VkCommandBuffer cmd, Image& in, Image& out, Profiler* p) { bloom.record(cmd, in, out, p); }, output_format);
   print_device(context, o.input, input);
   std::printf("bloom: filter %s, %s intermediates, %u level%s", bloom_filter_name(o.config.filter),
               o.fp32 ? "fp32" : "fp16", bloom.levels(), bloom.levels() == 1 ? "" : "s");

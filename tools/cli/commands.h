@@ -78,6 +78,11 @@ Context make_context(const std::string& device);
 /// Prints "device: NAME (TYPE)" and "input: PATH, WxH".
 void print_device(const Context& context, const std::string& input_path, const CpuImage& input);
 
+/// Makes and frees the device images run_image_effect() will make for an input of `extent`, so
+/// that an input too large for the device is refused (Error(unsupported_size), naming the bytes
+/// needed and available) before the file's pixels are read.
+void check_device_images(const Context& context, VkExtent2D extent, VkFormat output_format);
+
 /// Uploads `input` as RGBA32F and, in one submission, records `effect` after the profiler's
 /// reset and "start" mark. The effect gets the input image and a profiler to mark.
 void run_on_input(const Context& context, const CpuImage& input, Profiler& profiler,

@@ -122,6 +122,13 @@ void print_device(const Context& context, const std::string& input_path, const C
   std::printf("input: %s, %ux%u\n", input_path.c_str(), input.width, input.height);
 }
 
+void check_device_images(const Context& context, VkExtent2D extent, VkFormat output_format) {
+  // Made and freed at once: each allocation checks the device's budget (and the image its
+  // maxResourceSize) and throws Error(unsupported_size) naming the bytes needed and available.
+  detail::OwnedImage source(context, extent, VK_FORMAT_R32G32B32A32_SFLOAT, detail::kToolImageUsage);
+  detail::OwnedImage result(context, extent, output_format, detail::kToolImageUsage);
+}
+
 void run_on_input(const Context& context, const CpuImage& input, Profiler& profiler,
                   const std::function<void(VkCommandBuffer, Image& source, Profiler*)>& effect) {
   detail::OwnedImage source(context, {input.width, input.height}, VK_FORMAT_R32G32B32A32_SFLOAT,

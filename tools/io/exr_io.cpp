@@ -211,6 +211,16 @@ void check_writable_image(const std::string& path, const CpuImage& image) {
   }
 }
 
+ExrExtent read_exr_extent(const std::string& path) {
+  limit_openexr_sizes();
+  check_input_file(path);
+  return guarded(path, "read OpenEXR file", [&] {
+    Imf::InputFile file(path.c_str());
+    const Window w = checked_window(path, file.header());
+    return ExrExtent{w.width, w.height};
+  });
+}
+
 CpuImage read_exr(const std::string& path) {
   limit_openexr_sizes();
   check_input_file(path);

@@ -28,6 +28,14 @@ inline constexpr uint64_t kMaxImagePixels = uint64_t(1) << 28;
 /// are not. path: the file to read.
 CpuImage read_exr(const std::string& path);
 
+/// The size of an OpenEXR file's data window, from its header alone (no pixel is read), checked
+/// against the limits above: for refusing work that cannot fit before the pixels are decoded.
+struct ExrExtent {
+  uint32_t width = 0;
+  uint32_t height = 0;
+};
+ExrExtent read_exr_extent(const std::string& path);
+
 /// One channel of an OpenEXR file.
 struct ExrChannel {
   uint32_t width = 0;

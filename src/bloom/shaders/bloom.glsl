@@ -5,6 +5,11 @@
 #include "image_io.glsl"
 
 layout(constant_id = 2) const uint FILTER = GLINT_BLOOM_COD13;
+// The tiled kernels' load step: every fetch issued before the first shared store (GPUs: the
+// latencies overlap), or a plain loop (CPU devices: invocations run in order as SIMD lanes, there
+// is no latency to hide, and the unrolled loads multiply the code the device's JIT compiles).
+// Both store the same values; the host sets it from the device type (specialization constant 3).
+layout(constant_id = 3) const bool PREFETCH = true;
 
 float luma(vec3 c) { return dot(c, vec3(0.2126, 0.7152, 0.0722)); }
 

@@ -23,14 +23,20 @@ shared vec4 s_box[BOX_W * BOX_H];
 vec3 downsample_2to1(texture2D src, BloomSource s, bool karis) {
   ivec2 origin = ivec2(gl_GlobalInvocationID.xy - gl_LocalInvocationID.xy) * 2 - 2;  // (see bloom_up_tiled)
   // All fetches are issued before the first store, so their latencies overlap.
-  vec3 fetched[LOADS_PER_INVOCATION];
-  [[unroll]] for (uint n = 0u; n < LOADS_PER_INVOCATION; ++n) {
-    uint i = min(gl_LocalInvocationIndex + n * GROUP_SIZE, TILE_W * TILE_H - 1u);
-    fetched[n] = source_texel(src, s, origin + ivec2(i % TILE_W, i / TILE_W));
-  }
-  [[unroll]] for (uint n = 0u; n < LOADS_PER_INVOCATION; ++n) {
-    uint i = gl_LocalInvocationIndex + n * GROUP_SIZE;
-    if (i < TILE_W * TILE_H) s_texel[i] = vec4(fetched[n], 0.0);
+  if (PREFETCH) {
+    vec3 fetched[LOADS_PER_INVOCATION];
+    [[unroll]] for (uint n = 0u; n < LOADS_PER_INVOCATION; ++n) {
+      uint i = min(gl_LocalInvocationIndex + n * GROUP_SIZE, TILE_W * TILE_H - 1u);
+      fetched[n] = source_texel(src, s, origin + ivec2(i % TILE_W, i / TILE_W));
+    }
+    [[unroll]] for (uint n = 0u; n < LOADS_PER_INVOCATION; ++n) {
+      uint i = gl_LocalInvocationIndex + n * GROUP_SIZE;
+      if (i < TILE_W * TILE_H) s_texel[i] = vec4(fetched[n], 0.0);
+    }
+  } else {
+    [[dont_unroll]] for (uint i = gl_LocalInvocationIndex; i < TILE_W * TILE_H; i += GROUP_SIZE) {
+      s_texel[i] = vec4(source_texel(src, s, origin + ivec2(i % TILE_W, i / TILE_W)), 0.0);
+    }
   }
   barrier();
   for (uint i = gl_LocalInvocationIndex; i < BOX_W * BOX_H; i += GROUP_SIZE) {

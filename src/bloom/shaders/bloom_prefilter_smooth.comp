@@ -147,14 +147,20 @@ void main() {
   ivec2 raw_origin = window - kRadius;
 
   // Every fetch is issued before the first shared store, so their latencies overlap.
-  vec3 fetched[kLoadsPerInvocation];
-  [[unroll]] for (uint n = 0u; n < kLoadsPerInvocation; ++n) {
-    uint i = min(gl_LocalInvocationIndex + n * kGroupSize, kRawW * kRawH - 1u);
-    fetched[n] = source_texel(scene, bright, raw_origin + ivec2(i % kRawW, i / kRawW));
-  }
-  [[unroll]] for (uint n = 0u; n < kLoadsPerInvocation; ++n) {
-    uint i = gl_LocalInvocationIndex + n * kGroupSize;
-    if (i < kRawW * kRawH) s_window[i] = vec4(fetched[n], 0.0);
+  if (PREFETCH) {  // (bloom.glsl)
+    vec3 fetched[kLoadsPerInvocation];
+    [[unroll]] for (uint n = 0u; n < kLoadsPerInvocation; ++n) {
+      uint i = min(gl_LocalInvocationIndex + n * kGroupSize, kRawW * kRawH - 1u);
+      fetched[n] = source_texel(scene, bright, raw_origin + ivec2(i % kRawW, i / kRawW));
+    }
+    [[unroll]] for (uint n = 0u; n < kLoadsPerInvocation; ++n) {
+      uint i = gl_LocalInvocationIndex + n * kGroupSize;
+      if (i < kRawW * kRawH) s_window[i] = vec4(fetched[n], 0.0);
+    }
+  } else {
+    [[dont_unroll]] for (uint i = gl_LocalInvocationIndex; i < kRawW * kRawH; i += kGroupSize) {
+      s_window[i] = vec4(source_texel(scene, bright, raw_origin + ivec2(i % kRawW, i / kRawW)), 0.0);
+    }
   }
   barrier();
   // P(t) = sum_m C(10, m) / 1024 * B(clamp(t + m - 5)) per axis. Entries of texels outside the

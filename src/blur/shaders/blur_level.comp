@@ -18,6 +18,12 @@ layout(constant_id = 3) const int RADIUS = 4;       // taps 2 * RADIUS + 1 (0: d
 layout(constant_id = 4) const int MODE = 0;         // source read: 0 same size, 1 exact 2:1 area,
                                                     // 2 any-ratio area, 3 binomial (docs/BLUR.md)
 layout(constant_id = 5) const bool HALF_SHARED = false;
+// Issue every source fetch of the load step before the first shared store (GPUs: the latencies
+// overlap), or load in a plain loop (CPU devices: invocations run in order as SIMD lanes, so there
+// is no latency to hide, and unrolling LOADS calls of load_source() - up to 16 texel fetches each
+// for MODE 3 - multiplies the code the device's JIT compiles, by minutes per variant on lavapipe).
+// Both store the same values.
+layout(constant_id = 6) const bool PREFETCH = true;
 
 layout(binding = 0) uniform texture2D src;
 #include "dst_image.glsl"
@@ -85,14 +91,21 @@ void main() {
   // Every fetch is issued before the first shared store, so their latencies overlap (H100,
   // 3840x2160: 9 taps 244 -> 178 us; the 3-level pyramid, which reads 4 texels per loaded one,
   // 147 us without this and 124 us with it).
-  vec4 fetched[LOADS];
-  [[unroll]] for (int n = 0; n < LOADS; ++n) {
-    int i = min(local + n * GROUP_SIZE, LOAD_W * LOAD_H - 1);
-    fetched[n] = load_source(clamp(tile - RADIUS + ivec2(i % LOAD_W, i / LOAD_W), ivec2(0), dst_size - 1));
-  }
-  [[unroll]] for (int n = 0; n < LOADS; ++n) {
-    int i = local + n * GROUP_SIZE;
-    if (i < LOAD_W * LOAD_H) put_src((i / LOAD_W) * LOAD_S + i % LOAD_W, fetched[n]);
+  if (PREFETCH) {
+    vec4 fetched[LOADS];
+    [[unroll]] for (int n = 0; n < LOADS; ++n) {
+      int i = min(local + n * GROUP_SIZE, LOAD_W * LOAD_H - 1);
+      fetched[n] = load_source(clamp(tile - RADIUS + ivec2(i % LOAD_W, i / LOAD_W), ivec2(0), dst_size - 1));
+    }
+    [[unroll]] for (int n = 0; n < LOADS; ++n) {
+      int i = local + n * GROUP_SIZE;
+      if (i < LOAD_W * LOAD_H) put_src((i / LOAD_W) * LOAD_S + i % LOAD_W, fetched[n]);
+    }
+  } else {
+    [[dont_unroll]] for (int i = local; i < LOAD_W * LOAD_H; i += GROUP_SIZE) {
+      vec4 v = load_source(clamp(tile - RADIUS + ivec2(i % LOAD_W, i / LOAD_W), ivec2(0), dst_size - 1));
+      put_src((i / LOAD_W) * LOAD_S + i % LOAD_W, v);
+    }
   }
   barrier();
 
