@@ -147,12 +147,24 @@ uint32_t bloom_shared_bytes(detail::Workgroup2D g) {
   return std::max({down, up, smooth, boxes});
 }
 
-// Whether the first downsample runs src/bloom/shaders/bloom_prefilter_boxes.comp: the karis_smooth guard at
-// an exact 2:1 step with a filter that reads 2x2 box means (cod13, dual). Every other case runs
-// the general src/bloom/shaders/bloom_prefilter_smooth.comp.
-bool smooth_boxes_apply(const BloomConfig& config, VkExtent2D full, LevelSize first) {
-  return config.firefly_guard == FireflyGuard::karis_smooth && config.filter != BloomFilter::gauss9 &&
-         full.width == 2 * first.width && full.height == 2 * first.height;
+// Whether src/bloom/shaders/bloom_prefilter_boxes.comp can serve this configuration: the
+// karis_smooth guard with a filter that reads 2x2 box means (cod13, dual), on a GPU, or on any
+// device whose workgroup the caller chose (ContextOptions::workgroup_2d, the tuning option, which
+// selects the GPU kernels so they can be tuned and tested anywhere). The kernel trades arithmetic
+// and shared memory per output, which bound a GPU's occupancy, for two more barriers with live
+// registers across them; lavapipe runs a barrier as a coroutine switch that saves those registers,
+// and with its default 8x8 workgroups measured the kernel 1.6x slower than the general one, so
+// CPU devices keep the general kernel by default.
+bool smooth_boxes_kernel(const Context& context, const BloomConfig& config) {
+  const bool gpu_kernels =
+      context.info().type != VK_PHYSICAL_DEVICE_TYPE_CPU || context.state().workgroup_2d.width != 0;
+  return config.firefly_guard == FireflyGuard::karis_smooth && config.filter != BloomFilter::gauss9 && gpu_kernels;
+}
+
+// Whether the first downsample runs that kernel: it needs an exact 2:1 step. Every other case
+// runs the general src/bloom/shaders/bloom_prefilter_smooth.comp.
+bool smooth_boxes_apply(const Context& context, const BloomConfig& config, VkExtent2D full, LevelSize first) {
+  return smooth_boxes_kernel(context, config) && full.width == 2 * first.width && full.height == 2 * first.height;
 }
 
 // The device's preferred workgroup if its shared memory holds the tiles, else 8x8 (12 KiB).
@@ -233,7 +245,7 @@ struct Bloom::Impl {
     const char* first =
         config.firefly_guard == FireflyGuard::karis_smooth ? "bloom_prefilter_smooth_" : "bloom_prefilter_down_";
     prefilter_down = detail::ComputePipeline(*context, desc(first + lv, {S, W}));
-    prefilter_boxes = config.firefly_guard == FireflyGuard::karis_smooth && config.filter != BloomFilter::gauss9
+    prefilter_boxes = smooth_boxes_kernel(*context, config)
                           ? detail::ComputePipeline(*context, desc("bloom_prefilter_boxes_" + lv, {S, W}))
                           : detail::ComputePipeline();
     down = detail::ComputePipeline(*context, desc("bloom_down_" + lv, {S, W}));
@@ -278,7 +290,7 @@ struct Bloom::Impl {
     chain = bloom_mip_chain(size, config.iterations, config.level0_height);
     pre_chain = bloom_pre_levels(size, config.level0_height);
     P.was_clamped = chain.size() < config.iterations;
-    P.boxes_first = smooth_boxes_apply(config, size, pre_chain.empty() ? chain[0] : pre_chain[0]);
+    P.boxes_first = smooth_boxes_apply(*context, config, size, pre_chain.empty() ? chain[0] : pre_chain[0]);
     const VkImageUsageFlags usage = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT;
     const bool gauss = config.filter == BloomFilter::gauss9;
     for (const LevelSize& l : pre_chain)
