@@ -9,8 +9,10 @@
 #include <limits>
 
 #include "core/half.h"
+#include "core/pipeline.h"
 #include "reference/bloom_reference.h"
 #include "support/effects.h"
+#include "support/environment.h"
 #include "support/gpu_test.h"
 
 namespace glint::test {
@@ -190,6 +192,68 @@ TEST_F(BloomTest, MatchesReferenceForEveryGuardAndLevel0Height) {
         EXPECT_LT(std::sqrt(diff / norm), 1e-3) << bloom_filter_name(filter) << " guard " << firefly_guard_name(guard)
                                                 << " " << c.w << "x" << c.h << " level0_height " << c.level0_height;
       }
+    }
+  }
+}
+
+// The karis_smooth first step at an exact 2:1 reduction with cod13 and dual runs its own kernel
+// on GPUs and wherever ContextOptions::workgroup_2d is set (src/bloom/shaders/bloom_prefilter_boxes.comp:
+// the box means of the binomially filtered source as one 12-tap binomial pass per axis, a
+// workgroup of W x H making W x 2H texels). Against the float64 reference on the light added, on
+// contexts with forced workgroups (8x8 and 3x5: tiles of 8x16 and 3x10, within
+// lavapipe's 32 KiB of shared memory for every bloom kernel) and on this program's context (the
+// general kernel on lavapipe): interior tiles, partial tiles at the right and bottom, and levels
+// of 2 and 3 texels whose tiles touch both edges of an axis (the 11-tap edge case on both sides).
+// fp32 levels and I/O: 1e-3 as above (fp32 arithmetic).
+TEST_F(BloomTest, SmoothBoxesFirstStepMatchesReference) {
+  const VkExtent2D sizes[] = {{160, 96}, {134, 70}, {6, 4}, {4, 10}};
+  std::vector<std::unique_ptr<Context>> forced;
+  for (VkExtent2D wg : {VkExtent2D{8, 8}, VkExtent2D{3, 5}}) {
+    ContextOptions options;
+    options.validation = true;
+    options = tools::context_options_from_environment(options);
+    options.workgroup_2d = wg;
+    forced.push_back(std::make_unique<Context>(Context::create(options)));
+  }
+  std::vector<const Context*> contexts{&context()};
+  for (const auto& c : forced) contexts.push_back(c.get());
+  for (const Context* ctx : contexts) {
+    for (BloomFilter filter : {BloomFilter::cod13, BloomFilter::dual}) {
+      BloomConfig config;
+      config.filter = filter;
+      config.precision = Precision::fp32;
+      config.iterations = 3;
+      config.intensity = 1.0f;
+      ASSERT_EQ(config.firefly_guard, FireflyGuard::karis_smooth);
+      Bloom bloom(*ctx, config);
+      for (VkExtent2D size : sizes) {
+        const CpuImage input = random_hdr(size.width, size.height, size.width * 3 + size.height, 0.05f);
+        detail::OwnedImage in(*ctx, size, kF32, detail::kToolImageUsage);
+        detail::OwnedImage out(*ctx, size, kF32, detail::kToolImageUsage);
+        detail::upload(*ctx, in.state, input);
+        detail::fill(*ctx, out.state, std::nanf(""));
+        ctx->run_once([&](VkCommandBuffer cmd) { bloom.record(cmd, in.state, out.state); });
+        bloom.forget_caller_resources();
+        const CpuImage gpu = detail::download(*ctx, out.state);
+        ASSERT_TRUE(all_finite(gpu)) << "unwritten (poisoned) texels remain";
+        const auto ref = reference::bloom(input, config);
+        double diff = 0.0, norm = 0.0;
+        for (size_t i = 0; i < gpu.rgba.size(); ++i) {
+          if (i % 4 == 3) continue;
+          const double want = ref.rgba[i] - input.rgba[i], got = double(gpu.rgba[i]) - input.rgba[i];
+          diff += (got - want) * (got - want);
+          norm += want * want;
+        }
+        EXPECT_GT(norm, 0.0);
+        const detail::Workgroup2D g = detail::choose_workgroup_2d(*ctx);
+        EXPECT_LT(std::sqrt(diff / norm), 1e-3) << bloom_filter_name(filter) << " " << size.width << "x" << size.height
+                                                << " workgroup " << g.x << "x" << g.y;
+      }
+    }
+    if (ctx != &context()) {  // the fixture checks the program's context
+      std::string log;
+      for (const std::string& m : ctx->validation_log()) log += m + "\n";
+      EXPECT_EQ(ctx->validation_messages(), 0u) << log;
     }
   }
 }

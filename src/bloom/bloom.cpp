@@ -136,13 +136,35 @@ constexpr VkAccessFlags2 kStorageWrite = VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT;
 constexpr VkAccessFlags2 kStorageRead = VK_ACCESS_2_SHADER_STORAGE_READ_BIT;
 
 // Shared memory the tiled kernels declare for a workgroup (src/bloom/shaders/bloom_down_tiled.glsl,
-// bloom_up_tiled.glsl and src/bloom/shaders/bloom_prefilter_smooth.comp): vec4 windows of the source.
+// bloom_up_tiled.glsl and src/bloom/shaders/bloom_prefilter_smooth.comp: vec4 windows of the source;
+// src/bloom/shaders/bloom_prefilter_boxes.comp: three floats per texel of a window for a 2 g.y row tile).
 uint32_t bloom_shared_bytes(detail::Workgroup2D g) {
   const uint32_t down = ((2 * g.x + 4) * (2 * g.y + 4) + (2 * g.x + 3) * (2 * g.y + 3)) * 16;
   const uint32_t up = ((g.x + 10) * (g.y + 10) + g.x * (g.y + 10)) * 16;
   const uint32_t apron = 2 * GLINT_BLOOM_SMOOTH_RADIUS;
   const uint32_t smooth = ((2 * g.x + 6 + apron) * (2 * g.y + 6 + apron) + (2 * g.y + 6 + apron) * (2 * g.x + 6)) * 16;
-  return std::max({down, up, smooth});
+  const uint32_t boxes = (2 * g.x + 4 + apron) * (4 * g.y + 4 + apron) * 12;
+  return std::max({down, up, smooth, boxes});
+}
+
+// Whether src/bloom/shaders/bloom_prefilter_boxes.comp can serve this configuration: the
+// karis_smooth guard with a filter that reads 2x2 box means (cod13, dual), on a GPU, or on any
+// device whose workgroup the caller chose (ContextOptions::workgroup_2d, the tuning option, which
+// selects the GPU kernels so they can be tuned and tested anywhere). The kernel trades arithmetic
+// and shared memory per output, which bound a GPU's occupancy, for two more barriers with live
+// registers across them; lavapipe runs a barrier as a coroutine switch that saves those registers,
+// and with its default 8x8 workgroups measured the kernel 1.6x slower than the general one, so
+// CPU devices keep the general kernel by default.
+bool smooth_boxes_kernel(const Context& context, const BloomConfig& config) {
+  const bool gpu_kernels =
+      context.info().type != VK_PHYSICAL_DEVICE_TYPE_CPU || context.state().workgroup_2d.width != 0;
+  return config.firefly_guard == FireflyGuard::karis_smooth && config.filter != BloomFilter::gauss9 && gpu_kernels;
+}
+
+// Whether the first downsample runs that kernel: it needs an exact 2:1 step. Every other case
+// runs the general src/bloom/shaders/bloom_prefilter_smooth.comp.
+bool smooth_boxes_apply(const Context& context, const BloomConfig& config, VkExtent2D full, LevelSize first) {
+  return smooth_boxes_kernel(context, config) && full.width == 2 * first.width && full.height == 2 * first.height;
 }
 
 // The device's preferred workgroup if its shared memory holds the tiles, else 8x8 (12 KiB).
@@ -166,6 +188,8 @@ struct Bloom::Impl {
 
   // Pipelines for the current shape (filter, precision); composite and copy per output format.
   detail::ComputePipeline prefilter_down, down, blur, up;
+  // karis_smooth at an exact 2:1 first step with cod13 or dual (smooth_boxes_apply()); else empty.
+  detail::ComputePipeline prefilter_boxes;
   // Composite and copy per output variant (core/formats.h, check_color_write()): rgba16f and
   // rgba32f are made with the others, r11f_g11f_b10f and noformat on first use.
   std::map<std::string, detail::ComputePipeline> composite, copy;
@@ -186,6 +210,7 @@ struct Bloom::Impl {
     std::vector<LevelSize> chain;
     bool was_clamped = false;
     std::vector<LevelSize> pre_chain;  // level0_height's 2:1 steps before level 0
+    bool boxes_first = false;          // the first step runs prefilter_boxes (smooth_boxes_apply())
     std::vector<detail::OwnedImage> pre_levels;
     std::vector<VkDescriptorSet> pre_sets;  // pre_levels[k] -> pre_levels[k + 1] or level 0
     std::vector<detail::OwnedImage> levels;
@@ -222,6 +247,9 @@ struct Bloom::Impl {
     const char* first =
         config.firefly_guard == FireflyGuard::karis_smooth ? "bloom_prefilter_smooth_" : "bloom_prefilter_down_";
     prefilter_down = detail::ComputePipeline(*context, desc(first + lv, {S, W}));
+    prefilter_boxes = smooth_boxes_kernel(*context, config)
+                          ? detail::ComputePipeline(*context, desc("bloom_prefilter_boxes_" + lv, {S, W}))
+                          : detail::ComputePipeline();
     down = detail::ComputePipeline(*context, desc("bloom_down_" + lv, {S, W}));
     blur = config.filter == BloomFilter::gauss9 ? detail::ComputePipeline(*context, desc("bloom_blur_" + lv, {S, W}))
                                                 : detail::ComputePipeline();
@@ -264,6 +292,7 @@ struct Bloom::Impl {
     chain = bloom_mip_chain(size, config.iterations, config.level0_height);
     pre_chain = bloom_pre_levels(size, config.level0_height);
     P.was_clamped = chain.size() < config.iterations;
+    P.boxes_first = smooth_boxes_apply(*context, config, size, pre_chain.empty() ? chain[0] : pre_chain[0]);
     const VkImageUsageFlags usage = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT;
     const bool gauss = config.filter == BloomFilter::gauss9;
     for (const LevelSize& l : pre_chain)
@@ -307,7 +336,7 @@ struct Bloom::Impl {
     const auto [composite_pipeline, copy_pipeline] = output_pipelines(out_variant);
     CallerSets s;
     const VkImageView first = pre_levels.empty() ? levels[0].state.view : pre_levels[0].state.view;
-    s.prefilter = arena.make_set(prefilter_down, {{in.view, in_layout}, {first, G}});
+    s.prefilter = arena.make_set(P.boxes_first ? prefilter_boxes : prefilter_down, {{in.view, in_layout}, {first, G}});
     s.composite = arena.make_set(*composite_pipeline, {{in.view, in_layout}, {levels[0].state.view, G}, {out.view, G}});
     s.copy = arena.make_set(*copy_pipeline, {{in.view, in_layout}, {out.view, G}});
     s.composite_pipeline = composite_pipeline;
@@ -430,7 +459,13 @@ void Bloom::Impl::record(VkCommandBuffer cmd, Image& input, Image& output, Profi
   b.use(scene, scene_layout, kCompute, kSampled);
   b.use(first, G, kCompute, kStorageWrite);
   b.flush(cmd);
-  prefilter_down.dispatch(cmd, sets.prefilter, push(P, full, first_size, karis), first_size.width, first_size.height);
+  if (P.boxes_first) {
+    // A workgroup of W x H invocations writes W x 2H texels (two rows per invocation).
+    prefilter_boxes.dispatch(cmd, sets.prefilter, push(P, full, first_size), first_size.width,
+                             (first_size.height + 1) / 2);
+  } else {
+    prefilter_down.dispatch(cmd, sets.prefilter, push(P, full, first_size, karis), first_size.width, first_size.height);
+  }
   for (uint32_t k = 0; k < m; ++k) {
     Image& next = k + 1 < m ? pre_levels[k + 1].state : levels[0].state;
     const LevelSize next_size = k + 1 < m ? pre_chain[k + 1] : chain[0];

@@ -6,6 +6,8 @@ set(GLINT_EFFECT_KERNELS
   "shaders/bloom_prefilter_down|rgba32f|DST_FORMAT=rgba32f"
   "shaders/bloom_prefilter_smooth|rgba16f|DST_FORMAT=rgba16f"
   "shaders/bloom_prefilter_smooth|rgba32f|DST_FORMAT=rgba32f"
+  "shaders/bloom_prefilter_boxes|rgba16f|DST_FORMAT=rgba16f"
+  "shaders/bloom_prefilter_boxes|rgba32f|DST_FORMAT=rgba32f"
   "shaders/bloom_down|rgba16f|DST_FORMAT=rgba16f"
   "shaders/bloom_down|rgba32f|DST_FORMAT=rgba32f"
   "shaders/bloom_blur|rgba16f|DST_FORMAT=rgba16f"
