@@ -63,7 +63,6 @@ CpuImage run_once_on(GaussianBlur& blur, const CpuImage& input) {
   detail::OwnedImage out(ctx, {input.width, input.height}, f, detail::kToolImageUsage);
   detail::upload(ctx, in.state, input);
   ctx.run_once([&](VkCommandBuffer cmd) { blur.record(cmd, in.state, out.state); });
-  blur.forget_caller_resources();  // `in` and `out` die here; their handles may be reused
   return detail::download(ctx, out.state);
 }
 

@@ -27,9 +27,6 @@ void BM_CopyFloor(benchmark::State& state) {
   desc.push_constant_bytes = sizeof(BloomPush);
   desc.workgroup = detail::choose_workgroup_2d(ctx);
   detail::ComputePipeline copy(ctx, desc);
-  detail::DescriptorArena arena(ctx, 1);
-  VkDescriptorSet set = arena.make_set(
-      copy, {{src.state.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL}, {dst.state.view, VK_IMAGE_LAYOUT_GENERAL}});
   BloomPush push{};
   push.dst_width = static_cast<int32_t>(width);
   push.dst_height = static_cast<int32_t>(height);
@@ -44,7 +41,9 @@ void BM_CopyFloor(benchmark::State& state) {
       b.use(dst.state, VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
             VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
       b.flush(cmd);
-      copy.dispatch(cmd, set, push, width, height);
+      copy.dispatch(
+          cmd, {{src.state.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL}, {dst.state.view, VK_IMAGE_LAYOUT_GENERAL}},
+          push, width, height);
     });
     all.push_back(m);
     state.SetIterationTime(m * 1e-3);

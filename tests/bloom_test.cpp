@@ -35,7 +35,6 @@ CpuImage run_bloom(Bloom& bloom, const CpuImage& input, VkFormat in_format, VkFo
     }
     bloom.record(cmd, in.state, out.state, profiler);
   });
-  bloom.forget_caller_resources();  // `in` and `out` die here; their handles may be reused
   return detail::download(context(), out.state);
 }
 
@@ -233,7 +232,6 @@ TEST_F(BloomTest, SmoothBoxesFirstStepMatchesReference) {
         detail::upload(*ctx, in.state, input);
         detail::fill(*ctx, out.state, std::nanf(""));
         ctx->run_once([&](VkCommandBuffer cmd) { bloom.record(cmd, in.state, out.state); });
-        bloom.forget_caller_resources();
         const CpuImage gpu = detail::download(*ctx, out.state);
         ASSERT_TRUE(all_finite(gpu)) << "unwritten (poisoned) texels remain";
         const auto ref = reference::bloom(input, config);

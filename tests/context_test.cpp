@@ -139,6 +139,8 @@ TEST_F(ContextTest, AdoptedDeviceRunsBloomInTheEnginesCommandBuffer) {
   di.pNext = &f13;
   di.queueCreateInfoCount = 1;
   di.pQueueCreateInfos = &q;
+  di.enabledExtensionCount = kGlintDeviceExtensionCount;
+  di.ppEnabledExtensionNames = kGlintDeviceExtensions;
   VkDevice device = VK_NULL_HANDLE;
   ASSERT_EQ(vkCreateDevice(mine.physical_device(), &di, nullptr, &device), VK_SUCCESS);
   VkQueue queue;
@@ -148,8 +150,8 @@ TEST_F(ContextTest, AdoptedDeviceRunsBloomInTheEnginesCommandBuffer) {
   VkCommandPool pool;
   ASSERT_EQ(vkCreateCommandPool(device, &pi, nullptr, &pool), VK_SUCCESS);
   {
-    Context engine =
-        Context::adopt({mine.instance(), VK_API_VERSION_1_3, mine.physical_device(), device, family, &f13});
+    Context engine = Context::adopt(
+        with_glint_extensions({mine.instance(), VK_API_VERSION_1_3, mine.physical_device(), device, family, &f13}));
     EXPECT_TRUE(engine.is_adopted());
     EXPECT_THROW(engine.run_once([](VkCommandBuffer) {}), Error);
 
@@ -238,11 +240,11 @@ TEST_F(ContextTest, AdoptRejectsNullHandlesAndBadQueueFamily) {
   }
 }
 
-// A device of the context's physical device, created with the given feature chain (the engine's
-// vkCreateDevice). Destroyed with the object.
+// A device of the context's physical device, created with the given feature chain and glint's
+// extensions (or none: push_descriptor false) (the engine's vkCreateDevice). Destroyed with the object.
 struct EngineDevice {
   VkDevice device = VK_NULL_HANDLE;
-  EngineDevice(const Context& mine, const void* features) {
+  EngineDevice(const Context& mine, const void* features, bool push_descriptor = true) {
     float priority = 1.0f;
     VkDeviceQueueCreateInfo q{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
     q.queueFamilyIndex = mine.queue_family_index();
@@ -252,6 +254,8 @@ struct EngineDevice {
     di.pNext = features;
     di.queueCreateInfoCount = 1;
     di.pQueueCreateInfos = &q;
+    di.enabledExtensionCount = push_descriptor ? kGlintDeviceExtensionCount : 0;
+    di.ppEnabledExtensionNames = kGlintDeviceExtensions;
     if (vkCreateDevice(mine.physical_device(), &di, nullptr, &device) != VK_SUCCESS) device = VK_NULL_HANDLE;
   }
   EngineDevice(const EngineDevice&) = delete;
@@ -261,7 +265,10 @@ struct EngineDevice {
   }
 };
 
-void expect_adopt_error(const AdoptInfo& info, ErrorCode code, const std::string& names) {
+// Adopting `info` (with glint's extensions listed unless `list_extensions` is false) throws
+// Error(code) whose message contains `names`.
+void expect_adopt_error(AdoptInfo info, ErrorCode code, const std::string& names, bool list_extensions = true) {
+  if (list_extensions) info = with_glint_extensions(info);
   try {
     Context::adopt(info);
     ADD_FAILURE() << "adopt accepted it; expected an error naming " << names;
@@ -319,15 +326,50 @@ TEST_F(ContextTest, AdoptChecksTheApiVersionsAndTheFeaturesGlintNeeds) {
   s2.pNext = &m4;
   EngineDevice promoted(mine, &s2);
   ASSERT_NE(promoted.device, VK_NULL_HANDLE);
-  const Context ok =
-      Context::adopt({mine.instance(), VK_API_VERSION_1_3, mine.physical_device(), promoted.device, family, &s2});
+  const Context ok = Context::adopt(with_glint_extensions(
+      {mine.instance(), VK_API_VERSION_1_3, mine.physical_device(), promoted.device, family, &s2}));
   EXPECT_TRUE(ok.is_adopted());
   EXPECT_EQ(ok.device(), promoted.device);
   // A good adopt without a chain (every 1.3 device supports both features); a later instance
   // version is fine.
-  EXPECT_TRUE(
-      Context::adopt({mine.instance(), VK_MAKE_API_VERSION(0, 1, 4, 0), mine.physical_device(), mine.device(), family})
-          .is_adopted());
+  EXPECT_TRUE(Context::adopt(with_glint_extensions({mine.instance(), VK_MAKE_API_VERSION(0, 1, 4, 0),
+                                                    mine.physical_device(), mine.device(), family}))
+                  .is_adopted());
+}
+
+// glint pushes every kernel's descriptors (VK_KHR_push_descriptor), and Vulkan cannot be asked
+// which extensions a device was created with: adopt() refuses, naming the extension, a list that
+// lacks it (no list, another extension only, or a count with a null list), and accepts the list of
+// a device created with it. Each refused device is valid Vulkan, so the layer stays silent.
+TEST_F(ContextTest, AdoptRefusesADeviceWithoutPushDescriptors) {
+  const Context& mine = context();
+  const uint32_t family = mine.queue_family_index();
+  VkPhysicalDeviceVulkan13Features f13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
+  f13.synchronization2 = VK_TRUE;
+  f13.maintenance4 = VK_TRUE;
+  EngineDevice without(mine, &f13, false);
+  ASSERT_NE(without.device, VK_NULL_HANDLE);
+  const AdoptInfo base{mine.instance(), VK_API_VERSION_1_3, mine.physical_device(), without.device, family, &f13};
+  expect_adopt_error(base, ErrorCode::invalid_argument,
+                     "VK_KHR_push_descriptor is not in AdoptInfo::enabled_extensions", false);
+  AdoptInfo other = base;
+  const char* const swapchain[] = {VK_KHR_SWAPCHAIN_EXTENSION_NAME};
+  other.enabled_extensions = swapchain;
+  other.enabled_extension_count = 1;
+  expect_adopt_error(other, ErrorCode::invalid_argument, "VK_KHR_push_descriptor", false);
+  AdoptInfo null_list = base;
+  null_list.enabled_extension_count = 2;
+  expect_adopt_error(null_list, ErrorCode::invalid_argument, "AdoptInfo::enabled_extension_count = 2", false);
+
+  EngineDevice with(mine, &f13, true);
+  ASSERT_NE(with.device, VK_NULL_HANDLE);
+  AdoptInfo good = base;
+  good.device = with.device;
+  const char* const listed[] = {VK_KHR_SWAPCHAIN_EXTENSION_NAME, VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME};
+  good.enabled_extensions = listed;
+  good.enabled_extension_count = 2;  // the extension need not come first
+  const Context adopted = Context::adopt(good);
+  EXPECT_TRUE(adopted.is_adopted());
 }
 
 // Compiled kernels (and samplers) are shared per context: a second pipeline of the same description compiles

@@ -120,7 +120,6 @@ FrameResult run_frame(LensFlarePass& pass, const CpuImage& background, const std
     b.use(d, VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
     b.flush(cmd);
   });
-  pass.forget_caller_resources();  // the images and buffers above die with this function
   FrameResult r;
   r.image = detail::read_staged(color_down, color.image());
   down.invalidate();

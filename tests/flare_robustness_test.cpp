@@ -276,7 +276,6 @@ std::vector<PassRun> run_pass(LensFlarePass& pass, const CpuImage& background, c
     if (n) std::memcpy(run.results.data(), bytes + 64 + instance_bytes, result_bytes);
     out.push_back(std::move(run));
   }
-  pass.forget_caller_resources();  // the images and buffers above die with this function
   return out;
 }
 
@@ -750,7 +749,6 @@ TEST_F(FlareRobustnessTest, LodNonFiniteQueriesFallBackToLevelZeroOnTheGpu) {
       EXPECT_EQ(lod_level(queries[i], atlas), 0.0f) << "query " << i << " on the host";
     }
   }
-  batch.forget_caller_resources();
 }
 
 }  // namespace

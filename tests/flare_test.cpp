@@ -114,7 +114,6 @@ CpuImage draw(LensFlare& flare, Path path, const CpuImage& background, VkFormat 
     in.record_upload(cmd);
     record(flare, path, cmd, color.state, in, config);
   });
-  flare.forget_caller_resources();  // `color` dies here, `in` may be remade
   return detail::download(context(), color.state);
 }
 
@@ -361,8 +360,9 @@ TEST_F(FlareTest, ChosenLevelsKeepFootprintsInsideThePadding) {
 // Poisoning: an adopted context records the generation in the first frame; every texel of every
 // level, cleared to NaN before, must come out finite and equal to the standalone atlas.
 TEST_F(FlareTest, AdoptedContextGeneratesTheAtlasInTheFirstRecordOverPoison) {
-  Context engine = Context::adopt({context().instance(), VK_API_VERSION_1_3, context().physical_device(),
-                                   context().device(), context().queue_family_index()});
+  Context engine =
+      Context::adopt(with_glint_extensions({context().instance(), VK_API_VERSION_1_3, context().physical_device(),
+                                            context().device(), context().queue_family_index()}));
   LensFlare flare(engine, kF32, {kW, kH});
   EXPECT_FALSE(flare.atlas().generated);
   const FlareAtlasInfo a = flare.atlas();
@@ -399,7 +399,7 @@ TEST_F(FlareTest, AdoptedContextGeneratesTheAtlasInTheFirstRecordOverPoison) {
   AdoptInfo info{context().instance(),           VK_API_VERSION_1_3,
                  context().physical_device(),    context().device(),
                  context().queue_family_index(), &f13};
-  Context no_rendering = Context::adopt(info);
+  Context no_rendering = Context::adopt(with_glint_extensions(info));
   LensFlare compute_only(no_rendering, kF32, {kW, kH});
   detail::OwnedImage color(context(), {kW, kH}, kF32, kUsage);
   FlareInputs in({}, 0, compute_only.groups_per_instance());

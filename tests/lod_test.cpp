@@ -228,58 +228,26 @@ std::vector<float> probe_sampler(const char* kernel, const LevelAtlas& atlas, co
   desc.push_constant_bytes = sizeof(GlintLodAtlas) + 4;
   desc.workgroup = {64, 1};
   detail::ComputePipeline probe(context(), desc);
-  VkDescriptorPoolSize sizes[] = {{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1},
-                                  {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 2}};
-  VkDescriptorPoolCreateInfo pi{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
-  pi.maxSets = 1;
-  pi.poolSizeCount = 2;
-  pi.pPoolSizes = sizes;
-  VkDescriptorPool pool;
-  EXPECT_EQ(vkCreateDescriptorPool(context().device(), &pi, nullptr, &pool), VK_SUCCESS);
-  VkDescriptorSetLayout layout = probe.set_layout();
-  VkDescriptorSetAllocateInfo ai{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
-  ai.descriptorPool = pool;
-  ai.descriptorSetCount = 1;
-  ai.pSetLayouts = &layout;
-  VkDescriptorSet set;
-  EXPECT_EQ(vkAllocateDescriptorSets(context().device(), &ai, &set), VK_SUCCESS);
-
   auto qbuf = host_buffer(queries.size() * sizeof(LodQuery));
   auto lbuf = host_buffer(queries.size() * sizeof(float));
   std::memcpy(qbuf.mapped(), queries.data(), queries.size() * sizeof(LodQuery));
   qbuf.flush();
-  VkDescriptorImageInfo ii{atlas.sampler, atlas.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
-  VkDescriptorBufferInfo bq{qbuf.buffer(), 0, VK_WHOLE_SIZE}, bl{lbuf.buffer(), 0, VK_WHOLE_SIZE};
-  VkWriteDescriptorSet w[3] = {{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET},
-                               {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET},
-                               {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET}};
-  for (uint32_t i = 0; i < 3; ++i) {
-    w[i].dstSet = set;
-    w[i].dstBinding = i;
-    w[i].descriptorCount = 1;
-    w[i].descriptorType = desc.bindings[i];
-  }
-  w[0].pImageInfo = &ii;
-  w[1].pBufferInfo = &bq;
-  w[2].pBufferInfo = &bl;
-  vkUpdateDescriptorSets(context().device(), 3, w, 0, nullptr);
-
   struct {
     GlintLodAtlas atlas;
     uint32_t count;
   } push{{float(size), float(size), float(levels), 0.0f, 1.0f, -1.0f, 0u, 0u}, uint32_t(queries.size())};
-  Buffer l = view(lbuf);
+  Buffer q = view(qbuf), l = view(lbuf);
   context().run_once([&](VkCommandBuffer cmd) {
     detail::Barriers b;
     b.use(l, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
     b.flush(cmd);
-    probe.dispatch(cmd, set, push, uint32_t(queries.size()), 1);
+    probe.dispatch(cmd, {{atlas.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, atlas.sampler}, q, l}, push,
+                   uint32_t(queries.size()), 1);
     to_host(cmd, l);
   });
   lbuf.invalidate();
   std::vector<float> hw(queries.size());
   std::memcpy(hw.data(), lbuf.mapped(), hw.size() * 4);
-  vkDestroyDescriptorPool(context().device(), pool, nullptr);
   return hw;
 }
 

@@ -145,7 +145,6 @@ TEST_F(OcclusionTest, HiZRepeatsFramesAndCapsLevels) {
         hiz.record(cmd, ib.state);
       });
       expect_pyramid(read_pyramid(hiz), b, false, "second build in one command buffer");
-      hiz.forget_caller_resources();  // ia and ib die at the end of this iteration
     }
   }
   HiZConfig capped;

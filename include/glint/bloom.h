@@ -76,10 +76,11 @@ std::vector<LevelSize> bloom_pre_levels(VkExtent2D input, uint32_t level0_height
 /// (GENERAL if it is also the output) and the output in GENERAL, both last used by the compute shader stage. Input and
 /// output may be the same image (in place).
 ///
-/// Per size and config shape, images, pipelines and descriptor sets are made once: by prepare(),
-/// or by the first record() at that size. A record() at a prepared size with seen images creates
-/// no Vulkan object. Each distinct (input view, output view) pair gets its descriptor sets on
-/// first use, per size.
+/// Per size and config shape, images and pipelines are made once: by prepare(), or by the first
+/// record() at that size. A record() at a prepared size creates no Vulkan object. Descriptors are
+/// pushed with each dispatch (VK_KHR_push_descriptor) and nothing keeps the caller's views: a view
+/// may be destroyed once the command buffers it was recorded into are done, and a new view (even
+/// one with the old handle) needs nothing before the next record().
 ///
 /// Several sizes (dynamic resolution, several views): one Bloom may be recorded at different
 /// extents, in one command buffer or in consecutive frames. Each size keeps its own pyramid; the
@@ -122,13 +123,6 @@ class Bloom {
   /// Sizes (with config shapes) whose pyramids are kept now: at most kMaxCachedSizes, and with one
   /// size per frame and begin_frame() every frame at most Context::frames_in_flight().
   uint32_t cached_sizes() const;
-
-  /// Drops the descriptor sets cached for the caller's images/buffers passed to record(). Vulkan
-  /// may give a new object the handle of a destroyed one, and these sets are keyed by handle: call
-  /// this before destroying (or after destroying, before the next record() with) a view or buffer
-  /// that was passed to record(), once no submitted work uses it. Engines that keep their render
-  /// targets alive never need it. Creates nothing; the next record() makes the sets again.
-  void forget_caller_resources();
 
   /// Levels the current size (the last one prepared or recorded) uses (after the small-size clamp),
   /// and whether iterations were reduced to get there. Valid after prepare() or record().

@@ -41,9 +41,9 @@ struct EffectiveSigma {
 /// caller's next barrier starts from level(k).stage/access). A shader samples all three with the
 /// same normalized UV as the input.
 ///
-/// Per input size, images, pipelines and descriptor sets are made once (prepare(), or the first
-/// record() at that size); record() at a prepared size with a seen input view creates no Vulkan
-/// object.
+/// Per input size, images and pipelines are made once (prepare(), or the first record() at that
+/// size); record() at a prepared size creates no Vulkan object. Descriptors are pushed with each
+/// dispatch: nothing keeps the caller's views past the command buffers they were recorded into.
 ///
 /// Several sizes: one pyramid may be recorded at different input extents, in one command buffer
 /// or in consecutive frames. Each size keeps its own levels; level(k) is the level of the size of
@@ -85,13 +85,6 @@ class BlurPyramid {
   /// Sizes (with configs) whose levels are kept now: at most kMaxCachedSizes, and with one size
   /// per frame and begin_frame() every frame at most Context::frames_in_flight().
   uint32_t cached_sizes() const;
-
-  /// Drops the descriptor sets cached for the caller's images/buffers passed to record(). Vulkan
-  /// may give a new object the handle of a destroyed one, and these sets are keyed by handle: call
-  /// this before destroying (or after destroying, before the next record() with) a view or buffer
-  /// that was passed to record(), once no submitted work uses it. Engines that keep their render
-  /// targets alive never need it. Creates nothing; the next record() makes the sets again.
-  void forget_caller_resources();
 
   /// Level k = 1, 2, 3 (Blur1 .. Blur3) with its current state. Valid after prepare()/record().
   /// Throws Error(invalid_argument) for another k. A caller that transitions or uses a level
@@ -180,11 +173,11 @@ struct BlurChoice {
 /// (docs/FORMATS.md: RGBA16F, RGBA32F, B10G11R11_UFLOAT, ...) with STORAGE usage, same extent, a
 /// different image (or another layer of the same one), left in GENERAL; both last used by the
 /// compute stage. Per size and output format, everything is made once; record() at a prepared
-/// size with seen image views creates no Vulkan object.
+/// size creates no Vulkan object, and keeps no reference to the caller's views.
 ///
 /// Several sizes: one blur may be recorded at different extents and output formats, in one
 /// command buffer or in consecutive frames; each (size, output format) keeps its own plan, images
-/// and descriptor sets, destroyed as BlurPyramid's levels are (Context::begin_frame()).
+/// and steps, destroyed as BlurPyramid's levels are (Context::begin_frame()).
 class GaussianBlur {
  public:
   /// Throws Error(invalid_argument) if config is invalid.
@@ -214,13 +207,6 @@ class GaussianBlur {
   void release_unused();
   /// (Size, output format, config) entries kept now (see BlurPyramid::cached_sizes()).
   uint32_t cached_sizes() const;
-
-  /// Drops the descriptor sets cached for the caller's images/buffers passed to record(). Vulkan
-  /// may give a new object the handle of a destroyed one, and these sets are keyed by handle: call
-  /// this before destroying (or after destroying, before the next record() with) a view or buffer
-  /// that was passed to record(), once no submitted work uses it. Engines that keep their render
-  /// targets alive never need it. Creates nothing; the next record() makes the sets again.
-  void forget_caller_resources();
 
   /// The plan of the last prepare() or record() (a default BlurChoice before either).
   const BlurChoice& choice() const;

@@ -85,18 +85,11 @@ struct FlareAtlasInfo {
 /// INDIRECT_COMMAND_READ and the vertex shader's storage read; compute: the compute shader's storage
 /// read of both) and updates the state fields.
 ///
-/// Recording creates no Vulkan object and updates no descriptor after the first use of a given
-/// instances buffer (raster) or (instances, indirect, color view) triple (compute); each new one
-/// gets its descriptor set once.
+/// Recording creates no Vulkan object: the descriptors are pushed with each draw or dispatch
+/// (VK_KHR_push_descriptor), so nothing keeps the caller's buffers or views past the command
+/// buffers they were recorded into.
 class LensFlare {
  public:
-  /// Drops the descriptor sets cached for the caller's images/buffers passed to record(). Vulkan
-  /// may give a new object the handle of a destroyed one, and these sets are keyed by handle: call
-  /// this before destroying (or after destroying, before the next record() with) a view or buffer
-  /// that was passed to record(), once no submitted work uses it. Engines that keep their render
-  /// targets alive never need it. Creates nothing; the next record() makes the sets again.
-  void forget_caller_resources();
-
   /// Creates the pipelines and the atlas for drawing into `color_format` images of `extent`.
   /// Standalone contexts generate the atlas here (one submit); adopted contexts record its
   /// generation in the first record_*() (or in record_setup()). The compute path owns a 32-byte

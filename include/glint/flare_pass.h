@@ -55,13 +55,6 @@ struct FlarePassConfig {
 /// LensFlare and the device-local instance, indirect, statistics and (optional) result buffers.
 class LensFlarePass {
  public:
-  /// Drops the descriptor sets cached for the caller's images/buffers passed to record(). Vulkan
-  /// may give a new object the handle of a destroyed one, and these sets are keyed by handle: call
-  /// this before destroying (or after destroying, before the next record() with) a view or buffer
-  /// that was passed to record(), once no submitted work uses it. Engines that keep their render
-  /// targets alive never need it. Creates nothing; the next record() makes the sets again.
-  void forget_caller_resources();
-
   /// Makes every part (pipelines, atlas, buffers), so
   /// that record() creates nothing. Throws Error for a bad config or one the device cannot run.
   LensFlarePass(const Context& context, const FlarePassConfig& config);

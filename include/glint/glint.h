@@ -114,7 +114,8 @@ struct AdoptInfo {
   /// Must not be null; created on physical_device with the Vulkan 1.3 features synchronization2
   /// (every barrier is vkCmdPipelineBarrier2) and maintenance4 (kernels size their workgroups by
   /// specialization, LocalSizeId) enabled, and dynamicRendering for LensFlare's raster path
-  /// (LensFlarePass with FlareDrawPath::raster); no extension is needed.
+  /// (LensFlarePass with FlareDrawPath::raster), and the device extension VK_KHR_push_descriptor
+  /// (listed in enabled_extensions).
   VkDevice device = VK_NULL_HANDLE;
   uint32_t queue_family_index = 0;  //!< family the command buffers come from; must support compute
                                     //!< (and graphics for the raster flare path)
@@ -128,6 +129,15 @@ struct AdoptInfo {
   const void* enabled_features = nullptr;
   /// As ContextOptions::frames_in_flight (1 to 16): the engine's frames in flight.
   uint32_t frames_in_flight = 3;
+  /// Required: the device extensions the engine enabled on `device`, as it passed them in
+  /// VkDeviceCreateInfo::ppEnabledExtensionNames / enabledExtensionCount (pass those two fields
+  /// here). It must name VK_KHR_push_descriptor (VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME): glint pushes
+  /// every kernel's descriptors with vkCmdPushDescriptorSetKHR and keeps no descriptor set, so the
+  /// views and buffers a command buffer names may be destroyed once that command buffer is done.
+  /// adopt() refuses a list without it (Error(invalid_argument) naming the extension). glint reads
+  /// the list only during adopt().
+  const char* const* enabled_extensions = nullptr;
+  uint32_t enabled_extension_count = 0;
 };
 
 /// Facts about the device that kernels are tuned by (rule: chosen per device, never assumed).
@@ -185,7 +195,7 @@ class Context {
   std::vector<std::string> validation_log() const;
 
   /// Number of Vulkan objects glint has created through this context (pipelines, images,
-  /// descriptor sets, ...). Tests use it to prove that recording a frame creates nothing.
+  /// descriptor set layouts, ...). Tests use it to prove that recording a frame creates nothing.
   uint64_t objects_created() const;
 
   /// Frames. Call begin_frame() once per frame, before recording the frame's commands and after

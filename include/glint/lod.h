@@ -52,13 +52,6 @@ class LodBatch {
   LodBatch& operator=(const LodBatch&) = delete;
   ~LodBatch();
 
-  /// Drops the descriptor sets cached for the caller's buffers passed to record(). Vulkan
-  /// may give a new object the handle of a destroyed one, and these sets are keyed by handle: call
-  /// this before destroying (or after destroying, before the next record() with) a buffer
-  /// that was passed to record(), once no submitted work uses it. Engines that keep their render
-  /// targets alive never need it. Creates nothing; the next record() makes the sets again.
-  void forget_caller_resources();
-
   /// Records the evaluation of `count` queries (LodQuery array in `queries`) into `levels`
   /// (`count` floats). Both buffers need STORAGE_BUFFER usage and at least count * 32 and
   /// count * 4 bytes. Their state fields are updated. count == 0 records nothing; count is at

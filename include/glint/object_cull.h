@@ -130,11 +130,6 @@ class ObjectCuller {
   /// the buffer is null, smaller than 4 * count bytes or lacks TRANSFER_DST usage.
   void record_clear_history(VkCommandBuffer cmd, Buffer& visibility, uint32_t count);
 
-  /// Drops the descriptor sets cached for the caller's images and buffers (keyed by handle): call
-  /// it before destroying, or re-creating with a possibly reused handle, any of them that was
-  /// passed to a record call, once no submitted work uses it.
-  void forget_caller_resources();
-
   const ObjectCullConfig& config() const;
   /// Bytes one record() moves at least: objects, visibility (read and written), group masks, and
   /// the written payloads; the Hi-Z texels read depend on the scene and are not counted.

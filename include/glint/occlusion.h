@@ -54,13 +54,6 @@ uint32_t hiz_level_count(const HiZConfig& config);
 /// depth of every source pixel it covers (fold rule in docs/OCCLUSION.md).
 class HiZPyramid {
  public:
-  /// Drops the descriptor sets cached for the caller's images/buffers passed to record(). Vulkan
-  /// may give a new object the handle of a destroyed one, and these sets are keyed by handle: call
-  /// this before destroying (or after destroying, before the next record() with) a view or buffer
-  /// that was passed to record(), once no submitted work uses it. Engines that keep their render
-  /// targets alive never need it. Creates nothing; the next record() makes the sets again.
-  void forget_caller_resources();
-
   /// Throws Error if config is invalid or larger than the device allows.
   HiZPyramid(const Context& context, const HiZConfig& config);
   HiZPyramid(const HiZPyramid&) = delete;
@@ -146,13 +139,6 @@ struct LightCullOutputs {
 /// Cull + occlusion grid test + compaction of a light list (GlintFlareLight, <glint/gpu/flare_types.h>).
 class LightCuller {
  public:
-  /// Drops the descriptor sets cached for the caller's images/buffers passed to record(). Vulkan
-  /// may give a new object the handle of a destroyed one, and these sets are keyed by handle: call
-  /// this before destroying (or after destroying, before the next record() with) a view or buffer
-  /// that was passed to record(), once no submitted work uses it. Engines that keep their render
-  /// targets alive never need it. Creates nothing; the next record() makes the sets again.
-  void forget_caller_resources();
-
   /// Throws Error if config is invalid or asks for a path the device lacks.
   LightCuller(const Context& context, const LightCullConfig& config = {});
   LightCuller(const LightCuller&) = delete;

@@ -194,15 +194,6 @@ struct Bloom::Impl {
   // rgba32f are made with the others, r11f_g11f_b10f and noformat on first use.
   std::map<std::string, detail::ComputePipeline> composite, copy;
 
-  // Descriptor sets that name caller images, made once per (input view, output view).
-  struct CallerSets {
-    VkDescriptorSet prefilter = VK_NULL_HANDLE;
-    VkDescriptorSet composite = VK_NULL_HANDLE;
-    VkDescriptorSet copy = VK_NULL_HANDLE;
-    const detail::ComputePipeline* composite_pipeline = nullptr;  // for the output's format
-    const detail::ComputePipeline* copy_pipeline = nullptr;
-  };
-
   // The pyramid of one input extent (and config generation). Kept per size in `cache` until no
   // submitted work can use it (core/size_cache.h), so one Bloom may be recorded at several sizes.
   struct Pyramid {
@@ -212,13 +203,8 @@ struct Bloom::Impl {
     std::vector<LevelSize> pre_chain;  // level0_height's 2:1 steps before level 0
     bool boxes_first = false;          // the first step runs prefilter_boxes (smooth_boxes_apply())
     std::vector<detail::OwnedImage> pre_levels;
-    std::vector<VkDescriptorSet> pre_sets;  // pre_levels[k] -> pre_levels[k + 1] or level 0
     std::vector<detail::OwnedImage> levels;
     std::vector<detail::OwnedImage> temps;  // gauss9 horizontal pass, one per level
-    detail::DescriptorArena internal_sets;
-    std::vector<VkDescriptorSet> down_sets, blur_h_sets, blur_v_sets, up_sets;
-    std::map<std::pair<VkImageView, VkImageView>, CallerSets> caller_sets;  // they name this pyramid's levels
-    detail::DescriptorArena caller_arena;                                   // grows by pools of 24 sets
   };
   detail::SizeCache<Pyramid> cache;
   Pyramid* cur = nullptr;   // the pyramid of the last prepare() or record()
@@ -282,13 +268,11 @@ struct Bloom::Impl {
   std::unique_ptr<Pyramid> make_pyramid(VkExtent2D size) const {
     auto made = std::make_unique<Pyramid>();
     Pyramid& P = *made;
-    P.caller_arena = detail::DescriptorArena(*context, 24);
     std::vector<LevelSize>& chain = P.chain;
     std::vector<LevelSize>& pre_chain = P.pre_chain;
     std::vector<detail::OwnedImage>& pre_levels = P.pre_levels;
     std::vector<detail::OwnedImage>& levels = P.levels;
     std::vector<detail::OwnedImage>& temps = P.temps;
-    detail::DescriptorArena& internal_sets = P.internal_sets;
     chain = bloom_mip_chain(size, config.iterations, config.level0_height);
     pre_chain = bloom_pre_levels(size, config.level0_height);
     P.was_clamped = chain.size() < config.iterations;
@@ -301,47 +285,8 @@ struct Bloom::Impl {
       levels.emplace_back(*context, VkExtent2D{l.width, l.height}, level_format(), usage);
       if (gauss) temps.emplace_back(*context, VkExtent2D{l.width, l.height}, level_format(), usage);
     }
-    const uint32_t n = static_cast<uint32_t>(chain.size());
-    const auto m = static_cast<uint32_t>(pre_chain.size());
-    internal_sets = detail::DescriptorArena(*context, 4 * n + m + 1);
-    const VkImageLayout G = VK_IMAGE_LAYOUT_GENERAL;  // pyramid images stay in GENERAL
-    for (uint32_t k = 0; k < m; ++k) {
-      const VkImageView next = k + 1 < m ? pre_levels[k + 1].state.view : levels[0].state.view;
-      P.pre_sets.push_back(internal_sets.make_set(down, {{pre_levels[k].state.view, G}, {next, G}}));
-    }
-    for (uint32_t k = 1; k < n; ++k) {
-      P.down_sets.push_back(internal_sets.make_set(down, {{levels[k - 1].state.view, G}, {levels[k].state.view, G}}));
-    }
-    for (uint32_t k = 0; gauss && k < n; ++k) {
-      P.blur_h_sets.push_back(internal_sets.make_set(blur, {{levels[k].state.view, G}, {temps[k].state.view, G}}));
-      P.blur_v_sets.push_back(internal_sets.make_set(blur, {{temps[k].state.view, G}, {levels[k].state.view, G}}));
-    }
-    for (uint32_t k = 0; k + 1 < n; ++k) {
-      P.up_sets.push_back(internal_sets.make_set(up, {{levels[k + 1].state.view, G}, {levels[k].state.view, G}}));
-    }
     P.extent = size;
     return made;
-  }
-
-  const CallerSets& sets_for(Pyramid& P, const Image& in, const Image& out, const char* out_variant) {
-    auto key = std::make_pair(in.view, out.view);
-    auto it = P.caller_sets.find(key);
-    if (it != P.caller_sets.end()) return it->second;
-    auto& arena = P.caller_arena;
-    const auto& pre_levels = P.pre_levels;
-    const auto& levels = P.levels;
-    const bool in_place = same_subresource(in, out);
-    const VkImageLayout in_layout = in_place ? VK_IMAGE_LAYOUT_GENERAL : VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
-    const VkImageLayout G = VK_IMAGE_LAYOUT_GENERAL;
-    const auto [composite_pipeline, copy_pipeline] = output_pipelines(out_variant);
-    CallerSets s;
-    const VkImageView first = pre_levels.empty() ? levels[0].state.view : pre_levels[0].state.view;
-    s.prefilter = arena.make_set(P.boxes_first ? prefilter_boxes : prefilter_down, {{in.view, in_layout}, {first, G}});
-    s.composite = arena.make_set(*composite_pipeline, {{in.view, in_layout}, {levels[0].state.view, G}, {out.view, G}});
-    s.copy = arena.make_set(*copy_pipeline, {{in.view, in_layout}, {out.view, G}});
-    s.composite_pipeline = composite_pipeline;
-    s.copy_pipeline = copy_pipeline;
-    return P.caller_sets.emplace(key, s).first->second;
   }
 
   BloomPush push(const Pyramid& P, LevelSize src, LevelSize dst, uint32_t flags = 0) const {
@@ -410,19 +355,21 @@ void Bloom::Impl::record(VkCommandBuffer cmd, Image& input, Image& output, Profi
     // Nothing to add: the output is the input. In place that is no work at all.
     if (in_place) return;
     Pyramid& P = pyramid_for(input.extent, "Bloom::record");
-    const CallerSets& s = sets_for(P, input, output, out_variant);
+    const detail::ComputePipeline* copy_pipeline = output_pipelines(out_variant).second;
     cache.recorded(&P, cmd);
     detail::Barriers b;
     b.use(input, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, kSampled);
     b.use(output, VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, kStorageWrite);
     b.flush(cmd);
     const LevelSize full{input.extent.width, input.extent.height};
-    s.copy_pipeline->dispatch(cmd, s.copy, push(P, full, full), full.width, full.height);
+    copy_pipeline->dispatch(
+        cmd, {{input.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL}, {output.view, VK_IMAGE_LAYOUT_GENERAL}},
+        push(P, full, full), full.width, full.height);
     if (profiler) profiler->mark(cmd, "bloom copy (intensity 0)");
     return;
   }
   Pyramid& P = pyramid_for(input.extent, "Bloom::record");
-  const CallerSets& sets = sets_for(P, input, output, out_variant);
+  const detail::ComputePipeline* composite_pipeline = output_pipelines(out_variant).first;
   cache.recorded(&P, cmd);
   const std::vector<LevelSize>& chain = P.chain;
   const std::vector<LevelSize>& pre_chain = P.pre_chain;
@@ -443,12 +390,13 @@ void Bloom::Impl::record(VkCommandBuffer cmd, Image& input, Image& output, Profi
     b.use(levels[k].state, G, kCompute, kSampled);
     b.use(temps[k].state, G, kCompute, kStorageWrite);
     b.flush(cmd);
-    blur.dispatch(cmd, P.blur_h_sets[k], push(P, chain[k], chain[k]), chain[k].width, chain[k].height);
+    blur.dispatch(cmd, {{levels[k].state.view, G}, {temps[k].state.view, G}}, push(P, chain[k], chain[k]),
+                  chain[k].width, chain[k].height);
     b.use(temps[k].state, G, kCompute, kSampled);
     b.use(levels[k].state, G, kCompute, kStorageWrite);
     b.flush(cmd);
-    blur.dispatch(cmd, P.blur_v_sets[k], push(P, chain[k], chain[k], GLINT_BLOOM_FLAG_VERTICAL), chain[k].width,
-                  chain[k].height);
+    blur.dispatch(cmd, {{temps[k].state.view, G}, {levels[k].state.view, G}},
+                  push(P, chain[k], chain[k], GLINT_BLOOM_FLAG_VERTICAL), chain[k].width, chain[k].height);
   };
 
   // 1. Bright-pass fused into the first downsample; with level0_height, 2:1 steps to level 0.
@@ -459,12 +407,14 @@ void Bloom::Impl::record(VkCommandBuffer cmd, Image& input, Image& output, Profi
   b.use(scene, scene_layout, kCompute, kSampled);
   b.use(first, G, kCompute, kStorageWrite);
   b.flush(cmd);
+  const detail::Bindings prefilter_bindings{{input.view, scene_layout}, {first.view, G}};
   if (P.boxes_first) {
     // A workgroup of W x H invocations writes W x 2H texels (two rows per invocation).
-    prefilter_boxes.dispatch(cmd, sets.prefilter, push(P, full, first_size), first_size.width,
+    prefilter_boxes.dispatch(cmd, prefilter_bindings, push(P, full, first_size), first_size.width,
                              (first_size.height + 1) / 2);
   } else {
-    prefilter_down.dispatch(cmd, sets.prefilter, push(P, full, first_size, karis), first_size.width, first_size.height);
+    prefilter_down.dispatch(cmd, prefilter_bindings, push(P, full, first_size, karis), first_size.width,
+                            first_size.height);
   }
   for (uint32_t k = 0; k < m; ++k) {
     Image& next = k + 1 < m ? pre_levels[k + 1].state : levels[0].state;
@@ -472,7 +422,8 @@ void Bloom::Impl::record(VkCommandBuffer cmd, Image& input, Image& output, Profi
     b.use(pre_levels[k].state, G, kCompute, kSampled);
     b.use(next, G, kCompute, kStorageWrite);
     b.flush(cmd);
-    down.dispatch(cmd, P.pre_sets[k], push(P, pre_chain[k], next_size), next_size.width, next_size.height);
+    down.dispatch(cmd, {{pre_levels[k].state.view, G}, {next.view, G}}, push(P, pre_chain[k], next_size),
+                  next_size.width, next_size.height);
   }
   if (gauss) blur_level(0);
   if (profiler) profiler->mark(cmd, "bloom bright-pass + down 0");
@@ -482,7 +433,8 @@ void Bloom::Impl::record(VkCommandBuffer cmd, Image& input, Image& output, Profi
     b.use(levels[k - 1].state, G, kCompute, kSampled);
     b.use(levels[k].state, G, kCompute, kStorageWrite);
     b.flush(cmd);
-    down.dispatch(cmd, P.down_sets[k - 1], push(P, chain[k - 1], chain[k]), chain[k].width, chain[k].height);
+    down.dispatch(cmd, {{levels[k - 1].state.view, G}, {levels[k].state.view, G}}, push(P, chain[k - 1], chain[k]),
+                  chain[k].width, chain[k].height);
     if (gauss) blur_level(k);
   }
   if (profiler && n > 1) profiler->mark(cmd, "bloom downsample");
@@ -492,7 +444,8 @@ void Bloom::Impl::record(VkCommandBuffer cmd, Image& input, Image& output, Profi
     b.use(levels[k + 1].state, G, kCompute, kSampled);
     b.use(levels[k].state, G, kCompute, kStorageRead | kStorageWrite);
     b.flush(cmd);
-    up.dispatch(cmd, P.up_sets[k], push(P, chain[k + 1], chain[k]), chain[k].width, chain[k].height);
+    up.dispatch(cmd, {{levels[k + 1].state.view, G}, {levels[k].state.view, G}}, push(P, chain[k + 1], chain[k]),
+                chain[k].width, chain[k].height);
   }
   if (profiler && n > 1) profiler->mark(cmd, "bloom upsample");
 
@@ -501,7 +454,8 @@ void Bloom::Impl::record(VkCommandBuffer cmd, Image& input, Image& output, Profi
   b.use(scene, scene_layout, kCompute, kSampled);
   b.use(output, G, kCompute, in_place ? (kSampled | kStorageWrite) : kStorageWrite);
   b.flush(cmd);
-  sets.composite_pipeline->dispatch(cmd, sets.composite, push(P, chain[0], full), full.width, full.height);
+  composite_pipeline->dispatch(cmd, {{input.view, scene_layout}, {levels[0].state.view, G}, {output.view, G}},
+                               push(P, chain[0], full), full.width, full.height);
   if (profiler) profiler->mark(cmd, "bloom composite");
   if (in_place) input = output;
 }
@@ -530,7 +484,6 @@ void Bloom::set_config(const BloomConfig& config) {
       old.iterations != config.iterations || old.level0_height != config.level0_height || pipelines_changed;
   if (!shape_changed) return;
   // Pyramids of the old shape stay cached, never found again, until no submitted work uses them.
-  // Their descriptor sets name set layouts of compiled kernels, which live as long as the context.
   ++impl_->generation;
   if (pipelines_changed) impl_->make_pipelines();
   if (impl_->cur) impl_->pyramid_for(impl_->cur->extent, "Bloom::set_config");
@@ -552,13 +505,6 @@ void Bloom::record(VkCommandBuffer cmd, Image& input, Image& output, Profiler* p
   detail::check_image_layout("Bloom::record", "input", input);
   detail::check_image_layout("Bloom::record", "output", output);
   impl_->record(cmd, input, output, profiler);
-}
-
-void Bloom::forget_caller_resources() {
-  impl_->cache.for_each([](Impl::Pyramid& p) {
-    p.caller_sets.clear();
-    p.caller_arena.reset();
-  });
 }
 
 void Bloom::release_unused() { impl_->cache.release_unused(impl_->cur); }

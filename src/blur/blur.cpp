@@ -1,6 +1,6 @@
 // Blur drivers (docs/BLUR.md): BlurPyramid (three cumulative levels) and GaussianBlur. Both are a list of
-// steps planned once per size (pipeline, descriptor set, push constants, image in, image out)
-// that record() walks, writing the barriers between them.
+// steps planned once per size (pipeline, push constants, image in, image out)
+// that record() walks, writing the barriers between them and pushing each step's descriptors.
 #include <glint/blur.h>
 
 #include <algorithm>
@@ -217,7 +217,6 @@ struct Step {
   uint32_t invocations_y = 0;
   bool sampler = false;                       // binding 0 is a combined image sampler
   const detail::OwnedBuffer* taps = nullptr;  // binding 2
-  VkDescriptorSet set = VK_NULL_HANDLE;       // when neither src nor dst is a caller image
   std::string label;
 };
 
@@ -225,7 +224,7 @@ struct Step {
 // steps' pointers stay valid while the effect lives).
 using PipelineMap = std::map<std::string, detail::ComputePipeline>;
 
-// The program of one size: owned images, steps, and the descriptor sets.
+// The program of one size: owned images and steps. Each step pushes its descriptors when recorded.
 struct StepProgram {
   const Context* context = nullptr;
   PipelineMap* pipelines = nullptr;
@@ -233,14 +232,6 @@ struct StepProgram {
   std::vector<detail::OwnedBuffer> tap_buffers;
   std::vector<Step> steps;
   VkSampler sampler = VK_NULL_HANDLE;  // bilinear, for the linear-sampling variant (owned by the context)
-  detail::DescriptorArena internal_sets;
-  std::map<std::pair<VkImageView, VkImageView>, std::vector<VkDescriptorSet>> caller_sets;
-  detail::DescriptorArena caller_arena;  // made with the internal sets; grows by pools of 8 sets
-
-  void forget_caller_sets() {
-    caller_sets.clear();
-    caller_arena.reset();
-  }
 
   const detail::ComputePipeline& pipeline(const std::string& kernel, VkFormat dst_format, detail::Workgroup2D wg,
                                           std::vector<uint32_t> spec, std::vector<VkDescriptorType> bindings) {
@@ -271,48 +262,21 @@ struct StepProgram {
     return &tap_buffers.back();
   }
 
-  std::vector<detail::DescriptorArena::AnyBinding> bindings_of(const Step& s, VkImageView in, VkImageView out) const {
-    VkImageView src = s.src == kInput ? in : images[s.src].state.view;
-    VkImageView dst = s.dst == kOutput ? out : images[s.dst].state.view;
-    std::vector<detail::DescriptorArena::AnyBinding> b(2);
-    b[0].image = {src, s.src == kInput ? kReadOnly : kGeneral};
-    b[0].sampler = s.sampler ? sampler : VK_NULL_HANDLE;
-    b[1].image = {dst, kGeneral};
+  // The descriptors of step `s`: source (with the bilinear sampler for the linear-sampling
+  // variant), destination, and the tap weights when the step has them.
+  detail::Bindings bindings_of(const Step& s, const Image& src, const Image& dst) const {
+    detail::Bindings b{{src.view, s.src == kInput ? kReadOnly : kGeneral, s.sampler ? sampler : VK_NULL_HANDLE},
+                       {dst.view, kGeneral}};
     if (s.taps) {
-      b.emplace_back();
-      b[2].buffer.buffer = s.taps->buffer();
-      b[2].buffer.size = s.taps->size();
+      Buffer taps;
+      taps.buffer = s.taps->buffer();
+      taps.size = s.taps->size();
+      b.push_back(taps);
     }
     return b;
   }
 
-  // After the steps of a size are planned: descriptor sets for the steps between owned images.
-  void make_internal_sets() {
-    uint32_t n = 0;
-    for (const Step& s : steps) n += (s.src >= 0 && s.dst >= 0);
-    internal_sets = detail::DescriptorArena(*context, std::max(1u, n));
-    caller_arena = detail::DescriptorArena(*context, 8);
-    for (Step& s : steps) {
-      if (s.src >= 0 && s.dst >= 0)
-        s.set = internal_sets.make_mixed_set(*s.pipeline, bindings_of(s, VK_NULL_HANDLE, VK_NULL_HANDLE));
-    }
-  }
-
-  // Sets for the steps that name caller images, once per (input view, output view).
-  const std::vector<VkDescriptorSet>& sets_for(VkImageView in, VkImageView out) {
-    auto key = std::make_pair(in, out);
-    auto it = caller_sets.find(key);
-    if (it != caller_sets.end()) return it->second;
-    std::vector<VkDescriptorSet> sets(steps.size(), VK_NULL_HANDLE);
-    for (size_t i = 0; i < steps.size(); ++i) {
-      const Step& s = steps[i];
-      sets[i] = (s.src < 0 || s.dst < 0) ? caller_arena.make_mixed_set(*s.pipeline, bindings_of(s, in, out)) : s.set;
-    }
-    return caller_sets.emplace(key, std::move(sets)).first->second;
-  }
-
   void record(VkCommandBuffer cmd, Image& input, Image* output, Profiler* profiler) {
-    const std::vector<VkDescriptorSet>& sets = sets_for(input.view, output ? output->view : VK_NULL_HANDLE);
     detail::Barriers b;
     for (size_t i = 0; i < steps.size(); ++i) {
       const Step& s = steps[i];
@@ -321,7 +285,7 @@ struct StepProgram {
       b.use(src, s.src == kInput ? kReadOnly : kGeneral, kCompute, kSampled);
       b.use(dst, kGeneral, kCompute, kStorageWrite);
       b.flush(cmd);
-      s.pipeline->dispatch(cmd, sets[i], s.push, s.invocations_x, s.invocations_y);
+      s.pipeline->dispatch(cmd, bindings_of(s, src, dst), s.push, s.invocations_x, s.invocations_y);
       if (profiler) profiler->mark(cmd, s.label);
     }
   }
@@ -464,7 +428,6 @@ struct BlurPyramid::Impl {
                                       concat("blur pyramid level ", k + 1)));
       prev = sizes[k];
     }
-    prog.make_internal_sets();
     return made;
   }
 };
@@ -517,10 +480,6 @@ const Image& BlurPyramid::level(uint32_t k) const {
 }
 
 Image& BlurPyramid::level(uint32_t k) { return const_cast<Image&>(std::as_const(*this).level(k)); }
-
-void BlurPyramid::forget_caller_resources() {
-  impl_->cache.for_each([](Impl::Size& s) { s.prog.forget_caller_sets(); });
-}
 
 void BlurPyramid::release_unused() { impl_->cache.release_unused(impl_->cur); }
 uint32_t BlurPyramid::cached_sizes() const { return impl_->cache.size(); }
@@ -753,7 +712,6 @@ struct GaussianBlur::Impl {
       }
     }
     choice.dispatches = static_cast<uint32_t>(prog.steps.size());
-    prog.make_internal_sets();
     return made;
   }
 };
@@ -805,10 +763,6 @@ void GaussianBlur::record(VkCommandBuffer cmd, Image& input, Image& output, Prof
   if (size.choice.linear_sampling) detail::check_color_read(ctx, input.format, "GaussianBlur::record", "input", true);
   impl_->cache.recorded(&size, cmd);
   size.prog.record(cmd, input, &output, profiler);
-}
-
-void GaussianBlur::forget_caller_resources() {
-  impl_->cache.for_each([](Impl::Size& s) { s.prog.forget_caller_sets(); });
 }
 
 void GaussianBlur::release_unused() { impl_->cache.release_unused(impl_->cur); }

@@ -53,36 +53,12 @@ Compaction::Compaction(const Context& context, const Desc& desc) {
   groups_state_.buffer = groups_.buffer();
   groups_state_.size = groups_.size();
   groups_state_.usage = usage;
-  // At most 5 storage buffers in a set (the light cull's scatter); pools of 16 sets.
-  arena_ = DescriptorArena(context, 16, 8);
-  tiles_set_ = arena_.make_buffer_set(scan_tiles_, {groups_state_});
 }
 
 void Compaction::grid(uint32_t count, uint32_t& gx, uint32_t& gy) const {
   const uint32_t g = std::max(1u, (count + kGroup - 1) / kGroup);
   gx = std::min(g, max_groups_x_);
   gy = (g + gx - 1) / gx;
-}
-
-VkDescriptorSet Compaction::set_for(uint32_t which, const ComputePipeline& p, const Buffer* const* buffers,
-                                    size_t count) {
-  if (count > kMaxBuffers) {
-    throw Error(ErrorCode::invalid_argument, concat("Compaction: ", count, " buffers; at most ", kMaxBuffers));
-  }
-  SetKey key{};
-  key[0] = which;
-  for (size_t i = 0; i < count; ++i) {
-    key[1 + 3 * i] = reinterpret_cast<uint64_t>(buffers[i]->buffer);
-    key[2 + 3 * i] = buffers[i]->offset;
-    key[3 + 3 * i] = buffers[i]->size;
-  }
-  auto it = sets_.find(key);
-  if (it == sets_.end()) {
-    std::vector<Buffer> bound{groups_state_};
-    for (size_t i = 0; i < count; ++i) bound.push_back(*buffers[i]);
-    it = sets_.emplace(key, arena_.make_buffer_set(p, bound)).first;
-  }
-  return it->second;
 }
 
 void Compaction::record_clear_once(VkCommandBuffer cmd, Barriers& b) {
@@ -96,14 +72,17 @@ void Compaction::record_clear_once(VkCommandBuffer cmd, Barriers& b) {
 
 void Compaction::record_scan(VkCommandBuffer cmd, Barriers& b, GlintCompactPush push,
                              std::initializer_list<Buffer*> outputs) {
-  const VkDescriptorSet top = set_for(0, scan_, outputs.begin(), outputs.size());
+  // The top-level scan's descriptors: the group buffer, then the user's outputs.
+  Bindings top{groups_state_};
+  for (Buffer* o : outputs) top.push_back(*o);
   push.tile_groups = scan_threads_;
   // 1. Tiles of scan_threads groups in parallel: slots within each tile, tile totals.
   const uint32_t group_count = (push.count + kGroup - 1) / kGroup;
   if (group_count > 0) {
     b.use(groups_state_, kCompute, kRead | kWrite);
     b.flush(cmd);
-    scan_tiles_.dispatch(cmd, tiles_set_, push, (group_count + scan_threads_ - 1) / scan_threads_ * scan_threads_, 1);
+    scan_tiles_.dispatch(cmd, {groups_state_}, push, (group_count + scan_threads_ - 1) / scan_threads_ * scan_threads_,
+                         1);
   }
   // 2. One workgroup: the tiles' first slots, then the user's outputs.
   b.use(groups_state_, kCompute, kRead | kWrite);
@@ -115,15 +94,10 @@ void Compaction::record_scan(VkCommandBuffer cmd, Barriers& b, GlintCompactPush 
 void Compaction::record_scatter(VkCommandBuffer cmd, Barriers& b, GlintCompactPush push,
                                 std::initializer_list<Buffer*> inputs, std::initializer_list<Buffer*> outputs) {
   if (push.count == 0) return;
-  std::array<const Buffer*, kMaxBuffers> all{};
-  size_t n = 0;
-  for (const auto* list : {&inputs, &outputs}) {
-    for (Buffer* x : *list) {
-      if (n == kMaxBuffers) throw Error(ErrorCode::invalid_argument, "Compaction: too many scatter buffers");
-      all[n++] = x;
-    }
-  }
-  const VkDescriptorSet set = set_for(1, scatter_, all.data(), n);
+  // The scatter's descriptors: the group buffer, the user's inputs, then its outputs.
+  Bindings set{groups_state_};
+  for (Buffer* in : inputs) set.push_back(*in);
+  for (Buffer* o : outputs) set.push_back(*o);
   uint32_t gx, gy;
   grid(push.count, gx, gy);
   push.tile_groups = scan_threads_;
@@ -133,12 +107,6 @@ void Compaction::record_scatter(VkCommandBuffer cmd, Barriers& b, GlintCompactPu
   for (Buffer* o : outputs) b.use(*o, kCompute, kWrite);
   b.flush(cmd);
   scatter_.dispatch(cmd, set, push, gx * kGroup, gy);
-}
-
-void Compaction::forget_caller_resources() {
-  sets_.clear();
-  arena_.reset();
-  tiles_set_ = arena_.make_buffer_set(scan_tiles_, {groups_state_});
 }
 
 }  // namespace glint::detail

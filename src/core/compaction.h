@@ -12,7 +12,6 @@
 #include <array>
 #include <cstdint>
 #include <initializer_list>
-#include <map>
 #include <string>
 
 #include "core/barriers.h"
@@ -60,25 +59,15 @@ class Compaction {
   /// push.groups_x.
   void record_scatter(VkCommandBuffer cmd, Barriers& b, GlintCompactPush push, std::initializer_list<Buffer*> inputs,
                       std::initializer_list<Buffer*> outputs);
-  /// Drops the descriptor sets of caller buffers.
-  void forget_caller_resources();
 
  private:
-  static constexpr size_t kMaxBuffers = 6;  // user buffers of one set (after the group buffer)
-  // Sets by pipeline (0: the top-level scan, 1: the scatter) and the (buffer, offset, size) of
-  // each binding after the group buffer: a fixed-size key, so a frame allocates nothing.
-  using SetKey = std::array<uint64_t, 1 + 3 * kMaxBuffers>;
-  VkDescriptorSet set_for(uint32_t which, const ComputePipeline& p, const Buffer* const* buffers, size_t count);
-
+  static constexpr size_t kMaxBuffers = 6;  // user buffers of one kernel (after the group buffer)
   uint32_t max_groups_x_ = 65535;
   uint32_t scan_threads_ = 1;
   ComputePipeline scan_tiles_, scan_, scatter_;
   OwnedBuffer groups_;
   Buffer groups_state_;
   bool counters_cleared_ = false;
-  VkDescriptorSet tiles_set_ = VK_NULL_HANDLE;
-  std::map<SetKey, VkDescriptorSet> sets_;
-  DescriptorArena arena_;
 };
 
 }  // namespace glint::detail

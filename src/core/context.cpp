@@ -246,7 +246,9 @@ uint32_t compute_queue_family(VkPhysicalDevice pd) {
 }
 
 void fill_info(ContextState& s) {
+  VkPhysicalDevicePushDescriptorPropertiesKHR push{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PUSH_DESCRIPTOR_PROPERTIES_KHR};
   VkPhysicalDeviceSubgroupProperties subgroup{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES};
+  subgroup.pNext = &push;  // filled only if the device has the extension (checked below)
   VkPhysicalDeviceProperties2 props{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
   props.pNext = &subgroup;
   vkGetPhysicalDeviceProperties2(s.physical_device, &props);
@@ -272,6 +274,19 @@ void fill_info(ContextState& s) {
   vkEnumerateDeviceExtensionProperties(s.physical_device, nullptr, &extension_count, extensions.data());
   for (const VkExtensionProperties& e : extensions) {
     if (std::strcmp(e.extensionName, VK_EXT_MEMORY_BUDGET_EXTENSION_NAME) == 0) s.memory_budget = true;
+    if (std::strcmp(e.extensionName, VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME) == 0) s.push_descriptor_supported = true;
+  }
+  s.max_push_descriptors = s.push_descriptor_supported ? push.maxPushDescriptors : 0;
+}
+
+// Loads vkCmdPushDescriptorSetKHR from the device, which has VK_KHR_push_descriptor enabled.
+void load_push_descriptor(ContextState& s) {
+  s.cmd_push_descriptor_set =
+      reinterpret_cast<PFN_vkCmdPushDescriptorSetKHR>(vkGetDeviceProcAddr(s.device, "vkCmdPushDescriptorSetKHR"));
+  if (!s.cmd_push_descriptor_set) {
+    throw Error(ErrorCode::no_device, concat("device '", s.info.name,
+                                             "' gives no vkCmdPushDescriptorSetKHR although VK_KHR_push_descriptor "
+                                             "is enabled"));
   }
 }
 
@@ -415,6 +430,14 @@ Context Context::create(const ContextOptions& options) {
     }
   }
 
+  detail::fill_info(s);
+  if (!s.push_descriptor_supported) {
+    throw Error(ErrorCode::no_device,
+                concat("device '", props.deviceName, "' does not support ", VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME,
+                       ", which glint needs (every kernel's descriptors are pushed)"));
+  }
+  const char* device_extensions[] = {VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME};
+
   VkPhysicalDeviceVulkan13Features e13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
   e13.synchronization2 = VK_TRUE;
   e13.dynamicRendering = f13.dynamicRendering;  // a Vulkan 1.3 requirement; LensFlare draws with it
@@ -440,7 +463,10 @@ Context Context::create(const ContextOptions& options) {
   info.pNext = &enabled;
   info.queueCreateInfoCount = 1;
   info.pQueueCreateInfos = &queue;
+  info.enabledExtensionCount = 1;
+  info.ppEnabledExtensionNames = device_extensions;
   vk_check(vkCreateDevice(s.physical_device, &info, nullptr, &s.device), "vkCreateDevice");
+  detail::load_push_descriptor(s);
   vkGetDeviceQueue(s.device, s.queue_family, 0, &s.queue);
 
   VkCommandPoolCreateInfo pool{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
@@ -449,7 +475,6 @@ Context Context::create(const ContextOptions& options) {
   vk_check(vkCreateCommandPool(s.device, &pool, nullptr, &s.command_pool), "vkCreateCommandPool");
   VkFenceCreateInfo fence{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
   vk_check(vkCreateFence(s.device, &fence, nullptr, &s.fence), "vkCreateFence");
-  detail::fill_info(s);
   s.dynamic_rendering = f13.dynamicRendering == VK_TRUE;
   const VkExtent2D wg = options.workgroup_2d;
   if (wg.width != 0 || wg.height != 0) {
@@ -515,6 +540,24 @@ Context Context::adopt(const AdoptInfo& a) {
     throw Error(code, concat("VkPhysicalDeviceVulkan13Features::maintenance4", source,
                              "; glint's kernels take their workgroup size from specialization (LocalSizeId)"));
   }
+  // Vulkan cannot be asked which extensions a device was created with: the engine says.
+  if (a.enabled_extension_count != 0 && !a.enabled_extensions) {
+    throw Error(ErrorCode::invalid_argument,
+                concat("AdoptInfo::enabled_extension_count = ", a.enabled_extension_count,
+                       " with a null AdoptInfo::enabled_extensions: give the list or a count of 0"));
+  }
+  bool push_descriptor = false;
+  for (uint32_t i = 0; i < a.enabled_extension_count; ++i) {
+    const char* name = a.enabled_extensions[i];
+    if (name && std::strcmp(name, VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME) == 0) push_descriptor = true;
+  }
+  if (!push_descriptor) {
+    throw Error(ErrorCode::invalid_argument,
+                concat(VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME, " is not in AdoptInfo::enabled_extensions (",
+                       a.enabled_extension_count,
+                       " names given); glint pushes every kernel's descriptors with vkCmdPushDescriptorSetKHR, so "
+                       "the device must be created with it (VkDeviceCreateInfo::ppEnabledExtensionNames)"));
+  }
   auto state = std::make_unique<detail::ContextState>();
   state->instance = a.instance;
   state->physical_device = a.physical_device;
@@ -523,6 +566,12 @@ Context Context::adopt(const AdoptInfo& a) {
   state->adopted = true;
   state->frames_in_flight = a.frames_in_flight;
   detail::fill_info(*state);
+  if (!state->push_descriptor_supported) {
+    throw Error(ErrorCode::invalid_argument,
+                concat("AdoptInfo::enabled_extensions names ", VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME,
+                       " but physical device '", state->info.name, "' does not support it"));
+  }
+  detail::load_push_descriptor(*state);
   state->dynamic_rendering = features.dynamic_rendering;
   return Context(std::move(state));
 }

@@ -34,6 +34,12 @@ struct ContextState {
   // Whether the physical device supports VK_EXT_memory_budget (a physical-device query, usable
   // whether or not the engine enabled the extension on its device).
   bool memory_budget = false;
+  // VK_KHR_push_descriptor: every kernel's descriptors are pushed with the dispatch
+  // (core/pipeline.h). The physical device's support and maxPushDescriptors (fill_info()), and the
+  // command, loaded with vkGetDeviceProcAddr once the device is known to have it enabled.
+  bool push_descriptor_supported = false;
+  uint32_t max_push_descriptors = 0;
+  PFN_vkCmdPushDescriptorSetKHR cmd_push_descriptor_set = nullptr;
 
   // Standalone helpers for run_once(). The pool, the fence and the queue need external
   // synchronization (Vulkan, "Threading Behavior"): run_once() holds submit_mutex from allocating

@@ -1,6 +1,7 @@
 #include "core/pipeline.h"
 
 #include <algorithm>
+#include <array>
 #include <cstdio>
 #include <cstdlib>
 #include <memory>
@@ -36,15 +37,12 @@ CompiledPipeline::~CompiledPipeline() {
 
 namespace {
 
-std::shared_ptr<CompiledPipeline> compile(ContextState& s, const PipelineDesc& desc, const KernelBinary& bin) {
+std::shared_ptr<CompiledPipeline> compile(const Context& context, const PipelineDesc& desc, const KernelBinary& bin) {
+  ContextState& s = context.state();
   auto c = std::make_shared<CompiledPipeline>();  // destroys whatever was made if a step throws
   c->device = s.device;
-  std::vector<VkDescriptorSetLayoutBinding> b(desc.bindings.size());
-  for (uint32_t i = 0; i < b.size(); ++i) b[i] = {i, desc.bindings[i], 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
-  VkDescriptorSetLayoutCreateInfo sl{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
-  sl.bindingCount = static_cast<uint32_t>(b.size());
-  sl.pBindings = b.data();
-  vk_check(vkCreateDescriptorSetLayout(s.device, &sl, nullptr, &c->set_layout), "vkCreateDescriptorSetLayout");
+  c->push_descriptor_set = s.cmd_push_descriptor_set;
+  c->set_layout = make_push_set_layout(context, desc.bindings, VK_SHADER_STAGE_COMPUTE_BIT);
   s.count_object();
 
   VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, desc.push_constant_bytes};
@@ -84,6 +82,66 @@ std::shared_ptr<CompiledPipeline> compile(ContextState& s, const PipelineDesc& d
 
 }  // namespace
 
+VkDescriptorSetLayout make_push_set_layout(const Context& context, const std::vector<VkDescriptorType>& types,
+                                           VkShaderStageFlags stages) {
+  const ContextState& s = context.state();
+  const uint32_t limit = std::min(kMaxBindings, s.max_push_descriptors);
+  if (types.size() > limit) {
+    throw Error(ErrorCode::no_device,
+                concat("a kernel pushes ", types.size(), " descriptors; device '", s.info.name, "' allows ",
+                       s.max_push_descriptors, " (VkPhysicalDevicePushDescriptorPropertiesKHR::maxPushDescriptors)"));
+  }
+  std::array<VkDescriptorSetLayoutBinding, kMaxBindings> b{};
+  for (uint32_t i = 0; i < types.size(); ++i) b[i] = {i, types[i], 1, stages, nullptr};
+  VkDescriptorSetLayoutCreateInfo sl{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
+  sl.flags = VK_DESCRIPTOR_SET_LAYOUT_CREATE_PUSH_DESCRIPTOR_BIT_KHR;
+  sl.bindingCount = static_cast<uint32_t>(types.size());
+  sl.pBindings = b.data();
+  VkDescriptorSetLayout layout = VK_NULL_HANDLE;
+  vk_check(vkCreateDescriptorSetLayout(s.device, &sl, nullptr, &layout), "vkCreateDescriptorSetLayout");
+  return layout;
+}
+
+void push_descriptors(PFN_vkCmdPushDescriptorSetKHR push, VkCommandBuffer cmd, VkPipelineBindPoint bind_point,
+                      VkPipelineLayout layout, const std::vector<VkDescriptorType>& types, const Bindings& bindings,
+                      const std::string& who) {
+  const uint32_t n = bindings.size();
+  if (n != types.size()) {
+    throw Error(ErrorCode::invalid_argument,
+                concat("internal: ", who, " has ", types.size(), " bindings; ", n, " descriptors were given"));
+  }
+  // Everything lives on this stack frame until vkCmdPushDescriptorSetKHR has copied it (the
+  // command records the descriptors themselves, Vulkan spec "Push Descriptor Updates").
+  std::array<VkWriteDescriptorSet, kMaxBindings> writes;
+  std::array<VkDescriptorImageInfo, kMaxBindings> images;
+  std::array<VkDescriptorBufferInfo, kMaxBindings> buffers;
+  for (uint32_t i = 0; i < n; ++i) {
+    const Binding& b = bindings[i];
+    VkWriteDescriptorSet& w = writes[i];
+    w = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+    w.dstBinding = i;
+    w.descriptorCount = 1;
+    w.descriptorType = types[i];
+    if (types[i] == VK_DESCRIPTOR_TYPE_STORAGE_BUFFER || types[i] == VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER) {
+      if (!b.buffer.buffer || b.buffer.size == 0) {
+        throw Error(ErrorCode::invalid_argument,
+                    concat("internal: ", who, " binding ", i, " needs a buffer and a size"));
+      }
+      buffers[i] = {b.buffer.buffer, b.buffer.offset, b.buffer.size};
+      w.pBufferInfo = &buffers[i];
+    } else {
+      const bool sampler = types[i] == VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
+      if (!b.view || (sampler && !b.sampler)) {
+        throw Error(ErrorCode::invalid_argument, concat("internal: ", who, " binding ", i,
+                                                        sampler ? " needs a view and a sampler" : " needs a view"));
+      }
+      images[i] = {b.sampler, b.view, b.layout};
+      w.pImageInfo = &images[i];
+    }
+  }
+  push(cmd, bind_point, layout, 0, n, writes.data());
+}
+
 ComputePipeline::ComputePipeline(const Context& context, const PipelineDesc& desc) {
   id_ = desc.kernel_id;
   push_bytes_ = desc.push_constant_bytes;
@@ -101,7 +159,7 @@ ComputePipeline::ComputePipeline(const Context& context, const PipelineDesc& des
   auto& s = context.state();
   std::lock_guard<std::mutex> lock(s.pipeline_mutex);
   auto& slot = s.pipelines[key];
-  if (!slot) slot = compile(s, desc, *bin);
+  if (!slot) slot = compile(context, desc, *bin);
   compiled_ = static_cast<const CompiledPipeline*>(slot.get());
 }
 
@@ -116,118 +174,23 @@ ComputePipeline& ComputePipeline::operator=(ComputePipeline&& o) noexcept {
   return *this;
 }
 
-void ComputePipeline::bind_and_push(VkCommandBuffer cmd, VkDescriptorSet set, const void* push, uint32_t bytes) const {
+void ComputePipeline::bind_and_push(VkCommandBuffer cmd, const Bindings& bindings, const void* push,
+                                    uint32_t bytes) const {
   if (bytes != push_bytes_) {
     throw Error(ErrorCode::invalid_argument,
                 concat("kernel ", id_, ": push constants are ", bytes, " bytes, pipeline expects ", push_bytes_));
   }
   count_recorded_command();
   vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, compiled_->pipeline);
-  vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, compiled_->layout, 0, 1, &set, 0, nullptr);
+  push_descriptors(compiled_->push_descriptor_set, cmd, VK_PIPELINE_BIND_POINT_COMPUTE, compiled_->layout, bindings_,
+                   bindings, id_);
   if (bytes) vkCmdPushConstants(cmd, compiled_->layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, bytes, push);
 }
 
-void ComputePipeline::dispatch_raw(VkCommandBuffer cmd, VkDescriptorSet set, const void* push, uint32_t bytes,
+void ComputePipeline::dispatch_raw(VkCommandBuffer cmd, const Bindings& bindings, const void* push, uint32_t bytes,
                                    uint32_t width, uint32_t height) const {
-  bind_and_push(cmd, set, push, bytes);
+  bind_and_push(cmd, bindings, push, bytes);
   vkCmdDispatch(cmd, (width + workgroup_.x - 1) / workgroup_.x, (height + workgroup_.y - 1) / workgroup_.y, 1);
-}
-
-DescriptorArena::DescriptorArena(const Context& context, uint32_t sets_per_pool, uint32_t per_type)
-    : context_(&context), sets_per_pool_(std::max(1u, sets_per_pool)), per_type_(std::max(1u, per_type)) {}
-
-DescriptorArena& DescriptorArena::operator=(DescriptorArena&& o) noexcept {
-  if (this != &o) {
-    reset();
-    context_ = std::exchange(o.context_, nullptr);
-    sets_per_pool_ = o.sets_per_pool_;
-    per_type_ = o.per_type_;
-    left_ = std::exchange(o.left_, 0);
-    pools_ = std::move(o.pools_);
-    o.pools_.clear();
-  }
-  return *this;
-}
-
-void DescriptorArena::reset() {
-  if (context_)
-    for (VkDescriptorPool p : pools_) vkDestroyDescriptorPool(context_->device(), p, nullptr);
-  pools_.clear();
-  left_ = 0;
-}
-
-VkDescriptorSet DescriptorArena::make_set(const ComputePipeline& pipeline, const std::vector<ImageBinding>& images) {
-  std::vector<AnyBinding> bindings(images.size());
-  for (size_t i = 0; i < images.size(); ++i) bindings[i].image = images[i];
-  return make_mixed_set(pipeline, bindings);
-}
-
-VkDescriptorSet DescriptorArena::make_buffer_set(const ComputePipeline& pipeline, const std::vector<Buffer>& buffers) {
-  std::vector<AnyBinding> bindings(buffers.size());
-  for (size_t i = 0; i < buffers.size(); ++i) bindings[i].buffer = buffers[i];
-  return make_mixed_set(pipeline, bindings);
-}
-
-VkDescriptorSet DescriptorArena::make_mixed_set(VkDescriptorSetLayout layout,
-                                                const std::vector<VkDescriptorType>& types,
-                                                const std::vector<AnyBinding>& bindings) {
-  if (bindings.size() != types.size()) {
-    throw Error(ErrorCode::invalid_argument,
-                concat("descriptor set: ", bindings.size(), " bindings for ", types.size()));
-  }
-  for (VkDescriptorType t : types) {
-    if (uint32_t(std::count(types.begin(), types.end(), t)) > per_type_) {
-      throw Error(ErrorCode::invalid_argument,
-                  concat("descriptor set: more descriptors of one type than the arena's ", per_type_, " per set"));
-    }
-  }
-  const VkDevice device = context_->device();
-  if (left_ == 0) {
-    const uint32_t n = sets_per_pool_;
-    VkDescriptorPoolSize sizes[] = {
-        {VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, n * per_type_},
-        {VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, n * per_type_},
-        {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, n * per_type_},
-        {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, n * per_type_},
-    };
-    VkDescriptorPoolCreateInfo info{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
-    info.maxSets = n;
-    info.poolSizeCount = 4;
-    info.pPoolSizes = sizes;
-    VkDescriptorPool pool = VK_NULL_HANDLE;
-    vk_check(vkCreateDescriptorPool(device, &info, nullptr, &pool), "vkCreateDescriptorPool");
-    context_->state().count_object();
-    pools_.push_back(pool);
-    left_ = n;
-  }
-  VkDescriptorSetAllocateInfo alloc{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
-  alloc.descriptorPool = pools_.back();
-  alloc.descriptorSetCount = 1;
-  alloc.pSetLayouts = &layout;
-  VkDescriptorSet set = VK_NULL_HANDLE;
-  vk_check(vkAllocateDescriptorSets(device, &alloc, &set), "vkAllocateDescriptorSets");
-  context_->state().count_object();
-  --left_;
-
-  std::vector<VkDescriptorImageInfo> images(bindings.size());
-  std::vector<VkDescriptorBufferInfo> buffers(bindings.size());
-  std::vector<VkWriteDescriptorSet> writes(bindings.size());
-  for (uint32_t i = 0; i < bindings.size(); ++i) {
-    writes[i] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
-    writes[i].dstSet = set;
-    writes[i].dstBinding = i;
-    writes[i].descriptorCount = 1;
-    writes[i].descriptorType = types[i];
-    if (bindings[i].buffer.buffer) {
-      buffers[i] = {bindings[i].buffer.buffer, bindings[i].buffer.offset, bindings[i].buffer.size};
-      writes[i].pBufferInfo = &buffers[i];
-    } else {
-      images[i] = {bindings[i].sampler, bindings[i].image.view, bindings[i].image.layout};
-      writes[i].pImageInfo = &images[i];
-    }
-  }
-  vkUpdateDescriptorSets(device, static_cast<uint32_t>(writes.size()), writes.data(), 0, nullptr);
-  return set;
 }
 
 }  // namespace glint::detail

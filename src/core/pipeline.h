@@ -1,8 +1,12 @@
-// Compute pipelines made from embedded kernels, and the descriptor sets that feed them.
+// Compute pipelines made from embedded kernels, and the descriptors that feed them: pushed with
+// every dispatch (VK_KHR_push_descriptor), so no effect keeps a descriptor set, and a caller's
+// view or buffer is named only by the command buffer it was recorded into.
 #pragma once
 
 #include <glint/glint.h>
 
+#include <array>
+#include <initializer_list>
 #include <string>
 #include <vector>
 
@@ -17,6 +21,60 @@ struct Workgroup2D {
   uint32_t y = 8;
 };
 Workgroup2D choose_workgroup_2d(const Context& context);
+
+/// The most descriptors one dispatch pushes. VkPhysicalDevicePushDescriptorPropertiesKHR::
+/// maxPushDescriptors is at least 32 on every device with VK_KHR_push_descriptor (Vulkan spec,
+/// "Limits"); pipelines are checked against the device's own limit when they are made.
+constexpr uint32_t kMaxBindings = 32;
+
+/// One descriptor of a dispatch: an image view in `layout` (with `sampler` for a combined image
+/// sampler binding), or a range of a buffer. Which one is read from the binding's type.
+struct Binding {
+  Binding() = default;
+  Binding(VkImageView v, VkImageLayout l, VkSampler s = VK_NULL_HANDLE) : view(v), layout(l), sampler(s) {}
+  Binding(const Buffer& b) : buffer(b) {}  // NOLINT(google-explicit-constructor): {buffer} in a list
+  VkImageView view = VK_NULL_HANDLE;
+  VkImageLayout layout = VK_IMAGE_LAYOUT_UNDEFINED;
+  VkSampler sampler = VK_NULL_HANDLE;
+  Buffer buffer{};
+};
+
+/// The descriptors of one dispatch, binding i at index i: a fixed-capacity array that lives on the
+/// recording thread's stack, so recording allocates nothing (tests/allocation_test.cpp).
+class Bindings {
+ public:
+  Bindings() = default;
+  Bindings(std::initializer_list<Binding> list) {
+    for (const Binding& b : list) push_back(b);
+  }
+  void push_back(const Binding& b) {
+    if (count_ == kMaxBindings) {
+      throw Error(ErrorCode::invalid_argument,
+                  concat("internal: more than kMaxBindings = ", kMaxBindings, " bindings"));
+    }
+    items_[count_++] = b;
+  }
+  uint32_t size() const { return count_; }
+  const Binding& operator[](uint32_t i) const { return items_[i]; }
+  Binding& operator[](uint32_t i) { return items_[i]; }
+
+ private:
+  std::array<Binding, kMaxBindings> items_{};
+  uint32_t count_ = 0;
+};
+
+/// A descriptor set layout for push descriptors (VK_DESCRIPTOR_SET_LAYOUT_CREATE_PUSH_DESCRIPTOR_BIT_KHR)
+/// whose binding i has type types[i], visible to `stages`. Refuses more bindings than the device's
+/// maxPushDescriptors (or kMaxBindings). The caller destroys it.
+VkDescriptorSetLayout make_push_set_layout(const Context& context, const std::vector<VkDescriptorType>& types,
+                                           VkShaderStageFlags stages);
+
+/// Records `push` (the context's vkCmdPushDescriptorSetKHR, ContextState::cmd_push_descriptor_set)
+/// for set 0 of `layout` at `bind_point`: binding i of type types[i] gets bindings[i]. `who` names the pipeline in the
+/// Error thrown, before anything is recorded, when the count differs or a descriptor is null.
+void push_descriptors(PFN_vkCmdPushDescriptorSetKHR push, VkCommandBuffer cmd, VkPipelineBindPoint bind_point,
+                      VkPipelineLayout layout, const std::vector<VkDescriptorType>& types, const Bindings& bindings,
+                      const std::string& who);
 
 struct PipelineDesc {
   std::string kernel_id;                   //!< e.g. "bloom_down_rgba16f"
@@ -35,6 +93,7 @@ struct PipelineDesc {
 /// shared by every ComputePipeline of the same PipelineDesc, destroyed with the context.
 struct CompiledPipeline {
   VkDevice device = VK_NULL_HANDLE;
+  PFN_vkCmdPushDescriptorSetKHR push_descriptor_set = nullptr;  // the context's, loaded once
   VkDescriptorSetLayout set_layout = VK_NULL_HANDLE;
   VkPipelineLayout layout = VK_NULL_HANDLE;
   VkPipeline pipeline = VK_NULL_HANDLE;
@@ -59,81 +118,38 @@ class ComputePipeline {
   ~ComputePipeline() = default;
   void reset() { compiled_ = nullptr; }
 
+  explicit operator bool() const { return compiled_ != nullptr; }
   VkDescriptorSetLayout set_layout() const { return compiled_ ? compiled_->set_layout : VK_NULL_HANDLE; }
   const std::vector<VkDescriptorType>& bindings() const { return bindings_; }
 
-  /// Binds the pipeline and `set`, pushes `push` and dispatches enough groups to cover
-  /// width x height invocations. The push-constant size is checked on every dispatch.
+  /// Binds the pipeline, pushes `bindings` (binding i of the kernel gets bindings[i]) and `push`,
+  /// and dispatches enough groups to cover width x height invocations. The push-constant size
+  /// and the binding count are checked on every dispatch.
   template <typename Push>
-  void dispatch(VkCommandBuffer cmd, VkDescriptorSet set, const Push& push, uint32_t width, uint32_t height) const {
-    dispatch_raw(cmd, set, &push, sizeof(Push), width, height);
+  void dispatch(VkCommandBuffer cmd, const Bindings& bindings, const Push& push, uint32_t width,
+                uint32_t height) const {
+    dispatch_raw(cmd, bindings, &push, sizeof(Push), width, height);
   }
 
-  /// Binds the pipeline and `set`, pushes `push` and records vkCmdDispatchIndirect reading a
+  /// Binds the pipeline, pushes `bindings` and `push`, and records vkCmdDispatchIndirect reading a
   /// VkDispatchIndirectCommand at `offset` in `args` (which needs INDIRECT_BUFFER usage and a
   /// barrier to DRAW_INDIRECT / INDIRECT_COMMAND_READ after whatever wrote it).
   template <typename Push>
-  void dispatch_indirect(VkCommandBuffer cmd, VkDescriptorSet set, const Push& push, VkBuffer args,
+  void dispatch_indirect(VkCommandBuffer cmd, const Bindings& bindings, const Push& push, VkBuffer args,
                          VkDeviceSize offset) const {
-    bind_and_push(cmd, set, &push, sizeof(Push));
+    bind_and_push(cmd, bindings, &push, sizeof(Push));
     vkCmdDispatchIndirect(cmd, args, offset);
   }
 
  private:
-  void bind_and_push(VkCommandBuffer cmd, VkDescriptorSet set, const void* push, uint32_t bytes) const;
-  void dispatch_raw(VkCommandBuffer cmd, VkDescriptorSet set, const void* push, uint32_t bytes, uint32_t width,
+  void bind_and_push(VkCommandBuffer cmd, const Bindings& bindings, const void* push, uint32_t bytes) const;
+  void dispatch_raw(VkCommandBuffer cmd, const Bindings& bindings, const void* push, uint32_t bytes, uint32_t width,
                     uint32_t height) const;
   const CompiledPipeline* compiled_ = nullptr;  // owned by the context
   std::string id_;
   uint32_t push_bytes_ = 0;
   Workgroup2D workgroup_;
   std::vector<VkDescriptorType> bindings_;
-};
-
-/// Descriptor pools and the sets allocated from them, owned by one effect. Pools are made on
-/// demand, each for `sets_per_pool` sets of up to `per_type` descriptors of each type, so an arena
-/// never runs out (effects that make sets for each new caller image keep one arena for them).
-class DescriptorArena {
- public:
-  DescriptorArena() = default;
-  DescriptorArena(const Context& context, uint32_t sets_per_pool, uint32_t per_type = 4);
-  DescriptorArena(DescriptorArena&& o) noexcept { *this = std::move(o); }
-  DescriptorArena& operator=(DescriptorArena&& o) noexcept;
-  DescriptorArena(const DescriptorArena&) = delete;
-  DescriptorArena& operator=(const DescriptorArena&) = delete;
-  ~DescriptorArena() { reset(); }
-  /// Frees every set and pool (the arena stays usable).
-  void reset();
-
-  struct ImageBinding {
-    VkImageView view;
-    VkImageLayout layout;
-  };
-  /// One binding of a set that mixes images and buffers: `buffer.buffer` set means a buffer;
-  /// `sampler` goes with the image of a combined image sampler binding.
-  struct AnyBinding {
-    ImageBinding image{VK_NULL_HANDLE, VK_IMAGE_LAYOUT_UNDEFINED};
-    Buffer buffer{};
-    VkSampler sampler = VK_NULL_HANDLE;
-  };
-  /// Allocates a set for `pipeline` and writes one image per binding, in binding order.
-  VkDescriptorSet make_set(const ComputePipeline& pipeline, const std::vector<ImageBinding>& images);
-  /// The same for pipelines whose bindings are all storage buffers.
-  VkDescriptorSet make_buffer_set(const ComputePipeline& pipeline, const std::vector<Buffer>& buffers);
-  /// Allocates a set for `pipeline` and writes one image or buffer per binding, in binding order.
-  VkDescriptorSet make_mixed_set(const ComputePipeline& pipeline, const std::vector<AnyBinding>& bindings) {
-    return make_mixed_set(pipeline.set_layout(), pipeline.bindings(), bindings);
-  }
-  /// The same for any set layout (a graphics pipeline's) whose binding i has type types[i].
-  VkDescriptorSet make_mixed_set(VkDescriptorSetLayout layout, const std::vector<VkDescriptorType>& types,
-                                 const std::vector<AnyBinding>& bindings);
-
- private:
-  const Context* context_ = nullptr;
-  uint32_t sets_per_pool_ = 0;
-  uint32_t per_type_ = 4;
-  uint32_t left_ = 0;  // sets the last pool can still give
-  std::vector<VkDescriptorPool> pools_;
 };
 
 }  // namespace glint::detail

@@ -8,10 +8,8 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdio>
-#include <map>
 #include <memory>
 #include <string>
-#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -100,16 +98,6 @@ constexpr VkPipelineStageFlags2 kCompute = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BI
 constexpr VkPipelineStageFlags2 kIndirect = VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT;
 constexpr VkAccessFlags2 kStorageRW = VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT;
 
-detail::DescriptorArena::AnyBinding buffer_binding(const Buffer& b) {
-  detail::DescriptorArena::AnyBinding a;
-  a.buffer = b;
-  return a;
-}
-
-using BufferKey = std::tuple<VkBuffer, VkDeviceSize, VkDeviceSize>;
-BufferKey key_of(const Buffer& b) { return {b.buffer, b.offset, b.size}; }
-// The compute path's descriptor sets: instances, indirect arguments, colour view.
-using GatherKey = std::tuple<BufferKey, BufferKey, VkImageView>;
 // Bytes of the sprite pre-pass's block per instance (src/flare/shaders/flare_params.h).
 constexpr VkDeviceSize kBlockBytes = GLINT_FLARE_BLOCK_VEC4S * 16;
 
@@ -132,12 +120,12 @@ struct LensFlare::Impl {
   VkSampler sampler = VK_NULL_HANDLE;  // owned by the context
   bool atlas_generated = false;
   detail::ComputePipeline atlas_pipeline;
-  detail::DescriptorArena atlas_sets_arena;
-  std::vector<VkDescriptorSet> atlas_sets;
 
   // Raster path (absent when the device cannot draw into `format` with blending).
-  std::string raster_unavailable;  // empty when the raster path is available
-  VkDescriptorSetLayout raster_set_layout = VK_NULL_HANDLE;
+  std::string raster_unavailable;                            // empty when the raster path is available
+  VkDescriptorSetLayout raster_set_layout = VK_NULL_HANDLE;  // pushed: instances, atlas
+  std::vector<VkDescriptorType> raster_types = {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+                                                VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER};
   VkPipelineLayout raster_layout = VK_NULL_HANDLE;
   VkPipeline raster_pipeline = VK_NULL_HANDLE;
 
@@ -150,39 +138,26 @@ struct LensFlare::Impl {
   bool gather_beyond_made = false;
   detail::OwnedBuffer gather_args_buffer;  // the gather's VkDispatchIndirectCommand, then the pre-pass's
   Buffer gather_args_state;
-  std::map<BufferKey, VkDescriptorSet> gather_args_sets;
   // The pre-pass's sprite blocks, one store per size: a larger instances buffer gets a new store,
-  // and the smaller ones stay (sets made for them may still be recorded) until the LensFlare goes.
+  // and the smaller ones stay (command buffers recorded with them may still be pending) until the
+  // LensFlare goes.
   struct SpriteStore {
     detail::OwnedBuffer buffer;
     Buffer state;
     uint32_t capacity = 0;  // instances
   };
   std::vector<std::unique_ptr<SpriteStore>> sprite_stores;
-  struct GatherSets {
-    VkDescriptorSet sprites = VK_NULL_HANDLE, gather = VK_NULL_HANDLE;
-    SpriteStore* store = nullptr;
-    bool beyond = false;  // the instances buffer holds more than the store: gather_beyond
-  };
-
-  detail::DescriptorArena sets;  // the sets naming caller buffers and images; pools of 16
-  std::map<BufferKey, VkDescriptorSet> raster_sets;
-  std::map<GatherKey, GatherSets> gather_sets;
 
   ~Impl() {
     if (!device) return;
     if (raster_pipeline) vkDestroyPipeline(device, raster_pipeline, nullptr);
     if (raster_layout) vkDestroyPipelineLayout(device, raster_layout, nullptr);
-    sets.reset();
     if (raster_set_layout) vkDestroyDescriptorSetLayout(device, raster_set_layout, nullptr);
   }
 
   // The atlas as a combined image sampler binding (every level, trilinear).
-  detail::DescriptorArena::AnyBinding atlas_binding() const {
-    detail::DescriptorArena::AnyBinding a;
-    a.image = {atlas_image.state.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
-    a.sampler = sampler;
-    return a;
+  detail::Binding atlas_binding() const {
+    return {atlas_image.state.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, sampler};
   }
 
   void make_atlas();
@@ -214,12 +189,6 @@ void LensFlare::Impl::make_atlas() {
   d.push_constant_bytes = sizeof(GlintFlareAtlasPush);
   d.workgroup = detail::choose_workgroup_2d(*context);
   atlas_pipeline = detail::ComputePipeline(*context, d);
-  atlas_sets_arena = detail::DescriptorArena(*context, levels);
-  const VkImageLayout G = VK_IMAGE_LAYOUT_GENERAL;
-  for (uint32_t k = 0; k < levels; ++k) {
-    atlas_sets.push_back(atlas_sets_arena.make_set(
-        atlas_pipeline, {{atlas_image.level_view(k == 0 ? 0 : k - 1), G}, {atlas_image.level_view(k), G}}));
-  }
 }
 
 void LensFlare::Impl::record_setup(VkCommandBuffer cmd) {
@@ -232,7 +201,9 @@ void LensFlare::Impl::record_setup(VkCommandBuffer cmd) {
     b.flush(cmd);
     GlintFlareAtlasPush p{k, std::max(1u, atlas_image.state.extent.width >> k),
                           std::max(1u, atlas_image.state.extent.height >> k)};
-    atlas_pipeline.dispatch(cmd, atlas_sets[k], p, p.width, p.height);
+    // Level k is made from level k - 1 (level 0 from nothing: its source binding is unused).
+    atlas_pipeline.dispatch(cmd, {{atlas_image.level_view(k == 0 ? 0 : k - 1), G}, {atlas_image.level_view(k), G}}, p,
+                            p.width, p.height);
   }
   b.use(atlas_image.state, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
         VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
@@ -262,6 +233,7 @@ void LensFlare::Impl::make_raster_pipeline() {
       {1, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, VK_SHADER_STAGE_FRAGMENT_BIT, nullptr},
   };
   VkDescriptorSetLayoutCreateInfo sl{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
+  sl.flags = VK_DESCRIPTOR_SET_LAYOUT_CREATE_PUSH_DESCRIPTOR_BIT_KHR;  // pushed with each draw
   sl.bindingCount = 2;
   sl.pBindings = b;
   detail::vk_check(vkCreateDescriptorSetLayout(device, &sl, nullptr, &raster_set_layout),
@@ -467,7 +439,6 @@ LensFlare::LensFlare(const Context& context, VkFormat color_format, VkExtent2D e
   const uint32_t tile_h = m.workgroup.y * GLINT_FLARE_GATHER_ROWS;
   m.tiles_x = (extent.width + m.workgroup.x - 1) / m.workgroup.x;
   m.tiles_y = (extent.height + tile_h - 1) / tile_h;
-  m.sets = detail::DescriptorArena(context, 16);
   m.make_atlas();
   m.make_raster_pipeline();
   m.make_compute_pipelines();
@@ -514,16 +485,6 @@ void LensFlare::record_raster(VkCommandBuffer cmd, Image& color, Buffer& instanc
   if (!config.enabled || config.intensity == 0.0f) return;  // adds nothing: record nothing
   m.record_setup(cmd);
 
-  VkDescriptorSet set;
-  if (auto it = m.raster_sets.find(key_of(instances)); it != m.raster_sets.end()) {
-    set = it->second;
-  } else {
-    set = m.sets.make_mixed_set(m.raster_set_layout,
-                                {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER},
-                                {buffer_binding(instances), m.atlas_binding()});
-    m.raster_sets.emplace(key_of(instances), set);
-  }
-
   detail::Barriers b;
   b.use(instances, VK_PIPELINE_STAGE_2_VERTEX_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
   b.use(indirect, kIndirect, VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT);
@@ -549,7 +510,8 @@ void LensFlare::record_raster(VkCommandBuffer cmd, Image& color, Buffer& instanc
   VkRect2D scissor{{0, 0}, m.extent};
   vkCmdSetViewport(cmd, 0, 1, &viewport);
   vkCmdSetScissor(cmd, 0, 1, &scissor);
-  vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, m.raster_layout, 0, 1, &set, 0, nullptr);
+  detail::push_descriptors(m.context->state().cmd_push_descriptor_set, cmd, VK_PIPELINE_BIND_POINT_GRAPHICS,
+                           m.raster_layout, m.raster_types, {instances, m.atlas_binding()}, "flare raster");
   const GlintFlarePush p = m.push(config);
   vkCmdPushConstants(cmd, m.raster_layout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof(p), &p);
   vkCmdDrawIndirect(cmd, indirect.buffer, indirect.offset + offsetof(GlintFlareIndirect, vertex_count), 1,
@@ -584,53 +546,34 @@ void LensFlare::record_compute(VkCommandBuffer cmd, Image& color, Buffer& instan
   const VkDeviceSize bound_offset = args_offset - args_offset % m.storage_alignment;
   const Buffer indirect_words{indirect.buffer, bound_offset,   args_offset - bound_offset + sizeof(uint32_t),
                               indirect.usage,  indirect.stage, indirect.access};
-  const GatherKey key{key_of(instances), key_of(indirect_words), color.view};
   // Instances whose sprites the pre-pass stores (all of them up to max_stored_instances).
   const uint32_t capacity = std::min(uint32_t(instances.size / sizeof(GlintFlareInstance)), m.max_stored_instances);
-  Impl::GatherSets gs;
-  if (auto it = m.gather_sets.find(key); it != m.gather_sets.end()) {
-    gs = it->second;
-  } else {
-    if (m.sprite_stores.empty() || m.sprite_stores.back()->capacity < capacity) {
-      // A new store for the larger buffer, twice the last one (at most the descriptor's limit), so
-      // that buffers growing one by one make few stores.
-      uint32_t c = m.sprite_stores.empty() ? 1u : m.sprite_stores.back()->capacity;
-      c = std::max(capacity, std::min(2 * c, m.max_stored_instances));
-      auto store = std::make_unique<Impl::SpriteStore>();
-      const VkDeviceSize bytes = VkDeviceSize(c) * kBlockBytes;
-      store->buffer = detail::OwnedBuffer(*m.context, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, false);
-      store->state =
-          Buffer{store->buffer.buffer(), 0, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, VK_PIPELINE_STAGE_2_NONE,
-                 VK_ACCESS_2_NONE};
-      store->capacity = c;
-      m.sprite_stores.push_back(std::move(store));
-    }
-    gs.store = m.sprite_stores.back().get();
-    gs.beyond = instances.size / sizeof(GlintFlareInstance) > gs.store->capacity;
-    if (gs.beyond && !m.gather_beyond_made) {
-      m.gather_beyond = m.make_gather(1);
-      m.gather_beyond_made = true;
-    }
-    detail::DescriptorArena::AnyBinding dst;
-    dst.image = {color.view, VK_IMAGE_LAYOUT_GENERAL};
-    gs.gather = m.sets.make_mixed_set(m.gather, {buffer_binding(instances), m.atlas_binding(),
-                                                 buffer_binding(indirect_words), dst, buffer_binding(gs.store->state)});
-    gs.sprites = m.sets.make_buffer_set(m.sprites, {instances, indirect_words, gs.store->state});
-    m.gather_sets.emplace(key, gs);
+  if (m.sprite_stores.empty() || m.sprite_stores.back()->capacity < capacity) {
+    // A new store for the larger buffer, twice the last one (at most the descriptor's limit), so
+    // that buffers growing one by one make few stores.
+    uint32_t c = m.sprite_stores.empty() ? 1u : m.sprite_stores.back()->capacity;
+    c = std::max(capacity, std::min(2 * c, m.max_stored_instances));
+    auto store = std::make_unique<Impl::SpriteStore>();
+    const VkDeviceSize bytes = VkDeviceSize(c) * kBlockBytes;
+    store->buffer = detail::OwnedBuffer(*m.context, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, false);
+    store->state =
+        Buffer{store->buffer.buffer(), 0, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, VK_PIPELINE_STAGE_2_NONE,
+               VK_ACCESS_2_NONE};
+    store->capacity = c;
+    m.sprite_stores.push_back(std::move(store));
   }
-  Buffer& store = gs.store->state;
-
-  VkDescriptorSet args_set;
-  if (auto it = m.gather_args_sets.find(key_of(indirect_words)); it != m.gather_args_sets.end()) {
-    args_set = it->second;
-  } else {
-    args_set = m.sets.make_buffer_set(m.gather_args, {indirect_words, m.gather_args_state});
-    m.gather_args_sets.emplace(key_of(indirect_words), args_set);
+  Impl::SpriteStore& sprite_store = *m.sprite_stores.back();
+  Buffer& store = sprite_store.state;
+  // The instances buffer holds more than the store: the gather evaluates the rest itself.
+  const bool beyond = instances.size / sizeof(GlintFlareInstance) > sprite_store.capacity;
+  if (beyond && !m.gather_beyond_made) {
+    m.gather_beyond = m.make_gather(1);
+    m.gather_beyond_made = true;
   }
 
   GlintFlarePush p = m.push(config);
   p.indirect_word = uint32_t((args_offset - bound_offset) / sizeof(uint32_t));
-  GlintFlareGatherArgsPush ap{p.indirect_word, m.tiles_x, m.tiles_y, std::min(capacity, gs.store->capacity),
+  GlintFlareGatherArgsPush ap{p.indirect_word, m.tiles_x, m.tiles_y, std::min(capacity, sprite_store.capacity),
                               m.max_groups_x};
   detail::Barriers b;
   // 1. The launch arguments: every tile when any instance is visible, none otherwise; the
@@ -638,28 +581,24 @@ void LensFlare::record_compute(VkCommandBuffer cmd, Image& color, Buffer& instan
   b.use(indirect, kCompute, VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
   b.use(m.gather_args_state, kCompute, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
   b.flush(cmd);
-  m.gather_args.dispatch(cmd, args_set, ap, 1, 1);
+  m.gather_args.dispatch(cmd, {indirect_words, m.gather_args_state}, ap, 1, 1);
   // 2. The sprite pre-pass: every sprite of every instance, once.
   b.use(m.gather_args_state, kIndirect, VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT);
   b.use(instances, kCompute, VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
   b.use(store, kCompute, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
   b.flush(cmd);
-  m.sprites.dispatch_indirect(cmd, gs.sprites, p, m.gather_args_buffer.buffer(), 16);
+  m.sprites.dispatch_indirect(cmd, {instances, indirect_words, store}, p, m.gather_args_buffer.buffer(), 16);
   // 3. The gather, one workgroup per tile.
   b.use(store, kCompute, VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
   b.use(m.atlas_image.state, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, kCompute, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT,
         GLINT_FLARE_ATLAS_LEVELS);
   b.use(color, VK_IMAGE_LAYOUT_GENERAL, kCompute, kStorageRW);
   b.flush(cmd);
-  (gs.beyond ? m.gather_beyond : m.gather).dispatch_indirect(cmd, gs.gather, p, m.gather_args_buffer.buffer(), 0);
+  (beyond ? m.gather_beyond : m.gather)
+      .dispatch_indirect(cmd,
+                         {instances, m.atlas_binding(), indirect_words, {color.view, VK_IMAGE_LAYOUT_GENERAL}, store},
+                         p, m.gather_args_buffer.buffer(), 0);
   if (profiler) profiler->mark(cmd, "flare gather");
-}
-
-void LensFlare::forget_caller_resources() {
-  impl_->raster_sets.clear();
-  impl_->gather_sets.clear();
-  impl_->gather_args_sets.clear();
-  impl_->sets.reset();
 }
 
 }  // namespace glint

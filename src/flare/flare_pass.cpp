@@ -212,10 +212,4 @@ LightCuller& LensFlarePass::culler() { return impl_->culler; }
 LensFlare& LensFlarePass::flare() { return impl_->flare; }
 const FlarePassConfig& LensFlarePass::config() const { return impl_->config; }
 
-void LensFlarePass::forget_caller_resources() {
-  impl_->hiz.forget_caller_resources();
-  impl_->culler.forget_caller_resources();
-  impl_->flare.forget_caller_resources();
-}
-
 }  // namespace glint

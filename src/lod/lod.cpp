@@ -2,8 +2,6 @@
 #include <glint/lod.h>
 
 #include <cstddef>
-#include <map>
-#include <tuple>
 
 #include "core/barriers.h"
 #include "core/check.h"
@@ -63,19 +61,9 @@ float lod_level(const LodQuery& query, const LodAtlasConfig& atlas) {
 struct LodBatch::Impl {
   const Context* context;
   detail::ComputePipeline pipeline;
-  detail::DescriptorArena arena;  // grows by pools of 16 sets
-  // Per (queries, levels) buffer range pair, made on first use and kept.
-  using Key = std::tuple<VkBuffer, VkDeviceSize, VkDeviceSize, VkBuffer, VkDeviceSize, VkDeviceSize>;
-  std::map<Key, VkDescriptorSet> sets;
-
-  VkDescriptorSet set_for(const Buffer& q, const Buffer& l) {
-    Key key{q.buffer, q.offset, q.size, l.buffer, l.offset, l.size};
-    if (auto it = sets.find(key); it != sets.end()) return it->second;
-    return sets[key] = arena.make_buffer_set(pipeline, {q, l});
-  }
 };
 
-LodBatch::LodBatch(const Context& context) : impl_(new Impl{&context, {}, {}, {}}) {
+LodBatch::LodBatch(const Context& context) : impl_(new Impl{&context, {}}) {
   detail::PipelineDesc d;
   d.kernel_id = "lod_batch_main";
   d.bindings = {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER};
@@ -83,7 +71,6 @@ LodBatch::LodBatch(const Context& context) : impl_(new Impl{&context, {}, {}, {}
   d.workgroup = {64, 1};
   try {
     impl_->pipeline = detail::ComputePipeline(context, d);
-    impl_->arena = detail::DescriptorArena(context, 16);
   } catch (...) {
     delete impl_;
     throw;
@@ -91,11 +78,6 @@ LodBatch::LodBatch(const Context& context) : impl_(new Impl{&context, {}, {}, {}
 }
 
 LodBatch::~LodBatch() { delete impl_; }
-
-void LodBatch::forget_caller_resources() {
-  impl_->sets.clear();
-  impl_->arena.reset();
-}
 
 void LodBatch::record(VkCommandBuffer cmd, Buffer& queries, Buffer& levels, uint32_t count, const LodAtlasConfig& atlas,
                       Profiler* profiler) {
@@ -113,13 +95,12 @@ void LodBatch::record(VkCommandBuffer cmd, Buffer& queries, Buffer& levels, uint
                        std::max<VkDeviceSize>(1, VkDeviceSize(count) * sizeof(float)),
                        VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
   if (count == 0) return;
-  VkDescriptorSet set = impl_->set_for(queries, levels);
   detail::Barriers b;
   b.use(queries, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
   b.use(levels, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
   b.flush(cmd);
   LodPush push{to_glsl_atlas(atlas), count};
-  impl_->pipeline.dispatch(cmd, set, push, count, 1);
+  impl_->pipeline.dispatch(cmd, {queries, levels}, push, count, 1);
   if (profiler) profiler->mark(cmd, "lod batch");
 }
 

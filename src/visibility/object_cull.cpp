@@ -7,7 +7,6 @@
 #include <cmath>
 #include <cstddef>
 #include <cstring>
-#include <map>
 #include <utility>
 #include <vector>
 
@@ -208,14 +207,6 @@ struct ObjectCuller::Impl {
   detail::Compaction compact;
   detail::OwnedBuffer dummy;
   Buffer dummy_state;
-  std::map<std::vector<uint64_t>, VkDescriptorSet> sets;  // the test's, by the resources it binds
-  detail::DescriptorArena arena;
-
-  static void key_add(std::vector<uint64_t>& key, const Buffer& b) {
-    key.push_back(reinterpret_cast<uint64_t>(b.buffer));
-    key.push_back(b.offset);
-    key.push_back(b.size);
-  }
 
   void check_common(const char* where, const ObjectCullFrame& frame, ObjectCullBuffers& in, ObjectCullOutputs& out,
                     GlintObjectCullPush& push) const {
@@ -272,7 +263,6 @@ ObjectCuller::ObjectCuller(const Context& context, const ObjectCullConfig& confi
   Impl& m = *impl_;
   m.context = &context;
   m.config = config;
-  m.arena = detail::DescriptorArena(context, 16, 8);
   VkPhysicalDeviceProperties props;
   vkGetPhysicalDeviceProperties(context.physical_device(), &props);
   m.max_range = props.limits.maxStorageBufferRange;
@@ -344,29 +334,15 @@ void ObjectCuller::Impl::run(VkCommandBuffer cmd, HiZPyramid* hiz, Image* depth,
   Buffer& payloads = config.payload_words > 0 ? in.payloads : dummy_state;
   Buffer& groups_state = compact.groups();
   const bool images = mode != GLINT_OBJECT_MODE_PHASE1;
-  std::vector<uint64_t> key{mode == GLINT_OBJECT_MODE_PHASE1 ? 1u : 0u};
+  // The test's descriptors: depth and Hi-Z (not in phase 1), objects, visibility, counters.
+  detail::Bindings test;
   if (images) {
-    key.push_back(reinterpret_cast<uint64_t>(depth->view));
-    key.push_back(reinterpret_cast<uint64_t>(hiz->image().view));
+    test.push_back({depth->view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL});
+    test.push_back({hiz->image().view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL});
   }
-  key_add(key, in.objects);
-  key_add(key, in.visibility);
-  auto it = sets.find(key);
-  if (it == sets.end()) {
-    std::vector<detail::DescriptorArena::AnyBinding> c;
-    if (images) {
-      c.resize(2);
-      c[0].image = {depth->view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
-      c[1].image = {hiz->image().view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
-    }
-    for (Buffer* b : {&in.objects, &in.visibility, &groups_state}) {
-      detail::DescriptorArena::AnyBinding a;
-      a.buffer = *b;
-      c.push_back(a);
-    }
-    it = sets.emplace(key, arena.make_mixed_set(images ? cull : phase1, c)).first;
-  }
-  const VkDescriptorSet set = it->second;
+  test.push_back(in.objects);
+  test.push_back(in.visibility);
+  test.push_back(groups_state);
 
   detail::Barriers b;
   compact.record_clear_once(cmd, b);  // the scan resets the counters after every cull
@@ -390,7 +366,7 @@ void ObjectCuller::Impl::run(VkCommandBuffer cmd, HiZPyramid* hiz, Image* depth,
       push.height = static_cast<int32_t>(hiz->config().extent.height);
       push.levels = hiz->levels();
     }
-    (images ? cull : phase1).dispatch(cmd, set, push, gx * kGroup, gy);
+    (images ? cull : phase1).dispatch(cmd, test, push, gx * kGroup, gy);
   }
   if (profiler) profiler->mark(cmd, "object cull");
   // 2. Scan: slots, arguments, statistics; counters reset. 3. Scatter: payloads in object order.
@@ -445,12 +421,6 @@ void ObjectCuller::record_clear_history(VkCommandBuffer cmd, Buffer& visibility,
   b.flush(cmd);
   vkCmdFillBuffer(cmd, visibility.buffer, visibility.offset, VkDeviceSize(count) * 4, 0);
   detail::count_recorded_command();
-}
-
-void ObjectCuller::forget_caller_resources() {
-  impl_->sets.clear();
-  impl_->arena.reset();
-  impl_->compact.forget_caller_resources();
 }
 
 }  // namespace glint

@@ -7,7 +7,6 @@
 #include <cmath>
 #include <cstddef>
 #include <cstring>
-#include <map>
 #include <utility>
 #include <vector>
 
@@ -116,18 +115,10 @@ struct HiZPyramid::Impl {
   // Nearest, clamp-to-edge: hiz_stream.comp gathers 2x2 depth texels per fetch.
   VkSampler sampler = VK_NULL_HANDLE;  // owned by the context
   // The two dispatches (docs/OCCLUSION.md, "Hi-Z pyramid"): hiz_stream.comp writes levels 1 and 2
-  // from the depth image, hiz_build.comp the levels above 2 (made only when there are any).
+  // from the depth image, hiz_build.comp the levels above 2 (made only when there are any). Both
+  // push their descriptors with every dispatch.
   detail::ComputePipeline stream_pipeline;
   detail::ComputePipeline tile_pipeline;
-  // Descriptor sets per caller depth view: the stream pass's (depth, levels 1 and 2); the tile
-  // pass's set holds no caller resource and is made once.
-  struct Sets {
-    detail::DescriptorArena arena;
-    VkDescriptorSet stream = VK_NULL_HANDLE;
-  };
-  std::map<VkImageView, Sets> sets;
-  detail::DescriptorArena tile_arena;
-  VkDescriptorSet tile_set = VK_NULL_HANDLE;
 
   GlintHiZPush stream_push{};  // base = the depth image; tile_levels = levels it writes (1 or 2)
   GlintHiZPush tile_push{};    // base = level 2
@@ -136,9 +127,6 @@ struct HiZPyramid::Impl {
   ~Impl() { release(); }
 
   void release() {
-    sets.clear();
-    tile_arena.reset();
-    tile_set = VK_NULL_HANDLE;
     VkDevice device = context ? context->device() : VK_NULL_HANDLE;
     if (!device) return;
     pyramid.reset();
@@ -186,31 +174,19 @@ struct HiZPyramid::Impl {
   // but every binding needs a view.
   VkImageView level_view(uint32_t k) const { return pyramid.level_view(std::min(k, std::max(1u, levels)) - 1); }
 
-  VkDescriptorSet stream_set_for(const Image& depth) {
-    auto it = sets.find(depth.view);
-    if (it == sets.end()) {
-      Sets s;
-      s.arena = detail::DescriptorArena(*context, 1, 2);
-      std::vector<detail::DescriptorArena::AnyBinding> b(3);
-      b[0].image = {depth.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
-      b[0].sampler = sampler;
-      b[1].image = {level_view(1), VK_IMAGE_LAYOUT_GENERAL};
-      b[2].image = {level_view(2), VK_IMAGE_LAYOUT_GENERAL};
-      s.stream = s.arena.make_mixed_set(stream_pipeline, b);
-      it = sets.emplace(depth.view, std::move(s)).first;
-    }
-    return it->second.stream;
+  // The stream pass's descriptors: the depth through the nearest sampler, levels 1 and 2.
+  detail::Bindings stream_bindings(const Image& depth) const {
+    return {{depth.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, sampler},
+            {level_view(1), VK_IMAGE_LAYOUT_GENERAL},
+            {level_view(2), VK_IMAGE_LAYOUT_GENERAL}};
   }
 
-  VkDescriptorSet tile_set_once() {
-    if (tile_set == VK_NULL_HANDLE) {
-      tile_arena = detail::DescriptorArena(*context, 1, GLINT_HIZ_MAX_LEVELS);
-      std::vector<detail::DescriptorArena::AnyBinding> b(GLINT_HIZ_MAX_LEVELS + 1);
-      for (uint32_t k = 1; k <= GLINT_HIZ_MAX_LEVELS; ++k) b[k - 1].image = {level_view(k), VK_IMAGE_LAYOUT_GENERAL};
-      b[GLINT_HIZ_MAX_LEVELS].buffer = counter_state;
-      tile_set = tile_arena.make_mixed_set(tile_pipeline, b);
-    }
-    return tile_set;
+  // The tile pass's descriptors: a storage view per level 1..GLINT_HIZ_MAX_LEVELS, the counter.
+  detail::Bindings tile_bindings() const {
+    detail::Bindings b;
+    for (uint32_t k = 1; k <= GLINT_HIZ_MAX_LEVELS; ++k) b.push_back({level_view(k), VK_IMAGE_LAYOUT_GENERAL});
+    b.push_back(counter_state);
+    return b;
   }
 };
 
@@ -317,11 +293,11 @@ void HiZPyramid::record(VkCommandBuffer cmd, Image& depth, Profiler* profiler) {
   b.flush(cmd);
   // Stream pass: one invocation per level-2 texel (level 2's size even when only level 1 is built).
   const uint32_t n2x = std::max(1u, m.config.extent.width >> 2), n2y = std::max(1u, m.config.extent.height >> 2);
-  m.stream_pipeline.dispatch(cmd, m.stream_set_for(depth), m.stream_push, n2x, n2y);
+  m.stream_pipeline.dispatch(cmd, m.stream_bindings(depth), m.stream_push, n2x, n2y);
   if (tile_pass) {  // the tile pass reads level 2, which the stream pass wrote
     b.use(m.pyramid.state, VK_IMAGE_LAYOUT_GENERAL, kCompute, kStorageRead | kStorageWrite, std::max(1u, m.levels));
     b.flush(cmd);
-    m.tile_pipeline.dispatch(cmd, m.tile_set_once(), m.tile_push, m.tile_groups_x * 256, m.tile_groups_y);
+    m.tile_pipeline.dispatch(cmd, m.tile_bindings(), m.tile_push, m.tile_groups_x * 256, m.tile_groups_y);
   }
   if (profiler) profiler->mark(cmd, "hi-z");
 }
@@ -355,19 +331,8 @@ struct LightCuller::Impl {
   // One vec4 record per light.
   detail::OwnedBuffer records;
   Buffer records_state;
-  // The cull's descriptor sets by the resources they name: the depth and Hi-Z views and (buffer,
-  // offset, size) of the lights and results buffers. A fixed-size key: no allocation.
-  using SetKey = std::array<uint64_t, 8>;
-  std::map<SetKey, VkDescriptorSet> sets;
-  detail::DescriptorArena arena;      // pools of 16 sets, 8 descriptors of a type each
   detail::OwnedBuffer dummy_results;  // bound when the caller wants no per-light results
   Buffer dummy_state;
-
-  static void key_add(SetKey& key, size_t& at, const Buffer& b) {
-    key[at++] = reinterpret_cast<uint64_t>(b.buffer);
-    key[at++] = b.offset;
-    key[at++] = b.size;
-  }
 };
 
 LightCuller::LightCuller(const Context& context, const LightCullConfig& config) : impl_(std::make_unique<Impl>()) {
@@ -375,7 +340,6 @@ LightCuller::LightCuller(const Context& context, const LightCullConfig& config) 
   Impl& m = *impl_;
   m.context = &context;
   m.config = config;
-  m.arena = detail::DescriptorArena(context, 16, 8);
   // The group limit and the scan's workgroup size from the device (CONTRIBUTING.md, "Device limits").
   VkPhysicalDeviceProperties props;
   vkGetPhysicalDeviceProperties(context.physical_device(), &props);
@@ -467,25 +431,7 @@ void LightCuller::record(VkCommandBuffer cmd, HiZPyramid& hiz, Image& depth, Buf
   }
   Buffer& results = want_results ? out.results : m.dummy_state;
 
-  // The cull's descriptor set for these resources (made once, then reused).
   Buffer& groups_state = m.compact.groups();
-  Impl::SetKey key{reinterpret_cast<uint64_t>(depth.view), reinterpret_cast<uint64_t>(hiz.image().view)};
-  size_t at = 2;
-  Impl::key_add(key, at, lights);
-  Impl::key_add(key, at, results);
-  auto it = m.sets.find(key);
-  if (it == m.sets.end()) {
-    std::vector<detail::DescriptorArena::AnyBinding> c(6);
-    c[0].image = {depth.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
-    c[1].image = {hiz.image().view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
-    c[2].buffer = lights;
-    c[3].buffer = m.records_state;
-    c[4].buffer = results;
-    c[5].buffer = groups_state;
-    it = m.sets.emplace(key, m.arena.make_mixed_set(m.cull, c)).first;
-  }
-  const VkDescriptorSet set = it->second;
-
   detail::Barriers b;
   m.compact.record_clear_once(cmd, b);  // the scan kernel resets the counters every frame
   const uint32_t flags = want_results ? GLINT_CULL_WRITE_RESULTS : 0u;
@@ -510,7 +456,14 @@ void LightCuller::record(VkCommandBuffer cmd, HiZPyramid& hiz, Image& depth, Buf
                  (m.config.pattern == OcclusionPattern::regular ? GLINT_CULL_REGULAR_GRID : 0u);
     push.margin_ndc = m.config.margin_ndc;
     push.depth_bias = m.config.depth_bias;
-    m.cull.dispatch(cmd, set, push, count, 1);
+    m.cull.dispatch(cmd,
+                    {{depth.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL},
+                     {hiz.image().view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL},
+                     lights,
+                     m.records_state,
+                     results,
+                     groups_state},
+                    push, count, 1);
   }
   if (profiler) profiler->mark(cmd, "light cull");
   // 2. Scan: the masks (and the counters' atomics) are complete; first slots, arguments, stats.
@@ -529,14 +482,6 @@ void LightCuller::record(VkCommandBuffer cmd, HiZPyramid& hiz, Image& depth, Buf
   // 3. Scatter: instances in light order, the visible lights' results.
   m.compact.record_scatter(cmd, b, cp, {&lights, &m.records_state}, {&out.instances, &results});
   if (profiler) profiler->mark(cmd, "cull scatter");
-}
-
-void HiZPyramid::forget_caller_resources() { impl_->sets.clear(); }
-
-void LightCuller::forget_caller_resources() {
-  impl_->sets.clear();
-  impl_->arena.reset();
-  impl_->compact.forget_caller_resources();
 }
 
 }  // namespace glint

@@ -98,6 +98,8 @@ struct Engine {
   // The feature chain the device is created with; glint reads it (AdoptInfo::enabled_features).
   VkPhysicalDeviceVulkan13Features f13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
   VkPhysicalDeviceFeatures2 features{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
+  // The device extensions it is created with; glint reads them (AdoptInfo::enabled_extensions).
+  const char* extensions[1] = {VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME};
 
   Engine() {
     const char* env = std::getenv("GLINT_VALIDATION");
@@ -136,7 +138,8 @@ struct Engine {
     }
     pick_device();
 
-    // Exactly what glint documents (README.md "Embedding"): Vulkan 1.3 features, no extension.
+    // Exactly what glint documents (README.md "Embedding"): Vulkan 1.3 features and
+    // VK_KHR_push_descriptor.
     f13.synchronization2 = VK_TRUE;
     f13.maintenance4 = VK_TRUE;
     f13.dynamicRendering = VK_TRUE;
@@ -150,6 +153,8 @@ struct Engine {
     di.pNext = &features;
     di.queueCreateInfoCount = 1;
     di.pQueueCreateInfos = &q;
+    di.enabledExtensionCount = 1;
+    di.ppEnabledExtensionNames = extensions;
     vk(vkCreateDevice(physical, &di, nullptr, &device), "vkCreateDevice");
     vkGetDeviceQueue(device, family, 0, &queue);
     vkGetPhysicalDeviceMemoryProperties(physical, &memory);
@@ -445,6 +450,8 @@ int run() {
     adopt.device = engine.device;
     adopt.queue_family_index = engine.family;
     adopt.enabled_features = &engine.features;
+    adopt.enabled_extensions = engine.extensions;
+    adopt.enabled_extension_count = 1;
     const glint::Context ctx = glint::Context::adopt(adopt);
     std::printf("glint %d.%d.%d adopted %s\n", glint::kVersionMajor, glint::kVersionMinor, glint::kVersionPatch,
                 ctx.info().name.c_str());

@@ -38,4 +38,17 @@ detail::OwnedImage make_poisoned(VkExtent2D extent, VkFormat format);
 /// True if every channel of every texel is finite (no NaN left from poisoning).
 bool all_finite(const CpuImage& image);
 
+/// The device extensions glint needs (VK_KHR_push_descriptor): tests that create a device for
+/// Context::adopt() enable these, as glint's own devices do.
+inline const char* const kGlintDeviceExtensions[] = {VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME};
+constexpr uint32_t kGlintDeviceExtensionCount = 1;
+
+/// `info` saying that its device was created with kGlintDeviceExtensions (true of context()'s
+/// device and of every device these tests create for adopt()).
+inline AdoptInfo with_glint_extensions(AdoptInfo info) {
+  info.enabled_extensions = kGlintDeviceExtensions;
+  info.enabled_extension_count = kGlintDeviceExtensionCount;
+  return info;
+}
+
 }  // namespace glint::test

@@ -20,8 +20,6 @@ namespace {
 
 struct DemoPipelines {
   detail::ComputePipeline pipeline;
-  detail::DescriptorArena arena;
-  std::map<VkImageView, VkDescriptorSet> sets;
 };
 
 // One per (context, format), owned by the context.
@@ -39,7 +37,6 @@ DemoPipelines& pipelines_for(const Context& context, VkFormat format) {
     d.push_constant_bytes = sizeof(StarfieldPush);
     d.workgroup = detail::choose_workgroup_2d(context);
     dp->pipeline = detail::ComputePipeline(context, d);
-    dp->arena = detail::DescriptorArena(context, 16);
     return dp;
   });
 }
@@ -61,10 +58,6 @@ void record_starfield(const Context& context, VkCommandBuffer cmd, Image& target
     throw Error(ErrorCode::missing_usage, "record_starfield: target lacks VK_IMAGE_USAGE_STORAGE_BIT usage");
   }
   DemoPipelines& dp = pipelines_for(context, target.format);
-  auto it = dp.sets.find(target.view);
-  if (it == dp.sets.end()) {
-    it = dp.sets.emplace(target.view, dp.arena.make_set(dp.pipeline, {{target.view, VK_IMAGE_LAYOUT_GENERAL}})).first;
-  }
   StarfieldPush p{};
   p.width = static_cast<int32_t>(target.extent.width);
   p.height = static_cast<int32_t>(target.extent.height);
@@ -82,7 +75,7 @@ void record_starfield(const Context& context, VkCommandBuffer cmd, Image& target
   detail::Barriers b;
   b.use(target, VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
   b.flush(cmd);
-  dp.pipeline.dispatch(cmd, it->second, p, target.extent.width, target.extent.height);
+  dp.pipeline.dispatch(cmd, {{target.view, VK_IMAGE_LAYOUT_GENERAL}}, p, target.extent.width, target.extent.height);
   if (profiler) profiler->mark(cmd, "demo starfield");
 }
 
