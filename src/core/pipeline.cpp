@@ -102,14 +102,34 @@ VkDescriptorSetLayout make_push_set_layout(const Context& context, const std::ve
   return layout;
 }
 
-void push_descriptors(PFN_vkCmdPushDescriptorSetKHR push, VkCommandBuffer cmd, VkPipelineBindPoint bind_point,
-                      VkPipelineLayout layout, const std::vector<VkDescriptorType>& types, const Bindings& bindings,
-                      const std::string& who) {
+void check_bindings(const std::vector<VkDescriptorType>& types, const Bindings& bindings, const std::string& who) {
   const uint32_t n = bindings.size();
   if (n != types.size()) {
     throw Error(ErrorCode::invalid_argument,
                 concat("internal: ", who, " has ", types.size(), " bindings; ", n, " descriptors were given"));
   }
+  for (uint32_t i = 0; i < n; ++i) {
+    const Binding& b = bindings[i];
+    if (types[i] == VK_DESCRIPTOR_TYPE_STORAGE_BUFFER || types[i] == VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER) {
+      if (!b.buffer.buffer || b.buffer.size == 0) {
+        throw Error(ErrorCode::invalid_argument,
+                    concat("internal: ", who, " binding ", i, " needs a buffer and a size"));
+      }
+    } else {
+      const bool sampler = types[i] == VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
+      if (!b.view || (sampler && !b.sampler)) {
+        throw Error(ErrorCode::invalid_argument, concat("internal: ", who, " binding ", i,
+                                                        sampler ? " needs a view and a sampler" : " needs a view"));
+      }
+    }
+  }
+}
+
+void push_descriptors(PFN_vkCmdPushDescriptorSetKHR push, VkCommandBuffer cmd, VkPipelineBindPoint bind_point,
+                      VkPipelineLayout layout, const std::vector<VkDescriptorType>& types, const Bindings& bindings,
+                      const std::string& who) {
+  check_bindings(types, bindings, who);
+  const uint32_t n = bindings.size();
   // Everything lives on this stack frame until vkCmdPushDescriptorSetKHR has copied it (the
   // command records the descriptors themselves, Vulkan spec "Push Descriptor Updates").
   std::array<VkWriteDescriptorSet, kMaxBindings> writes;
@@ -123,18 +143,9 @@ void push_descriptors(PFN_vkCmdPushDescriptorSetKHR push, VkCommandBuffer cmd, V
     w.descriptorCount = 1;
     w.descriptorType = types[i];
     if (types[i] == VK_DESCRIPTOR_TYPE_STORAGE_BUFFER || types[i] == VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER) {
-      if (!b.buffer.buffer || b.buffer.size == 0) {
-        throw Error(ErrorCode::invalid_argument,
-                    concat("internal: ", who, " binding ", i, " needs a buffer and a size"));
-      }
       buffers[i] = {b.buffer.buffer, b.buffer.offset, b.buffer.size};
       w.pBufferInfo = &buffers[i];
     } else {
-      const bool sampler = types[i] == VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
-      if (!b.view || (sampler && !b.sampler)) {
-        throw Error(ErrorCode::invalid_argument, concat("internal: ", who, " binding ", i,
-                                                        sampler ? " needs a view and a sampler" : " needs a view"));
-      }
       images[i] = {b.sampler, b.view, b.layout};
       w.pImageInfo = &images[i];
     }
@@ -180,6 +191,7 @@ void ComputePipeline::bind_and_push(VkCommandBuffer cmd, const Bindings& binding
     throw Error(ErrorCode::invalid_argument,
                 concat("kernel ", id_, ": push constants are ", bytes, " bytes, pipeline expects ", push_bytes_));
   }
+  check_bindings(bindings_, bindings, id_);  // before anything is recorded
   count_recorded_command();
   vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, compiled_->pipeline);
   push_descriptors(compiled_->push_descriptor_set, cmd, VK_PIPELINE_BIND_POINT_COMPUTE, compiled_->layout, bindings_,

@@ -69,9 +69,13 @@ class Bindings {
 VkDescriptorSetLayout make_push_set_layout(const Context& context, const std::vector<VkDescriptorType>& types,
                                            VkShaderStageFlags stages);
 
+/// Throws Error(invalid_argument) naming `who` unless `bindings` has one descriptor per type of
+/// `types`, each with what its type needs (a view, a sampler too, or a buffer with a size).
+void check_bindings(const std::vector<VkDescriptorType>& types, const Bindings& bindings, const std::string& who);
+
 /// Records `push` (the context's vkCmdPushDescriptorSetKHR, ContextState::cmd_push_descriptor_set)
-/// for set 0 of `layout` at `bind_point`: binding i of type types[i] gets bindings[i]. `who` names the pipeline in the
-/// Error thrown, before anything is recorded, when the count differs or a descriptor is null.
+/// for set 0 of `layout` at `bind_point`: binding i of type types[i] gets bindings[i]. Checks them
+/// first (check_bindings()), so nothing is recorded when they are wrong.
 void push_descriptors(PFN_vkCmdPushDescriptorSetKHR push, VkCommandBuffer cmd, VkPipelineBindPoint bind_point,
                       VkPipelineLayout layout, const std::vector<VkDescriptorType>& types, const Bindings& bindings,
                       const std::string& who);

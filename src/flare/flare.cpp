@@ -483,6 +483,8 @@ void LensFlare::record_raster(VkCommandBuffer cmd, Image& color, Buffer& instanc
         concat("LensFlare::record_raster: ", m.raster_unavailable, "; use record_compute"));
   }
   if (!config.enabled || config.intensity == 0.0f) return;  // adds nothing: record nothing
+  const detail::Bindings bindings{instances, m.atlas_binding()};
+  detail::check_bindings(m.raster_types, bindings, "flare raster");  // before anything is recorded
   m.record_setup(cmd);
 
   detail::Barriers b;
@@ -511,7 +513,7 @@ void LensFlare::record_raster(VkCommandBuffer cmd, Image& color, Buffer& instanc
   vkCmdSetViewport(cmd, 0, 1, &viewport);
   vkCmdSetScissor(cmd, 0, 1, &scissor);
   detail::push_descriptors(m.context->state().cmd_push_descriptor_set, cmd, VK_PIPELINE_BIND_POINT_GRAPHICS,
-                           m.raster_layout, m.raster_types, {instances, m.atlas_binding()}, "flare raster");
+                           m.raster_layout, m.raster_types, bindings, "flare raster");
   const GlintFlarePush p = m.push(config);
   vkCmdPushConstants(cmd, m.raster_layout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof(p), &p);
   vkCmdDrawIndirect(cmd, indirect.buffer, indirect.offset + offsetof(GlintFlareIndirect, vertex_count), 1,
