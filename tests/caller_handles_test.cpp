@@ -21,11 +21,11 @@
 #include <vector>
 
 #include "core/barriers.h"
-#include "core/transfer.h"
 #include "reference/bloom_reference.h"
 #include "reference/blur_reference.h"
+#include "support/environment.h"
 #include "support/gpu_test.h"
-#include "tooling/environment.h"
+#include "support/transfer.h"
 
 namespace glint::test {
 namespace {
