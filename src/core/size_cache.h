@@ -1,5 +1,5 @@
-// The per-size resources of an effect (pyramid images, their descriptor sets, planned steps),
-// kept for every size the effect is recorded at until no submitted work can use them.
+// The per-size resources of an effect (pyramid images, planned steps; no descriptor set: those are
+// pushed per dispatch), kept for every size the effect is recorded at until no submitted work can use them.
 //
 // Lifetime rule (Context::begin_frame() documents the caller's side): every slot notes the last
 // frame it was recorded into a caller's command buffer (gpu_frame) and the serial of the last
