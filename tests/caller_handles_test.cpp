@@ -10,6 +10,7 @@
 #include <glint/bloom.h>
 #include <glint/blur.h>
 #include <glint/lod.h>
+#include <glint/occlusion.h>
 
 #include <algorithm>
 #include <cmath>
@@ -17,12 +18,14 @@
 #include <cstring>
 #include <limits>
 #include <memory>
+#include <random>
 #include <string>
 #include <vector>
 
 #include "core/barriers.h"
 #include "reference/bloom_reference.h"
 #include "reference/blur_reference.h"
+#include "reference/occlusion_reference.h"
 #include "support/environment.h"
 #include "support/gpu_test.h"
 #include "support/transfer.h"
@@ -156,6 +159,57 @@ TEST_F(CallerHandlesTest, LodBatchIsCorrectWithNewBuffersOfDestroyedOnesHandles)
             << name_of(*ctx) << ", round " << round << ", query " << i;
       }
     }
+  }
+}
+
+// Hi-Z: a new depth image (R32F, sampled) each round, same size, so its view may get a destroyed
+// one's handle; the pyramid (NaN-poisoned first) must equal the float64 reference bit for bit at
+// every level, as in occlusion_test.cpp: each texel is the max (min when reversed) of exact inputs.
+// 1030x771 builds 9 levels, so both dispatches (stream pass, tile pass from level 2) run.
+TEST_F(CallerHandlesTest, HiZPyramidIsCorrectWithNewViewsOfDestroyedOnesHandles) {
+  for (const Context* ctx : contexts()) {
+    HiZConfig config;
+    config.extent = {1030, 771};
+    config.format = VK_FORMAT_R32_SFLOAT;
+    HiZPyramid hiz(*ctx, config);
+    const uint32_t levels = hiz.levels();
+    ASSERT_GT(levels, 2u);
+    std::vector<VkImageView> before, now;
+    uint32_t reuses = 0;
+    for (uint32_t round = 0; round < 3; ++round) {
+      std::mt19937 rng(300 + round);
+      std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+      reference::DepthImage depth{config.extent.width, config.extent.height,
+                                  std::vector<float>(size_t(config.extent.width) * config.extent.height)};
+      for (float& v : depth.depth) v = unit(rng);
+      detail::OwnedImage img(*ctx, config.extent, config.format,
+                             VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT);
+      detail::upload_r32(*ctx, img.state, depth.depth);
+      now = {img.state.view};
+      ctx->run_once([&](VkCommandBuffer cmd) {
+        detail::Barriers b;  // NaN in every level, so a level the pass did not write fails
+        b.use(hiz.image(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_PIPELINE_STAGE_2_CLEAR_BIT,
+              VK_ACCESS_2_TRANSFER_WRITE_BIT, levels);
+        b.flush(cmd);
+        VkClearColorValue nan{};
+        for (float& c : nan.float32) c = std::nanf("");
+        const VkImageSubresourceRange range{VK_IMAGE_ASPECT_COLOR_BIT, 0, levels, 0, 1};
+        vkCmdClearColorImage(cmd, hiz.image().image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, &nan, 1, &range);
+        hiz.record(cmd, img.state);
+      });
+      const auto ref = reference::hiz_pyramid(depth, false, levels);
+      for (uint32_t k = 1; k <= levels; ++k) {
+        const VkExtent2D e{std::max(1u, config.extent.width >> k), std::max(1u, config.extent.height >> k)};
+        const std::vector<float> gpu = detail::download_r32(*ctx, hiz.image(), k - 1, e, levels);
+        ASSERT_EQ(gpu.size(), ref[k - 1].depth.size());
+        size_t bad = 0;
+        for (size_t i = 0; i < gpu.size(); ++i) bad += std::memcmp(&gpu[i], &ref[k - 1].depth[i], 4) != 0;
+        EXPECT_EQ(bad, 0u) << name_of(*ctx) << ", round " << round << ", level " << k;
+      }
+      if (round > 0) reuses += reused(before, now);
+      before = now;
+    }
+    std::printf("hi-z, %s: %u view handles of destroyed views came back\n", name_of(*ctx).c_str(), reuses);
   }
 }
 
