@@ -92,7 +92,9 @@ struct ContextOptions {
   bool gpu_assisted_validation = false;
   /// The 2-D workgroup of every image kernel, for tuning benchmarks: 0x0 (default) lets each
   /// kernel choose from the device's limits; else W x H with W, H >= 1 and W * H at most
-  /// maxComputeWorkGroupInvocations (checked by create()).
+  /// maxComputeWorkGroupInvocations (checked by create()). Setting it also makes Bloom's
+  /// karis_smooth first step use its box-means kernel on CPU devices too (GPUs always do;
+  /// docs/BLOOM.md), which is how the tests reach that kernel on lavapipe.
   VkExtent2D workgroup_2d{0, 0};
   /// How many frames the caller may have submitted and not yet waited for (1 to 16): when
   /// Context::begin_frame() starts frame F, every command buffer recorded in frame
