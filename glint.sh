@@ -108,8 +108,29 @@ asan_test() {
 # have. CTest runs each test program as one entry, so the cases are picked by a gtest filter in
 # every GPU program (a program without a matching case runs nothing).
 GPU_AV_FILTER="*MatchesReference*:*MatchesItsReference*:*MatchesTheReference*:*MatchesTheFloat64*:*BatchKernelMatchesTheCppTwin*:*StatisticsAndResultsMatch*"
+# GPU-assisted validation in the validation layer Debian 12 ships (1.3.239) does not follow
+# descriptors pushed with vkCmdPushDescriptorSetKHR: its instrumented shaders take every pushed
+# descriptor for uninitialized, report "Descriptor index 0 is uninitialized" and skip the access,
+# so the kernels write nothing (reported upstream as KhronosGroup/Vulkan-ValidationLayers#5321).
+# glint pushes every descriptor, so this step runs only with a layer of 1.3.250 or later (a
+# release after that report was closed; check the layer's changelog before lowering it), and says
+# so when it is skipped. Plain validation with synchronization validation checks every test.
+GPU_AV_MIN_LAYER="1.3.250"
+validation_layer_version() {
+  local manifest
+  for manifest in /usr/share/vulkan/explicit_layer.d/VkLayer_khronos_validation.json \
+                  /etc/vulkan/explicit_layer.d/VkLayer_khronos_validation.json; do
+    [[ -f "$manifest" ]] && { sed -n 's/.*"api_version" *: *"\([0-9.]*\)".*/\1/p' "$manifest" | head -n1; return; }
+  done
+}
 gpu_assisted_tests() {
   local dir="$1"; shift
+  local have
+  have="$(validation_layer_version)"
+  if [[ -z "$have" || "$(printf '%s\n%s\n' "$GPU_AV_MIN_LAYER" "$have" | sort -V | head -n1)" != "$GPU_AV_MIN_LAYER" ]]; then
+    log "GPU-assisted validation skipped: the validation layer is ${have:-not found}, GPU-AV follows pushed descriptors from $GPU_AV_MIN_LAYER on"
+    return 0
+  fi
   log "GPU-assisted validation: the reference comparisons"
   local programs=()
   mapfile -t programs < <(ctest --test-dir "$dir" -N -L gpu | sed -n 's/^ *Test *#[0-9]*: \([a-z0-9_]*_test\)$/\1/p')
