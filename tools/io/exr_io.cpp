@@ -192,6 +192,19 @@ auto guarded(const std::string& path, const char* action, F&& body) -> decltype(
   }
 }
 
+// Opens `path` for reading with the size limits and file checks every reader needs, checks its
+// data window and runs `body(file, window)` guarded as above.
+template <typename F>
+auto read_guarded(const std::string& path, F&& body) {
+  limit_openexr_sizes();
+  check_input_file(path);
+  return guarded(path, "read OpenEXR file", [&] {
+    Imf::InputFile file(path.c_str());
+    const Window w = checked_window(path, file.header());
+    return body(file, w);
+  });
+}
+
 }  // namespace
 
 void check_writable_image(const std::string& path, const CpuImage& image) {
@@ -212,21 +225,11 @@ void check_writable_image(const std::string& path, const CpuImage& image) {
 }
 
 ExrExtent read_exr_extent(const std::string& path) {
-  limit_openexr_sizes();
-  check_input_file(path);
-  return guarded(path, "read OpenEXR file", [&] {
-    Imf::InputFile file(path.c_str());
-    const Window w = checked_window(path, file.header());
-    return ExrExtent{w.width, w.height};
-  });
+  return read_guarded(path, [&](Imf::InputFile&, const Window& w) { return ExrExtent{w.width, w.height}; });
 }
 
 CpuImage read_exr(const std::string& path) {
-  limit_openexr_sizes();
-  check_input_file(path);
-  return guarded(path, "read OpenEXR file", [&] {
-    Imf::InputFile file(path.c_str());
-    const Window w = checked_window(path, file.header());
+  return read_guarded(path, [&](Imf::InputFile& file, const Window& w) {
     if (!file.isComplete()) fail(path, "truncated or incomplete OpenEXR file (missing pixel data)");
     const Imf::ChannelList& channels = file.header().channels();
 
@@ -274,11 +277,7 @@ CpuImage read_exr(const std::string& path) {
 }
 
 ExrChannel read_exr_channel(const std::string& path, const std::string& preferred_name) {
-  limit_openexr_sizes();
-  check_input_file(path);
-  return guarded(path, "read OpenEXR file", [&] {
-    Imf::InputFile file(path.c_str());
-    const Window w = checked_window(path, file.header());
+  return read_guarded(path, [&](Imf::InputFile& file, const Window& w) {
     if (!file.isComplete()) fail(path, "truncated or incomplete OpenEXR file (missing pixel data)");
     const Imf::ChannelList& channels = file.header().channels();
     if (channels.begin() == channels.end()) fail(path, "the file has no channels");
