@@ -1,6 +1,6 @@
 # Blur (include/glint/blur.h, docs/BLUR.md): the planner (blur_plan.h: taps, error model, cost model,
 # border padding, plans), the cost model's measurement (blur_calibration) and the driver.
-set(GLINT_EFFECT_SOURCES blur.cpp blur_plan.cpp blur_taps.cpp blur_error_model.cpp blur_cost_model.cpp blur_border.cpp
+set(GLINT_EFFECT_SOURCES gaussian_blur.cpp blur_pyramid.cpp blur_steps.cpp blur_plan.cpp blur_taps.cpp blur_error_model.cpp blur_cost_model.cpp blur_border.cpp
                           blur_calibration.cpp)
 set(GLINT_EFFECT_KERNELS
   "shaders/blur_level|rgba16f|DST_FORMAT=rgba16f"

@@ -13,6 +13,8 @@
 #include <utility>
 #include <vector>
 
+#include "core/formats.h"
+
 namespace glint::detail {
 
 struct ContextState {
@@ -111,10 +113,10 @@ struct ContextState {
   std::mutex sampler_mutex;
   std::map<std::tuple<int, int, float>, VkSampler> samplers;
 
-  /// optimalTilingFeatures of each format asked about (core/formats.h, format_features()): queried
-  /// once per format, since effects check them on every record().
-  std::mutex format_mutex;
-  std::map<VkFormat, VkFormatFeatureFlags2> format_features;
+  /// optimalTilingFeatures of each format of kCheckedFormats (core/formats.h, format_features()),
+  /// read by fill_info() when the context is made and never written afterwards: effects look them
+  /// up on every record(), from any thread, without a lock.
+  FormatFeatureTable format_features{};
 };
 
 /// Validation messages seen by every context of the process, including those that arrive while a

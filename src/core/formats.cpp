@@ -1,24 +1,32 @@
 #include "core/formats.h"
 
 #include <cfloat>
-#include <mutex>
 
 #include "core/check.h"
 #include "core/context_state.h"
 
 namespace glint::detail {
 
+FormatFeatureTable fill_format_features(VkPhysicalDevice physical_device) {
+  FormatFeatureTable table{};
+  for (size_t i = 0; i < kCheckedFormats.size(); ++i) {
+    // VkFormatProperties3 (Vulkan 1.3) reports the 64-bit flags, among them
+    // STORAGE_WRITE_WITHOUT_FORMAT, which the 32-bit VkFormatProperties cannot.
+    VkFormatProperties3 p3{VK_STRUCTURE_TYPE_FORMAT_PROPERTIES_3};
+    VkFormatProperties2 p2{VK_STRUCTURE_TYPE_FORMAT_PROPERTIES_2, &p3};
+    vkGetPhysicalDeviceFormatProperties2(physical_device, kCheckedFormats[i], &p2);
+    table[i] = p3.optimalTilingFeatures;
+  }
+  return table;
+}
+
 VkFormatFeatureFlags2 format_features(const Context& context, VkFormat format) {
-  auto& s = context.state();
-  std::lock_guard<std::mutex> lock(s.format_mutex);
-  auto it = s.format_features.find(format);
-  if (it != s.format_features.end()) return it->second;
-  // VkFormatProperties3 (Vulkan 1.3) reports the 64-bit flags, among them
-  // STORAGE_WRITE_WITHOUT_FORMAT, which the 32-bit VkFormatProperties cannot.
-  VkFormatProperties3 p3{VK_STRUCTURE_TYPE_FORMAT_PROPERTIES_3};
-  VkFormatProperties2 p2{VK_STRUCTURE_TYPE_FORMAT_PROPERTIES_2, &p3};
-  vkGetPhysicalDeviceFormatProperties2(s.physical_device, format, &p2);
-  return s.format_features[format] = p3.optimalTilingFeatures;
+  for (size_t i = 0; i < kCheckedFormats.size(); ++i) {
+    if (kCheckedFormats[i] == format) return context.state().format_features[i];
+  }
+  throw Error(ErrorCode::unsupported_format,
+              concat("format ", format_name(format), " is none of those glint checks for a device: ",
+                     float_color_formats(), ", a depth format of HiZConfig::format or VK_FORMAT_R32_SFLOAT"));
 }
 
 bool is_float_color(VkFormat format) {

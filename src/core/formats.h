@@ -6,11 +6,34 @@
 
 #include <glint/glint.h>
 
+#include <array>
 #include <string>
 
 namespace glint::detail {
 
-/// optimalTilingFeatures of `format` on the context's device (queried once per format, cached).
+/// Every format an effect accepts for a caller image: the float colour formats below
+/// (is_float_color(); LensFlare's RGBA ones among them) and the formats HiZConfig::format accepts
+/// (is_depth_format() and R32_SFLOAT). Their features are read from the device once, when the
+/// context is made (fill_format_features()), so that record() only looks them up.
+inline constexpr std::array<VkFormat, 12> kCheckedFormats = {
+    VK_FORMAT_R16G16B16_SFLOAT,    VK_FORMAT_R16G16B16A16_SFLOAT,     VK_FORMAT_R32G32B32_SFLOAT,
+    VK_FORMAT_R32G32B32A32_SFLOAT, VK_FORMAT_B10G11R11_UFLOAT_PACK32, VK_FORMAT_E5B9G9R9_UFLOAT_PACK32,
+    VK_FORMAT_D16_UNORM,           VK_FORMAT_X8_D24_UNORM_PACK32,     VK_FORMAT_D24_UNORM_S8_UINT,
+    VK_FORMAT_D32_SFLOAT,          VK_FORMAT_D32_SFLOAT_S8_UINT,      VK_FORMAT_R32_SFLOAT,
+};
+
+/// optimalTilingFeatures of each of kCheckedFormats, in its order.
+using FormatFeatureTable = std::array<VkFormatFeatureFlags2, kCheckedFormats.size()>;
+
+/// Queries the optimal-tiling features of every format of kCheckedFormats on `physical_device`
+/// (vkGetPhysicalDeviceFormatProperties2 with VkFormatProperties3). Called once per context, at
+/// Context::create or Context::adopt.
+FormatFeatureTable fill_format_features(VkPhysicalDevice physical_device);
+
+/// optimalTilingFeatures of `format` on the context's device, from the table the context filled
+/// when it was made: no Vulkan call, no lock, no allocation (the table never changes afterwards, so
+/// any thread may read it). Throws Error(unsupported_format) for a format outside kCheckedFormats,
+/// which callers refuse by name before asking.
 VkFormatFeatureFlags2 format_features(const Context& context, VkFormat format);
 
 /// The HDR colour formats image effects take: float formats with at least red, green and blue

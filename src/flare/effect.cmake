@@ -1,6 +1,7 @@
-# Lens flares (include/glint/flare.h, docs/FLARE.md): the flare effect, the flare pass and the
+# Lens flares (include/glint/flare.h, docs/FLARE.md): the flare effect (flare.cpp: setup and checks;
+# flare_raster.cpp and flare_compute.cpp: the two draws), the flare pass and the
 # layout checks of the GPU types (flare_types_check.cpp).
-set(GLINT_EFFECT_SOURCES flare.cpp flare_pass.cpp flare_types_check.cpp)
+set(GLINT_EFFECT_SOURCES flare.cpp flare_raster.cpp flare_compute.cpp flare_pass.cpp flare_types_check.cpp)
 set(GLINT_EFFECT_KERNELS
   "shaders/flare_atlas|main|"
   "shaders/flare_gather_args|main|"

@@ -1,6 +1,6 @@
 # Visibility (docs/OCCLUSION.md): the Hi-Z pyramid and the light cull (include/glint/occlusion.h,
-# occlusion.cpp) and the object cull (include/glint/object_cull.h, object_cull.cpp).
-set(GLINT_EFFECT_SOURCES occlusion.cpp object_cull.cpp)
+# hiz_pyramid.cpp, light_culler.cpp) and the object cull (include/glint/object_cull.h, object_cull.cpp).
+set(GLINT_EFFECT_SOURCES hiz_pyramid.cpp light_culler.cpp object_cull.cpp)
 # compact_scan_tiles and compact_scatter are the ordered compaction's own kernels (both culls use
 # them through src/core/compaction.h; its shared GLSL is src/core/shaders/compact.glsl).
 set(GLINT_EFFECT_KERNELS

@@ -1,6 +1,5 @@
-// Blur drivers (docs/BLUR.md): BlurPyramid (three cumulative levels) and GaussianBlur. Both are a list of
-// steps planned once per size (pipeline, push constants, image in, image out)
-// that record() walks, writing the barriers between them and pushing each step's descriptors.
+// GaussianBlur (docs/BLUR.md): the plan the planner chooses per size (separable lines, fused
+// levels, pyramid or dual), turned into steps (blur_steps.h) that record() walks.
 #include <glint/blur.h>
 
 #include <algorithm>
@@ -12,6 +11,7 @@
 #include <utility>
 
 #include "blur/blur_plan.h"
+#include "blur/blur_steps.h"
 #include "blur/shaders/blur_params.h"
 #include "core/barriers.h"
 #include "core/check.h"
@@ -23,6 +23,7 @@
 
 namespace glint {
 
+using namespace blur_steps;
 using detail::check_range;
 using detail::concat;
 
@@ -51,18 +52,6 @@ const char* blur_method_name(BlurMethod method) {
 }
 
 const char* to_string(BlurMethod method) { return blur_method_name(method); }
-
-void BlurPyramidConfig::validate() const {
-  const char* names[3] = {"BlurPyramidConfig::sigma_texels[0]", "BlurPyramidConfig::sigma_texels[1]",
-                          "BlurPyramidConfig::sigma_texels[2]"};
-  for (int k = 0; k < 3; ++k) check_range(names[k], sigma_texels[k], 0.3, 4.0);
-  const auto p = static_cast<uint32_t>(precision);
-  if (p > 1) {
-    throw Error(ErrorCode::invalid_argument,
-                concat("BlurPyramidConfig::precision = ", p, " is not a Precision: accepted fp16, fp32"));
-  }
-}
-
 void GaussianBlurConfig::validate() const {
   check_range("GaussianBlurConfig::sigma_px", sigma_px, 0.5, 64.0);
   check_range("GaussianBlurConfig::max_relative_error", max_relative_error, 1e-4, 1.0);
@@ -102,55 +91,8 @@ void GaussianBlurConfig::validate() const {
 
 namespace {
 
-constexpr VkPipelineStageFlags2 kCompute = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
-constexpr VkAccessFlags2 kSampled = VK_ACCESS_2_SHADER_SAMPLED_READ_BIT;
-constexpr VkAccessFlags2 kStorageWrite = VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT;
-constexpr VkImageLayout kGeneral = VK_IMAGE_LAYOUT_GENERAL;
-constexpr VkImageLayout kReadOnly = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
 constexpr uint32_t kLineSegment = 256;  // blur_line.comp: outputs per workgroup along the line
 using blur_plan::kFusedMaxRadius;       // one constant for the planner and the driver
-
-VkFormat precision_format(Precision p) {
-  return p == Precision::fp32 ? VK_FORMAT_R32G32B32A32_SFLOAT : VK_FORMAT_R16G16B16A16_SFLOAT;
-}
-// The fused kernel's tile: workgroup (x, y) with `rows` outputs per invocation along y.
-struct FusedShape {
-  detail::Workgroup2D workgroup{8, 8};
-  uint32_t rows = 1;
-};
-
-// Shared memory of src/blur/shaders/blur_level.comp: the loaded tile + apron and the horizontal pass's
-// rows, 16 bytes a texel (8 packed as fp16).
-uint32_t fused_shared_bytes(FusedShape s, uint32_t radius, bool half_shared) {
-  const uint32_t w = s.workgroup.x, h = s.workgroup.y * s.rows;
-  const auto padded = [](uint32_t n) { return n + (17 - n % 16) % 16; };  // LOAD_S, ROW_S
-  return (half_shared ? 8 : 16) * (padded(w + 2 * radius) * (h + 2 * radius) + padded(w) * (h + 2 * radius));
-}
-
-// The largest tile whose shared memory fits the device (CONTRIBUTING.md, "Device limits"): larger tiles re-read less
-// apron. CPU devices (lavapipe) get 8-row-high tiles, which keep their per-thread groups small.
-FusedShape fused_shape(const DeviceInfo& info, uint32_t radius, bool half_shared = false) {
-  static const FusedShape gpu[] = {{{32, 8}, 4}, {{32, 8}, 2}, {{32, 8}, 1}, {{16, 8}, 2}, {{16, 8}, 1}, {{8, 8}, 1}};
-  static const FusedShape cpu[] = {{{16, 8}, 1}, {{8, 8}, 1}};  // widths are multiples of 4 (RUN)
-  const bool is_cpu = info.type == VK_PHYSICAL_DEVICE_TYPE_CPU;
-  const FusedShape* begin = is_cpu ? cpu : gpu;
-  const FusedShape* end = is_cpu ? cpu + 2 : gpu + 6;
-  for (const FusedShape* s = begin; s != end; ++s) {
-    if (s->workgroup.x * s->workgroup.y <= info.max_workgroup_invocations &&
-        fused_shared_bytes(*s, radius, half_shared) <= info.max_shared_memory_bytes) {
-      return *s;
-    }
-  }
-  throw Error(ErrorCode::no_device,
-              concat("blur radius ", radius, " needs ", fused_shared_bytes({{8, 8}, 1}, radius, half_shared),
-                     " bytes of shared memory; device '", info.name, "' has ", info.max_shared_memory_bytes));
-}
-
-// Largest value a texel may hold so that every image of the chain stays finite (docs/BLUR.md):
-// fp32 keeps headroom for the 4-texel sums the kernels form before scaling.
-float max_value_for(VkFormat a, VkFormat b) {
-  return std::min({detail::format_max(a), detail::format_max(b), 1.0e37f});
-}
 
 // blur_plan::Storage's unit of a store into `format`: one ulp of its mantissa, relative.
 double store_unit(VkFormat format) {
@@ -165,144 +107,6 @@ double store_unit(VkFormat format) {
     default:
       return blur_plan::store_unit(10);  // fp16
   }
-}
-
-// The kernel variant that stores `format`: its GLSL qualifier's, else "noformat" (which
-// detail::check_color_write() accepted for the caller's output before any pipeline is made).
-std::string store_variant(VkFormat format) {
-  const char* q = detail::qualified_variant(format);
-  return q ? q : "noformat";
-}
-
-// Throws Error(unsupported_size) "<where>: <role> extent WxH is out of range: accepted 1 to N on
-// each side" (role may be empty). The message is built only when it is thrown.
-void check_extent_named(const Context& context, VkExtent2D e, const char* where, const char* role) {
-  const uint32_t max_dim = context.info().max_image_dimension_2d;
-  if (e.width == 0 || e.height == 0 || e.width > max_dim || e.height > max_dim) {
-    throw Error(ErrorCode::unsupported_size,
-                concat(where, ": ", role, *role ? " " : "", "extent ", e.width, "x", e.height,
-                       " is out of range: accepted 1 to ", max_dim, " on each side"));
-  }
-}
-
-void check_extent(const Context& context, VkExtent2D e, const char* where) {
-  check_extent_named(context, e, where, "");
-}
-
-void check_image(const Context& context, const Image& img, const char* where, const char* role, VkImageUsageFlags need,
-                 const char* need_name) {
-  if (!img.image || !img.view)
-    throw Error(ErrorCode::invalid_argument, concat(where, ": ", role, " image and view must be non-null"));
-  detail::check_layers(img, where, role);
-  if (need & VK_IMAGE_USAGE_STORAGE_BIT) {
-    detail::check_color_write(context, img.format, where, role);
-  } else {
-    detail::check_color_read(context, img.format, where, role);
-  }
-  check_extent_named(context, img.extent, where, role);
-  if ((img.usage & need) != need)
-    throw Error(ErrorCode::missing_usage, concat(where, ": ", role, " image lacks ", need_name, " usage"));
-}
-
-// Which image a step reads or writes: the caller's input or output, or an owned image.
-constexpr int kInput = -1;
-constexpr int kOutput = -2;
-
-struct Step {
-  const detail::ComputePipeline* pipeline = nullptr;
-  int src = kInput;
-  int dst = kOutput;
-  BlurPush push{};
-  uint32_t invocations_x = 0;  // dispatch covers these (the pipeline divides by its workgroup)
-  uint32_t invocations_y = 0;
-  bool sampler = false;                       // binding 0 is a combined image sampler
-  const detail::OwnedBuffer* taps = nullptr;  // binding 2
-  std::string label;
-};
-
-// Pipelines keyed by what specializes them, shared by every size of one effect (a std::map, so the
-// steps' pointers stay valid while the effect lives).
-using PipelineMap = std::map<std::string, detail::ComputePipeline>;
-
-// The program of one size: owned images and steps. Each step pushes its descriptors when recorded.
-struct StepProgram {
-  const Context* context = nullptr;
-  PipelineMap* pipelines = nullptr;
-  std::vector<detail::OwnedImage> images;
-  std::vector<detail::OwnedBuffer> tap_buffers;
-  std::vector<Step> steps;
-  VkSampler sampler = VK_NULL_HANDLE;  // bilinear, for the linear-sampling variant (owned by the context)
-
-  const detail::ComputePipeline& pipeline(const std::string& kernel, VkFormat dst_format, detail::Workgroup2D wg,
-                                          std::vector<uint32_t> spec, std::vector<VkDescriptorType> bindings) {
-    std::string key = concat(kernel, "_", store_variant(dst_format), "/", wg.x, "x", wg.y);
-    for (uint32_t v : spec) key += concat("/", v);
-    auto it = pipelines->find(key);
-    if (it != pipelines->end()) return it->second;
-    detail::PipelineDesc d;
-    d.kernel_id = concat(kernel, "_", store_variant(dst_format));
-    d.bindings = std::move(bindings);
-    d.push_constant_bytes = sizeof(BlurPush);
-    d.workgroup = wg;
-    d.specialization = std::move(spec);
-    return pipelines->emplace(key, detail::ComputePipeline(*context, d)).first->second;
-  }
-
-  // Owned images can also be copied from (BlurPyramid hands its levels to the caller).
-  int add_image(VkExtent2D e, VkFormat f) {
-    images.emplace_back(*context, e, f,
-                        VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT);
-    return static_cast<int>(images.size()) - 1;
-  }
-
-  const detail::OwnedBuffer* add_taps(const std::vector<float>& values) {
-    tap_buffers.emplace_back(*context, values.size() * sizeof(float), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, true);
-    std::memcpy(tap_buffers.back().mapped(), values.data(), values.size() * sizeof(float));
-    tap_buffers.back().flush();
-    return &tap_buffers.back();
-  }
-
-  // The descriptors of step `s`: source (with the bilinear sampler for the linear-sampling
-  // variant), destination, and the tap weights when the step has them.
-  detail::Bindings bindings_of(const Step& s, const Image& src, const Image& dst) const {
-    detail::Bindings b{{src.view, s.src == kInput ? kReadOnly : kGeneral, s.sampler ? sampler : VK_NULL_HANDLE},
-                       {dst.view, kGeneral}};
-    if (s.taps) {
-      Buffer taps;
-      taps.buffer = s.taps->buffer();
-      taps.size = s.taps->size();
-      b.push_back(taps);
-    }
-    return b;
-  }
-
-  void record(VkCommandBuffer cmd, Image& input, Image* output, Profiler* profiler) {
-    detail::Barriers b;
-    for (size_t i = 0; i < steps.size(); ++i) {
-      const Step& s = steps[i];
-      Image& src = s.src == kInput ? input : images[s.src].state;
-      Image& dst = s.dst == kOutput ? *output : images[s.dst].state;
-      b.use(src, s.src == kInput ? kReadOnly : kGeneral, kCompute, kSampled);
-      b.use(dst, kGeneral, kCompute, kStorageWrite);
-      b.flush(cmd);
-      s.pipeline->dispatch(cmd, bindings_of(s, src, dst), s.push, s.invocations_x, s.invocations_y);
-      if (profiler) profiler->mark(cmd, s.label);
-    }
-  }
-};
-
-BlurPush make_push(VkExtent2D src, VkExtent2D dst, uint32_t flags, float max_value) {
-  BlurPush p{};
-  p.src_width = static_cast<int32_t>(src.width);
-  p.src_height = static_cast<int32_t>(src.height);
-  p.dst_width = static_cast<int32_t>(dst.width);
-  p.dst_height = static_cast<int32_t>(dst.height);
-  p.max_value = max_value;
-  p.flags = flags;
-  p.offset = 1.0f;
-  p.ratio_x = static_cast<float>(src.width) / static_cast<float>(dst.width);
-  p.ratio_y = static_cast<float>(src.height) / static_cast<float>(dst.height);
-  return p;
 }
 
 // A padded chain's first step (docs/BLUR.md "Borders"): it reads the caller's input, `input`
@@ -326,191 +130,7 @@ void write_padded_output(Step& s, VkExtent2D output, const blur_plan::Padding& p
   s.invocations_y = output.height;
 }
 
-VkExtent2D half_extent(VkExtent2D e) { return {blur_plan::half_size(e.width), blur_plan::half_size(e.height)}; }
-
-// A fused level-blur step B(src -> dst, sigma) (docs/BLUR.md); sigma 0 is the area downsample alone.
-// `binomial` picks the pyramid method's downsample over the area average (docs/BLUR.md).
-Step fused_step(StepProgram& prog, const DeviceInfo& info, int src, int dst, VkExtent2D src_size, VkExtent2D dst_size,
-                VkFormat dst_format, double sigma, double truncation, bool binomial, uint32_t flags, float max_value,
-                std::string label) {
-  const std::vector<double> w = blur_plan::gaussian_half_taps(sigma, truncation);
-  const uint32_t radius = static_cast<uint32_t>(w.size()) - 1;
-  if (radius > kFusedMaxRadius)
-    throw Error(ErrorCode::invalid_argument, concat("blur sigma ", sigma, " needs radius ", radius,
-                                                    "; the fused kernel takes at most ", kFusedMaxRadius));
-  // Where the result is stored as fp16, the shared copies may be too (half the shared traffic).
-  const bool half_shared = dst_format == VK_FORMAT_R16G16B16A16_SFLOAT;
-  const FusedShape shape = fused_shape(info, radius, half_shared);
-  // The source read, fixed per pipeline so each variant compiles only its own path.
-  const bool same = src_size.width == dst_size.width && src_size.height == dst_size.height;
-  const bool exact_half = src_size.width == 2 * dst_size.width && src_size.height == 2 * dst_size.height;
-  const uint32_t mode = binomial ? 3u : same ? 0u : exact_half ? 1u : 2u;
-  Step s;
-  // Prefetching the load step (shaders/blur_level.comp, PREFETCH) pays on GPUs only.
-  const uint32_t prefetch = info.type == VK_PHYSICAL_DEVICE_TYPE_CPU ? 0u : 1u;
-  s.pipeline = &prog.pipeline("blur_level", dst_format, shape.workgroup,
-                              {shape.rows, radius, mode, half_shared ? 1u : 0u, prefetch},
-                              {VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
-  s.src = src;
-  s.dst = dst;
-  s.push = make_push(src_size, dst_size, flags, max_value);
-  for (uint32_t t = 0; t <= radius; ++t) s.push.weights[t] = static_cast<float>(w[t]);
-  s.invocations_x = dst_size.width;
-  s.invocations_y = (dst_size.height + shape.rows - 1) / shape.rows;
-  s.label = std::move(label);
-  return s;
-}
-
-// A plain per-texel step (upsample, dual down/up) with 2D workgroups.
-Step simple_step(StepProgram& prog, const char* kernel, int src, int dst, VkExtent2D src_size, VkExtent2D dst_size,
-                 VkFormat dst_format, uint32_t flags, float max_value, std::string label,
-                 std::vector<VkDescriptorType> bindings = {VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE,
-                                                           VK_DESCRIPTOR_TYPE_STORAGE_IMAGE}) {
-  Step s;
-  s.pipeline = &prog.pipeline(kernel, dst_format, detail::choose_workgroup_2d(*prog.context), {}, std::move(bindings));
-  s.src = src;
-  s.dst = dst;
-  s.push = make_push(src_size, dst_size, flags, max_value);
-  s.invocations_x = dst_size.width;
-  s.invocations_y = dst_size.height;
-  s.label = std::move(label);
-  return s;
-}
-
 }  // namespace
-
-// ---------------------------------------------------------------------------------------------
-// BlurPyramid
-
-struct BlurPyramid::Impl {
-  const Context* context = nullptr;
-  BlurPyramidConfig config;
-  PipelineMap pipelines;
-  // The program of one input size (and config generation), kept per size until no submitted work
-  // can use it (core/size_cache.h).
-  struct Size {
-    StepProgram prog;
-    VkExtent2D extent{0, 0};
-    std::array<VkExtent2D, 3> sizes{};
-  };
-  detail::SizeCache<Size> cache;
-  Size* cur = nullptr;      // the size of the last prepare() or record()
-  uint32_t generation = 0;  // bumped by set_config()
-
-  VkFormat level_format() const { return precision_format(config.precision); }
-
-  Size& size_for(VkExtent2D size, const char* who) {
-    cur = &cache.get({size, VK_FORMAT_UNDEFINED, generation}, cur, who, [&] { return make(size); });
-    return *cur;
-  }
-
-  std::unique_ptr<Size> make(VkExtent2D size) {
-    auto made = std::make_unique<Size>();
-    StepProgram& prog = made->prog;
-    std::array<VkExtent2D, 3>& sizes = made->sizes;
-    prog.context = context;
-    prog.pipelines = &pipelines;
-    made->extent = size;
-    const DeviceInfo& info = context->info();
-    VkExtent2D prev = size;
-    for (int k = 0; k < 3; ++k) {
-      sizes[k] = half_extent(prev);
-      prog.add_image(sizes[k], level_format());
-      prev = sizes[k];
-    }
-    // The input clamp uses the level format: the levels are the only images written.
-    const float max_value = max_value_for(level_format(), level_format());
-    prev = size;
-    for (int k = 0; k < 3; ++k) {
-      prog.steps.push_back(fused_step(prog, info, k == 0 ? kInput : k - 1, k, prev, sizes[k], level_format(),
-                                      config.sigma_texels[k], blur_plan::kPyramidTruncation, false,
-                                      k == 0 ? GLINT_BLUR_FLAG_SANITIZE : 0u, max_value,
-                                      concat("blur pyramid level ", k + 1)));
-      prev = sizes[k];
-    }
-    return made;
-  }
-};
-
-BlurPyramid::BlurPyramid(const Context& context, const BlurPyramidConfig& config) : impl_(std::make_unique<Impl>()) {
-  config.validate();
-  impl_->config = config;
-  impl_->context = &context;
-  impl_->cache.bind(context);
-  // Fail now, not at the first record, if the largest radius cannot fit the device.
-  for (float s : config.sigma_texels) {
-    fused_shape(context.info(),
-                static_cast<uint32_t>(blur_plan::gaussian_half_taps(s, blur_plan::kPyramidTruncation).size() - 1));
-  }
-}
-BlurPyramid::BlurPyramid(BlurPyramid&&) noexcept = default;
-BlurPyramid& BlurPyramid::operator=(BlurPyramid&&) noexcept = default;
-BlurPyramid::~BlurPyramid() = default;
-
-void BlurPyramid::set_config(const BlurPyramidConfig& config) {
-  config.validate();
-  impl_->config = config;
-  // Programs of the old config stay cached, never found again, until no submitted work uses them.
-  ++impl_->generation;
-  if (impl_->cur) impl_->size_for(impl_->cur->extent, "BlurPyramid::set_config");
-}
-const BlurPyramidConfig& BlurPyramid::config() const { return impl_->config; }
-
-void BlurPyramid::prepare(VkExtent2D input_extent) {
-  check_extent(*impl_->context, input_extent, "BlurPyramid::prepare");
-  impl_->size_for(input_extent, "BlurPyramid::prepare");
-}
-
-void BlurPyramid::record(VkCommandBuffer cmd, Image& input, Profiler* profiler) {
-  detail::check_command_buffer("BlurPyramid::record", cmd);
-  detail::check_image_layout("BlurPyramid::record", "input", input);
-  check_image(*impl_->context, input, "BlurPyramid::record", "input", VK_IMAGE_USAGE_SAMPLED_BIT,
-              "VK_IMAGE_USAGE_SAMPLED_BIT");
-  Impl::Size& size = impl_->size_for(input.extent, "BlurPyramid::record");
-  impl_->cache.recorded(&size, cmd);
-  size.prog.record(cmd, input, nullptr, profiler);
-}
-
-const Image& BlurPyramid::level(uint32_t k) const {
-  if (k < 1 || k > 3)
-    throw Error(ErrorCode::invalid_argument,
-                concat("BlurPyramid::level: k = ", k, " is out of range: accepted 1 to 3"));
-  if (!impl_->cur) throw Error(ErrorCode::invalid_argument, "BlurPyramid::level: call prepare() or record() first");
-  return impl_->cur->prog.images[k - 1].state;
-}
-
-Image& BlurPyramid::level(uint32_t k) { return const_cast<Image&>(std::as_const(*this).level(k)); }
-
-void BlurPyramid::release_unused() { impl_->cache.release_unused(impl_->cur); }
-uint32_t BlurPyramid::cached_sizes() const { return impl_->cache.size(); }
-
-LevelSize BlurPyramid::level_size(uint32_t k) const {
-  const Image& l = level(k);
-  return {l.extent.width, l.extent.height};
-}
-
-EffectiveSigma BlurPyramid::effective_sigma_px(uint32_t k) const {
-  level(k);  // validates k and that a size is prepared
-  const std::vector<double> s(impl_->config.sigma_texels.begin(), impl_->config.sigma_texels.end());
-  return {blur_plan::pyramid_effective_sigma(impl_->cur->extent.width, s)[k - 1],
-          blur_plan::pyramid_effective_sigma(impl_->cur->extent.height, s)[k - 1]};
-}
-
-uint64_t BlurPyramid::min_bytes_moved(VkFormat input_format) const {
-  if (!impl_->cur) return 0;
-  const Impl::Size& size = *impl_->cur;
-  const uint64_t in_bytes = detail::texel_bytes(input_format);
-  const uint64_t level_bytes = detail::texel_bytes(impl_->level_format());
-  uint64_t total = uint64_t(size.extent.width) * size.extent.height * in_bytes;
-  for (int k = 0; k < 3; ++k) {
-    const uint64_t texels = uint64_t(size.sizes[k].width) * size.sizes[k].height;
-    total += texels * level_bytes * (k < 2 ? 2 : 1);  // written; read by the next level
-  }
-  return total;
-}
-
-// ---------------------------------------------------------------------------------------------
-// GaussianBlur
 
 struct GaussianBlur::Impl {
   const Context* context = nullptr;

@@ -1,4 +1,5 @@
-// Visibility driver for lens flares: the Hi-Z pyramid and the light culler (docs/OCCLUSION.md).
+// Hi-Z pyramid: the conservative depth pyramid that LightCuller tests lights against
+// (docs/OCCLUSION.md).
 #include <glint/gpu/flare_types.h>
 #include <glint/occlusion.h>
 
@@ -18,34 +19,18 @@
 #include "core/pipeline.h"
 #include "core/resources.h"
 #include "visibility/shaders/light_cull_params.h"  // push constants and buffer layouts shared with the kernels
+#include "visibility/visibility_util.h"
 
 namespace glint {
 
-using detail::check_range;
 using detail::concat;
+using namespace visibility_detail;
 
 // The GLSL push-constant blocks must match byte for byte (CONTRIBUTING.md, "Shared structs").
 static_assert(sizeof(GlintHiZPush) == 32);
 static_assert(offsetof(GlintHiZPush, counter_index) == 24);
-static_assert(sizeof(GlintCullPush) == 112);
-static_assert(offsetof(GlintCullPush, width) == 64);
-static_assert(offsetof(GlintCullPush, flags) == 88);
-static_assert(offsetof(GlintCullPush, depth_bias) == 96);
-static_assert(sizeof(GlintCullCompactPush) == sizeof(GlintCompactPush));
-static_assert(offsetof(GlintCullCompactPush, tile_groups) == offsetof(GlintCompactPush, tile_groups));
-static_assert(offsetof(GlintCullCompactPush, groups_x) == offsetof(GlintCompactPush, groups_x));
-static_assert(offsetof(GlintCullCompactPush, vertex_count) == offsetof(GlintCompactPush, step));
-static_assert(sizeof(LightCullFrame::view_proj) == sizeof(GlintCullPush::view_proj));
 
 namespace {
-
-constexpr VkPipelineStageFlags2 kCompute = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
-constexpr VkAccessFlags2 kSampled = VK_ACCESS_2_SHADER_SAMPLED_READ_BIT;
-constexpr VkAccessFlags2 kStorageRead = VK_ACCESS_2_SHADER_STORAGE_READ_BIT;
-constexpr VkAccessFlags2 kStorageWrite = VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT;
-constexpr uint32_t kCullGroup = GLINT_CULL_GROUP;  // lights per workgroup: one 64-bit visibility mask
-static_assert(kCullGroup == 64, "light_cull.comp keeps a workgroup's visibility in two 32-bit words");
-constexpr uint32_t kMaxGroupsX = 65535;  // guaranteed maxComputeWorkGroupCount[0]
 
 uint32_t floor_log2(uint32_t v) {
   uint32_t k = 0;
@@ -58,31 +43,10 @@ uint32_t ceil_log2(uint32_t v) {
   return (1u << k) < v ? k + 1 : k;
 }
 
-// A glint-made buffer described as a glint::Buffer with its last use.
-Buffer view_of(const detail::OwnedBuffer& b, VkBufferUsageFlags usage) {
-  Buffer v;
-  v.buffer = b.buffer();
-  v.size = b.size();
-  v.usage = usage;
-  return v;
-}
-
-// Integer range check whose message prints the values exactly (check_range formats doubles).
-void check_uint(const char* name, uint64_t value, uint64_t lo, uint64_t hi) {
-  if (value < lo || value > hi) {
-    throw Error(ErrorCode::invalid_argument, concat(name, " = ", value, " is out of range: accepted ", lo, " to ", hi));
-  }
-}
-
-}  // namespace
-
-// ---------------------------------------------------------------------------------------------
-// HiZPyramid
-
-namespace {
 constexpr const char* kHiZFormats =
     "VK_FORMAT_D16_UNORM, VK_FORMAT_X8_D24_UNORM_PACK32, VK_FORMAT_D24_UNORM_S8_UINT, VK_FORMAT_D32_SFLOAT, "
     "VK_FORMAT_D32_SFLOAT_S8_UINT or VK_FORMAT_R32_SFLOAT";
+
 }  // namespace
 
 void HiZConfig::validate() const {
@@ -300,188 +264,6 @@ void HiZPyramid::record(VkCommandBuffer cmd, Image& depth, Profiler* profiler) {
     m.tile_pipeline.dispatch(cmd, m.tile_bindings(), m.tile_push, m.tile_groups_x * 256, m.tile_groups_y);
   }
   if (profiler) profiler->mark(cmd, "hi-z");
-}
-
-// ---------------------------------------------------------------------------------------------
-// LightCuller
-
-void LightCullConfig::validate() const {
-  check_uint("LightCullConfig::capacity", capacity, 1, 16777216);
-  check_uint("LightCullConfig::grid", grid, 1, 16);
-  check_range("LightCullConfig::margin_ndc", margin_ndc, 1.0, 8.0);
-  check_range("LightCullConfig::depth_bias", depth_bias, 0.0, 0.1);
-  check_uint("LightCullConfig::max_lights", max_lights, 1, uint64_t(kMaxGroupsX) * kCullGroup);
-  const auto q = static_cast<uint32_t>(pattern);
-  if (q > 1) {
-    throw Error(ErrorCode::invalid_argument, concat("LightCullConfig::pattern = ", q,
-                                                    " is not an OcclusionPattern: accepted multi_jittered, regular"));
-  }
-}
-
-struct LightCuller::Impl {
-  const Context* context = nullptr;
-  LightCullConfig config;
-  uint32_t max_groups_x = kMaxGroupsX;
-  uint32_t max_groups_y = kMaxGroupsX;
-  // The dispatches of a cull (docs/OCCLUSION.md): cull + grid test, then the ordered compaction
-  // (core/compaction.h): its two-level scan, finished by light_cull_scan.comp (indirect arguments,
-  // statistics), and light_cull_scatter.comp (instances in light order).
-  detail::ComputePipeline cull;
-  detail::Compaction compact;
-  // One vec4 record per light.
-  detail::OwnedBuffer records;
-  Buffer records_state;
-  detail::OwnedBuffer dummy_results;  // bound when the caller wants no per-light results
-  Buffer dummy_state;
-};
-
-LightCuller::LightCuller(const Context& context, const LightCullConfig& config) : impl_(std::make_unique<Impl>()) {
-  config.validate();
-  Impl& m = *impl_;
-  m.context = &context;
-  m.config = config;
-  // The group limit and the scan's workgroup size from the device (CONTRIBUTING.md, "Device limits").
-  VkPhysicalDeviceProperties props;
-  vkGetPhysicalDeviceProperties(context.physical_device(), &props);
-  m.max_groups_x = props.limits.maxComputeWorkGroupCount[0];
-  m.max_groups_y = props.limits.maxComputeWorkGroupCount[1];
-  const auto S = VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE;
-  const auto B = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-  detail::PipelineDesc d;
-  d.kernel_id = "light_cull_main";
-  d.bindings = {S, S, B, B, B, B};
-  d.push_constant_bytes = sizeof(GlintCullPush);
-  d.workgroup = {kCullGroup, 1};
-  m.cull = detail::ComputePipeline(context, d);
-  detail::Compaction::Desc cd;
-  cd.max_items = config.max_lights;
-  cd.scan_kernel = "light_cull_scan_main";  // writes the indirect arguments and statistics
-  cd.scan_outputs = 2;
-  cd.scatter_kernel = "light_cull_scatter_main";  // reads lights and records; writes instances and results
-  cd.scatter_inputs = 2;
-  cd.scatter_outputs = 2;
-  m.compact = detail::Compaction(context, cd);
-  m.records =
-      detail::OwnedBuffer(context, VkDeviceSize(config.max_lights) * 16, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, false);
-  m.records_state = view_of(m.records, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
-  m.dummy_results =
-      detail::OwnedBuffer(context, sizeof(GlintFlareLightResult), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, false);
-  m.dummy_state = view_of(m.dummy_results, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
-}
-
-LightCuller::LightCuller(LightCuller&&) noexcept = default;
-LightCuller& LightCuller::operator=(LightCuller&&) noexcept = default;
-LightCuller::~LightCuller() = default;
-
-const LightCullConfig& LightCuller::config() const { return impl_->config; }
-
-uint32_t LightCuller::max_groups_per_instance() const {
-  const Impl& m = *impl_;
-  // capacity x groups workgroups as rows of max_groups_x: at most max_groups_y rows, and the
-  // scan's groups + max_groups_x - 1 must not wrap in 32 bits.
-  const uint64_t total = std::min<uint64_t>(uint64_t(m.max_groups_x) * m.max_groups_y, (1ull << 32) - m.max_groups_x);
-  return uint32_t(std::min<uint64_t>(65535, total / std::max(1u, m.config.capacity)));
-}
-
-void LightCuller::record(VkCommandBuffer cmd, HiZPyramid& hiz, Image& depth, Buffer& lights, uint32_t count,
-                         const LightCullFrame& frame, LightCullOutputs& out, Profiler* profiler) {
-  detail::check_command_buffer("LightCuller::record", cmd);
-  Impl& m = *impl_;
-  const char* where = "LightCuller::record";
-  const HiZConfig& hc = hiz.config();
-  // Everything is checked before anything is recorded.
-  check_uint("LightCuller::record: count", count, 0, m.config.max_lights);
-  check_uint("LightCullFrame::vertex_count", frame.vertex_count, 0, 1 << 20);
-  if (frame.groups_per_instance > max_groups_per_instance()) {
-    throw Error(ErrorCode::invalid_argument,
-                concat("LightCullFrame::groups_per_instance = ", frame.groups_per_instance,
-                       " is out of range for LightCullConfig::capacity = ", m.config.capacity,
-                       " on this device: accepted 0 to ", max_groups_per_instance(),
-                       " (capacity x groups must fit maxComputeWorkGroupCount[0] x [1] = ", m.max_groups_x, " x ",
-                       m.max_groups_y, ")"));
-  }
-  for (int i = 0; i < 16; ++i) {
-    if (!std::isfinite(frame.view_proj[i])) {
-      throw Error(ErrorCode::invalid_argument,
-                  concat("LightCullFrame::view_proj[", i, "] = ", frame.view_proj[i], " is not finite"));
-    }
-  }
-  if (!depth.image || !depth.view)
-    throw Error(ErrorCode::invalid_argument, concat(where, ": depth image or view is null"));
-  detail::check_layers(depth, where, "depth");
-  if (depth.format != hc.format || depth.extent.width != hc.extent.width || depth.extent.height != hc.extent.height) {
-    throw Error(ErrorCode::invalid_argument,
-                concat(where, ": depth (", detail::format_name(depth.format), " ", depth.extent.width, "x",
-                       depth.extent.height, ") does not match the Hi-Z pyramid (", detail::format_name(hc.format), " ",
-                       hc.extent.width, "x", hc.extent.height, ")"));
-  }
-  if (!(depth.usage & VK_IMAGE_USAGE_SAMPLED_BIT)) {
-    throw Error(ErrorCode::missing_usage, concat(where, ": depth image lacks VK_IMAGE_USAGE_SAMPLED_BIT usage"));
-  }
-  const VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
-  detail::check_buffer(where, "lights", lights, VkDeviceSize(count) * sizeof(GlintFlareLight), storage);
-  detail::check_buffer(where, "instances", out.instances, VkDeviceSize(m.config.capacity) * sizeof(GlintFlareInstance),
-                       storage);
-  detail::check_buffer(where, "indirect", out.indirect, sizeof(GlintFlareIndirect),
-                       storage | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT);
-  detail::check_buffer(where, "stats", out.stats, sizeof(GlintFlareStats), storage);
-  const bool want_results = out.results.buffer != VK_NULL_HANDLE;
-  if (want_results) {
-    detail::check_buffer(where, "results", out.results, VkDeviceSize(count) * sizeof(GlintFlareLightResult), storage);
-  }
-  Buffer& results = want_results ? out.results : m.dummy_state;
-
-  Buffer& groups_state = m.compact.groups();
-  detail::Barriers b;
-  m.compact.record_clear_once(cmd, b);  // the scan kernel resets the counters every frame
-  const uint32_t flags = want_results ? GLINT_CULL_WRITE_RESULTS : 0u;
-  // 1. Cull + grid test: visibility masks and records, the other lights' results, the counters.
-  b.use(depth, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, kCompute, kSampled);
-  b.use(hiz.image(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, kCompute, kSampled, std::max(1u, hiz.levels()));
-  b.use(lights, kCompute, kStorageRead);
-  b.use(m.records_state, kCompute, kStorageWrite);
-  b.use(results, kCompute, kStorageWrite);
-  b.use(groups_state, kCompute, kStorageRead | kStorageWrite);
-  b.use(out.instances, kCompute, kStorageWrite);  // written by the scatter; here after the last frame's reads
-  b.flush(cmd);
-  if (count > 0) {
-    GlintCullPush push{};
-    std::copy(frame.view_proj, frame.view_proj + 16, push.view_proj);
-    push.width = static_cast<int32_t>(hc.extent.width);
-    push.height = static_cast<int32_t>(hc.extent.height);
-    push.count = count;
-    push.grid = m.config.grid;
-    push.levels = hiz.levels();
-    push.flags = (hc.reversed_z ? GLINT_CULL_REVERSED_Z : 0u) | flags |
-                 (m.config.pattern == OcclusionPattern::regular ? GLINT_CULL_REGULAR_GRID : 0u);
-    push.margin_ndc = m.config.margin_ndc;
-    push.depth_bias = m.config.depth_bias;
-    m.cull.dispatch(cmd,
-                    {{depth.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL},
-                     {hiz.image().view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL},
-                     lights,
-                     m.records_state,
-                     results,
-                     groups_state},
-                    push, count, 1);
-  }
-  if (profiler) profiler->mark(cmd, "light cull");
-  // 2. Scan: the masks (and the counters' atomics) are complete; first slots, arguments, stats.
-  GlintCullCompactPush lp{};
-  lp.count = count;
-  lp.capacity = m.config.capacity;
-  lp.vertex_count = frame.vertex_count;
-  lp.groups_per_instance = frame.groups_per_instance;
-  lp.flags = flags;
-  lp.max_group_count_x = m.max_groups_x;
-  GlintCompactPush cp;
-  static_assert(sizeof(cp) == sizeof(lp));
-  std::memcpy(&cp, &lp, sizeof(cp));
-  m.compact.record_scan(cmd, b, cp, {&out.indirect, &out.stats});
-  if (profiler) profiler->mark(cmd, "cull scan");
-  // 3. Scatter: instances in light order, the visible lights' results.
-  m.compact.record_scatter(cmd, b, cp, {&lights, &m.records_state}, {&out.instances, &results});
-  if (profiler) profiler->mark(cmd, "cull scatter");
 }
 
 }  // namespace glint

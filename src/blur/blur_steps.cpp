@@ -1,0 +1,213 @@
+// The blur step machinery (blur_steps.h): tile shapes, caller-image checks, step programs and the
+// steps both drivers plan.
+#include "blur/blur_steps.h"
+
+#include <algorithm>
+#include <cstring>
+#include <utility>
+
+#include "core/barriers.h"
+#include "core/check.h"
+#include "core/context_state.h"
+#include "core/formats.h"
+
+namespace glint::blur_steps {
+
+using blur_plan::kFusedMaxRadius;  // one constant for the planner and the driver
+using detail::concat;
+
+namespace {
+
+constexpr VkPipelineStageFlags2 kCompute = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
+constexpr VkAccessFlags2 kSampled = VK_ACCESS_2_SHADER_SAMPLED_READ_BIT;
+constexpr VkAccessFlags2 kStorageWrite = VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT;
+
+// Shared memory of src/blur/shaders/blur_level.comp: the loaded tile + apron and the horizontal pass's
+// rows, 16 bytes a texel (8 packed as fp16).
+uint32_t fused_shared_bytes(FusedShape s, uint32_t radius, bool half_shared) {
+  const uint32_t w = s.workgroup.x, h = s.workgroup.y * s.rows;
+  const auto padded = [](uint32_t n) { return n + (17 - n % 16) % 16; };  // LOAD_S, ROW_S
+  return (half_shared ? 8 : 16) * (padded(w + 2 * radius) * (h + 2 * radius) + padded(w) * (h + 2 * radius));
+}
+
+// Throws Error(unsupported_size) "<where>: <role> extent WxH is out of range: accepted 1 to N on
+// each side" (role may be empty). The message is built only when it is thrown.
+void check_extent_named(const Context& context, VkExtent2D e, const char* where, const char* role) {
+  const uint32_t max_dim = context.info().max_image_dimension_2d;
+  if (e.width == 0 || e.height == 0 || e.width > max_dim || e.height > max_dim) {
+    throw Error(ErrorCode::unsupported_size,
+                concat(where, ": ", role, *role ? " " : "", "extent ", e.width, "x", e.height,
+                       " is out of range: accepted 1 to ", max_dim, " on each side"));
+  }
+}
+
+}  // namespace
+
+VkFormat precision_format(Precision p) {
+  return p == Precision::fp32 ? VK_FORMAT_R32G32B32A32_SFLOAT : VK_FORMAT_R16G16B16A16_SFLOAT;
+}
+
+FusedShape fused_shape(const DeviceInfo& info, uint32_t radius, bool half_shared) {
+  static const FusedShape gpu[] = {{{32, 8}, 4}, {{32, 8}, 2}, {{32, 8}, 1}, {{16, 8}, 2}, {{16, 8}, 1}, {{8, 8}, 1}};
+  static const FusedShape cpu[] = {{{16, 8}, 1}, {{8, 8}, 1}};  // widths are multiples of 4 (RUN)
+  const bool is_cpu = info.type == VK_PHYSICAL_DEVICE_TYPE_CPU;
+  const FusedShape* begin = is_cpu ? cpu : gpu;
+  const FusedShape* end = is_cpu ? cpu + 2 : gpu + 6;
+  for (const FusedShape* s = begin; s != end; ++s) {
+    if (s->workgroup.x * s->workgroup.y <= info.max_workgroup_invocations &&
+        fused_shared_bytes(*s, radius, half_shared) <= info.max_shared_memory_bytes) {
+      return *s;
+    }
+  }
+  throw Error(ErrorCode::no_device,
+              concat("blur radius ", radius, " needs ", fused_shared_bytes({{8, 8}, 1}, radius, half_shared),
+                     " bytes of shared memory; device '", info.name, "' has ", info.max_shared_memory_bytes));
+}
+
+float max_value_for(VkFormat a, VkFormat b) {
+  return std::min({detail::format_max(a), detail::format_max(b), 1.0e37f});
+}
+
+std::string store_variant(VkFormat format) {
+  const char* q = detail::qualified_variant(format);
+  return q ? q : "noformat";
+}
+
+void check_extent(const Context& context, VkExtent2D e, const char* where) {
+  check_extent_named(context, e, where, "");
+}
+
+void check_image(const Context& context, const Image& img, const char* where, const char* role, VkImageUsageFlags need,
+                 const char* need_name) {
+  if (!img.image || !img.view)
+    throw Error(ErrorCode::invalid_argument, concat(where, ": ", role, " image and view must be non-null"));
+  detail::check_layers(img, where, role);
+  if (need & VK_IMAGE_USAGE_STORAGE_BIT) {
+    detail::check_color_write(context, img.format, where, role);
+  } else {
+    detail::check_color_read(context, img.format, where, role);
+  }
+  check_extent_named(context, img.extent, where, role);
+  if ((img.usage & need) != need)
+    throw Error(ErrorCode::missing_usage, concat(where, ": ", role, " image lacks ", need_name, " usage"));
+}
+
+const detail::ComputePipeline& StepProgram::pipeline(const std::string& kernel, VkFormat dst_format,
+                                                     detail::Workgroup2D wg, std::vector<uint32_t> spec,
+                                                     std::vector<VkDescriptorType> bindings) {
+  std::string key = concat(kernel, "_", store_variant(dst_format), "/", wg.x, "x", wg.y);
+  for (uint32_t v : spec) key += concat("/", v);
+  auto it = pipelines->find(key);
+  if (it != pipelines->end()) return it->second;
+  detail::PipelineDesc d;
+  d.kernel_id = concat(kernel, "_", store_variant(dst_format));
+  d.bindings = std::move(bindings);
+  d.push_constant_bytes = sizeof(BlurPush);
+  d.workgroup = wg;
+  d.specialization = std::move(spec);
+  return pipelines->emplace(key, detail::ComputePipeline(*context, d)).first->second;
+}
+
+int StepProgram::add_image(VkExtent2D e, VkFormat f) {
+  images.emplace_back(*context, e, f,
+                      VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT);
+  return static_cast<int>(images.size()) - 1;
+}
+
+const detail::OwnedBuffer* StepProgram::add_taps(const std::vector<float>& values) {
+  tap_buffers.emplace_back(*context, values.size() * sizeof(float), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, true);
+  std::memcpy(tap_buffers.back().mapped(), values.data(), values.size() * sizeof(float));
+  tap_buffers.back().flush();
+  return &tap_buffers.back();
+}
+
+detail::Bindings StepProgram::bindings_of(const Step& s, const Image& src, const Image& dst) const {
+  detail::Bindings b{{src.view, s.src == kInput ? kReadOnly : kGeneral, s.sampler ? sampler : VK_NULL_HANDLE},
+                     {dst.view, kGeneral}};
+  if (s.taps) {
+    Buffer taps;
+    taps.buffer = s.taps->buffer();
+    taps.size = s.taps->size();
+    b.push_back(taps);
+  }
+  return b;
+}
+
+void StepProgram::record(VkCommandBuffer cmd, Image& input, Image* output, Profiler* profiler) {
+  detail::Barriers b;
+  for (size_t i = 0; i < steps.size(); ++i) {
+    const Step& s = steps[i];
+    Image& src = s.src == kInput ? input : images[s.src].state;
+    Image& dst = s.dst == kOutput ? *output : images[s.dst].state;
+    b.use(src, s.src == kInput ? kReadOnly : kGeneral, kCompute, kSampled);
+    b.use(dst, kGeneral, kCompute, kStorageWrite);
+    b.flush(cmd);
+    s.pipeline->dispatch(cmd, bindings_of(s, src, dst), s.push, s.invocations_x, s.invocations_y);
+    if (profiler) profiler->mark(cmd, s.label);
+  }
+}
+
+BlurPush make_push(VkExtent2D src, VkExtent2D dst, uint32_t flags, float max_value) {
+  BlurPush p{};
+  p.src_width = static_cast<int32_t>(src.width);
+  p.src_height = static_cast<int32_t>(src.height);
+  p.dst_width = static_cast<int32_t>(dst.width);
+  p.dst_height = static_cast<int32_t>(dst.height);
+  p.max_value = max_value;
+  p.flags = flags;
+  p.offset = 1.0f;
+  p.ratio_x = static_cast<float>(src.width) / static_cast<float>(dst.width);
+  p.ratio_y = static_cast<float>(src.height) / static_cast<float>(dst.height);
+  return p;
+}
+
+VkExtent2D half_extent(VkExtent2D e) { return {blur_plan::half_size(e.width), blur_plan::half_size(e.height)}; }
+
+// A fused level-blur step B(src -> dst, sigma) (docs/BLUR.md); sigma 0 is the area downsample alone.
+// `binomial` picks the pyramid method's downsample over the area average (docs/BLUR.md).
+Step fused_step(StepProgram& prog, const DeviceInfo& info, int src, int dst, VkExtent2D src_size, VkExtent2D dst_size,
+                VkFormat dst_format, double sigma, double truncation, bool binomial, uint32_t flags, float max_value,
+                std::string label) {
+  const std::vector<double> w = blur_plan::gaussian_half_taps(sigma, truncation);
+  const uint32_t radius = static_cast<uint32_t>(w.size()) - 1;
+  if (radius > kFusedMaxRadius)
+    throw Error(ErrorCode::invalid_argument, concat("blur sigma ", sigma, " needs radius ", radius,
+                                                    "; the fused kernel takes at most ", kFusedMaxRadius));
+  // Where the result is stored as fp16, the shared copies may be too (half the shared traffic).
+  const bool half_shared = dst_format == VK_FORMAT_R16G16B16A16_SFLOAT;
+  const FusedShape shape = fused_shape(info, radius, half_shared);
+  // The source read, fixed per pipeline so each variant compiles only its own path.
+  const bool same = src_size.width == dst_size.width && src_size.height == dst_size.height;
+  const bool exact_half = src_size.width == 2 * dst_size.width && src_size.height == 2 * dst_size.height;
+  const uint32_t mode = binomial ? 3u : same ? 0u : exact_half ? 1u : 2u;
+  Step s;
+  // Prefetching the load step (shaders/blur_level.comp, PREFETCH) pays on GPUs only.
+  const uint32_t prefetch = info.type == VK_PHYSICAL_DEVICE_TYPE_CPU ? 0u : 1u;
+  s.pipeline = &prog.pipeline("blur_level", dst_format, shape.workgroup,
+                              {shape.rows, radius, mode, half_shared ? 1u : 0u, prefetch},
+                              {VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
+  s.src = src;
+  s.dst = dst;
+  s.push = make_push(src_size, dst_size, flags, max_value);
+  for (uint32_t t = 0; t <= radius; ++t) s.push.weights[t] = static_cast<float>(w[t]);
+  s.invocations_x = dst_size.width;
+  s.invocations_y = (dst_size.height + shape.rows - 1) / shape.rows;
+  s.label = std::move(label);
+  return s;
+}
+
+Step simple_step(StepProgram& prog, const char* kernel, int src, int dst, VkExtent2D src_size, VkExtent2D dst_size,
+                 VkFormat dst_format, uint32_t flags, float max_value, std::string label,
+                 std::vector<VkDescriptorType> bindings) {
+  Step s;
+  s.pipeline = &prog.pipeline(kernel, dst_format, detail::choose_workgroup_2d(*prog.context), {}, std::move(bindings));
+  s.src = src;
+  s.dst = dst;
+  s.push = make_push(src_size, dst_size, flags, max_value);
+  s.invocations_x = dst_size.width;
+  s.invocations_y = dst_size.height;
+  s.label = std::move(label);
+  return s;
+}
+
+}  // namespace glint::blur_steps

@@ -1,0 +1,120 @@
+// The step machinery both blur drivers run (docs/BLUR.md): a size's program is a list of steps
+// (pipeline, push constants, image in, image out) planned once, which record() walks, writing the
+// barriers between them and pushing each step's descriptors. BlurPyramid (blur_pyramid.cpp) and
+// GaussianBlur (gaussian_blur.cpp) plan their own steps from these parts. Internal.
+#pragma once
+
+#include <glint/blur.h>
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include "blur/blur_plan.h"
+#include "blur/shaders/blur_params.h"
+#include "core/pipeline.h"
+#include "core/resources.h"
+
+namespace glint::blur_steps {
+
+constexpr VkImageLayout kGeneral = VK_IMAGE_LAYOUT_GENERAL;
+constexpr VkImageLayout kReadOnly = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+
+/// The format of the owned images at `p`: RGBA16F or RGBA32F.
+VkFormat precision_format(Precision p);
+
+// The fused kernel's tile: workgroup (x, y) with `rows` outputs per invocation along y.
+struct FusedShape {
+  detail::Workgroup2D workgroup{8, 8};
+  uint32_t rows = 1;
+};
+
+// The largest tile whose shared memory fits the device (CONTRIBUTING.md, "Device limits"): larger tiles re-read less
+// apron. CPU devices (lavapipe) get 8-row-high tiles, which keep their per-thread groups small.
+FusedShape fused_shape(const DeviceInfo& info, uint32_t radius, bool half_shared = false);
+
+// Largest value a texel may hold so that every image of the chain stays finite (docs/BLUR.md):
+// fp32 keeps headroom for the 4-texel sums the kernels form before scaling.
+float max_value_for(VkFormat a, VkFormat b);
+
+// The kernel variant that stores `format`: its GLSL qualifier's, else "noformat" (which
+// detail::check_color_write() accepted for the caller's output before any pipeline is made).
+std::string store_variant(VkFormat format);
+
+/// Throws Error(unsupported_size) "<where>: extent WxH is out of range: accepted 1 to N on each
+/// side" unless `e` fits the device's maxImageDimension2D.
+void check_extent(const Context& context, VkExtent2D e, const char* where);
+
+/// Checks a caller image before anything is recorded: non-null handles, one layer, a float colour
+/// format the device reads (or, when `need` has STORAGE, writes), its extent, and the usage `need`
+/// (named `need_name` in the message).
+void check_image(const Context& context, const Image& img, const char* where, const char* role, VkImageUsageFlags need,
+                 const char* need_name);
+
+// Which image a step reads or writes: the caller's input or output, or an owned image.
+constexpr int kInput = -1;
+constexpr int kOutput = -2;
+
+struct Step {
+  const detail::ComputePipeline* pipeline = nullptr;
+  int src = kInput;
+  int dst = kOutput;
+  BlurPush push{};
+  uint32_t invocations_x = 0;  // dispatch covers these (the pipeline divides by its workgroup)
+  uint32_t invocations_y = 0;
+  bool sampler = false;                       // binding 0 is a combined image sampler
+  const detail::OwnedBuffer* taps = nullptr;  // binding 2
+  std::string label;
+};
+
+// Pipelines keyed by what specializes them, shared by every size of one effect (a std::map, so the
+// steps' pointers stay valid while the effect lives).
+using PipelineMap = std::map<std::string, detail::ComputePipeline>;
+
+// The program of one size: owned images and steps. Each step pushes its descriptors when recorded.
+struct StepProgram {
+  const Context* context = nullptr;
+  PipelineMap* pipelines = nullptr;
+  std::vector<detail::OwnedImage> images;
+  std::vector<detail::OwnedBuffer> tap_buffers;
+  std::vector<Step> steps;
+  VkSampler sampler = VK_NULL_HANDLE;  // bilinear, for the linear-sampling variant (owned by the context)
+
+  /// The pipeline of `kernel` storing `dst_format` with workgroup `wg` and specialization `spec`,
+  /// made at its first use and shared through `pipelines`.
+  const detail::ComputePipeline& pipeline(const std::string& kernel, VkFormat dst_format, detail::Workgroup2D wg,
+                                          std::vector<uint32_t> spec, std::vector<VkDescriptorType> bindings);
+
+  // Owned images can also be copied from (BlurPyramid hands its levels to the caller).
+  int add_image(VkExtent2D e, VkFormat f);
+
+  /// A host-visible storage buffer holding `values` (a step's tap weights), owned by the program.
+  const detail::OwnedBuffer* add_taps(const std::vector<float>& values);
+
+  // The descriptors of step `s`: source (with the bilinear sampler for the linear-sampling
+  // variant), destination, and the tap weights when the step has them.
+  detail::Bindings bindings_of(const Step& s, const Image& src, const Image& dst) const;
+
+  /// Records every step, with the barriers between them; `output` is the caller's output image
+  /// (null for BlurPyramid, whose steps write owned images only).
+  void record(VkCommandBuffer cmd, Image& input, Image* output, Profiler* profiler);
+};
+
+/// The push constants of a step from `src` to `dst` texels.
+BlurPush make_push(VkExtent2D src, VkExtent2D dst, uint32_t flags, float max_value);
+
+VkExtent2D half_extent(VkExtent2D e);
+
+// A fused level-blur step B(src -> dst, sigma) (docs/BLUR.md); sigma 0 is the area downsample alone.
+// `binomial` picks the pyramid method's downsample over the area average (docs/BLUR.md).
+Step fused_step(StepProgram& prog, const DeviceInfo& info, int src, int dst, VkExtent2D src_size, VkExtent2D dst_size,
+                VkFormat dst_format, double sigma, double truncation, bool binomial, uint32_t flags, float max_value,
+                std::string label);
+
+// A plain per-texel step (upsample, dual down/up) with 2D workgroups.
+Step simple_step(StepProgram& prog, const char* kernel, int src, int dst, VkExtent2D src_size, VkExtent2D dst_size,
+                 VkFormat dst_format, uint32_t flags, float max_value, std::string label,
+                 std::vector<VkDescriptorType> bindings = {VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE,
+                                                           VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
+
+}  // namespace glint::blur_steps

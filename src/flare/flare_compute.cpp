@@ -1,0 +1,121 @@
+// Lens-flare compute path: the sprite pre-pass and the tiled gather (its arguments written on the
+// device from the instance count) and LensFlare::record_compute(). docs/FLARE.md, "Compute (record_compute)".
+#include "flare/flare_impl.h"
+
+namespace glint {
+
+using namespace flare_detail;
+using detail::concat;
+
+detail::ComputePipeline LensFlare::Impl::make_gather(uint32_t beyond_store) const {
+  const auto SB = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+  detail::PipelineDesc d;
+  d.kernel_id = std::string("flare_gather_") + detail::format_variant(format);
+  d.bindings = {SB, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, SB, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, SB};
+  d.push_constant_bytes = sizeof(GlintFlarePush);
+  d.workgroup = workgroup;
+  d.specialization = {beyond_store};
+  return detail::ComputePipeline(*context, d);
+}
+
+void LensFlare::Impl::make_compute_pipelines() {
+  const auto SB = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+  gather = make_gather(0);
+  detail::PipelineDesc sp;
+  sp.kernel_id = "flare_sprites_main";
+  sp.bindings = {SB, SB, SB};
+  sp.push_constant_bytes = sizeof(GlintFlarePush);
+  sp.workgroup = {GLINT_FLARE_SPRITES_SLOTS, GLINT_FLARE_SPRITES_INSTANCES};
+  sprites = detail::ComputePipeline(*context, sp);
+  detail::PipelineDesc a;
+  a.kernel_id = "flare_gather_args_main";
+  a.bindings = {SB, SB};
+  a.push_constant_bytes = sizeof(GlintFlareGatherArgsPush);
+  a.workgroup = {1, 1};
+  gather_args = detail::ComputePipeline(*context, a);
+  // The gather's and the pre-pass's VkDispatchIndirectCommand, written on the GPU each frame.
+  const VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT;
+  gather_args_buffer = detail::OwnedBuffer(*context, 32, usage, false);
+  gather_args_state = Buffer{gather_args_buffer.buffer(), 0, 32, usage, VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE};
+}
+void LensFlare::record_compute(VkCommandBuffer cmd, Image& color, Buffer& instances, Buffer& indirect,
+                               const FlareConfig& config, Profiler* profiler) {
+  detail::check_command_buffer("LensFlare::record_compute", cmd);
+  Impl& m = *impl_;
+  m.check_inputs("LensFlare::record_compute", color, VK_IMAGE_USAGE_STORAGE_BIT, "VK_IMAGE_USAGE_STORAGE_BIT",
+                 instances, indirect, config);
+  if (!(indirect.usage & VK_BUFFER_USAGE_STORAGE_BUFFER_BIT)) {
+    throw Error(ErrorCode::missing_usage,
+                "LensFlare::record_compute: indirect buffer lacks VK_BUFFER_USAGE_STORAGE_BUFFER_BIT usage (the "
+                "compute path reads the instance count from it)");
+  }
+  if (instances.size / sizeof(GlintFlareInstance) > max_compute_instances()) {
+    throw Error(
+        ErrorCode::invalid_argument,
+        concat("LensFlare::record_compute: the instances buffer holds ", instances.size / sizeof(GlintFlareInstance),
+               " instances; one storage-buffer descriptor holds at most ", max_compute_instances()));
+  }
+  if (!config.enabled || config.intensity == 0.0f) return;  // adds nothing: record nothing
+  m.record_setup(cmd);
+
+  // The indirect arguments are read as words from a storage-buffer binding whose offset is rounded
+  // down to minStorageBufferOffsetAlignment; the push constant says where group_count_x is.
+  const VkDeviceSize args_offset = indirect.offset + offsetof(GlintFlareIndirect, instance_count);
+  const VkDeviceSize bound_offset = args_offset - args_offset % m.storage_alignment;
+  const Buffer indirect_words{indirect.buffer, bound_offset,   args_offset - bound_offset + sizeof(uint32_t),
+                              indirect.usage,  indirect.stage, indirect.access};
+  // Instances whose sprites the pre-pass stores (all of them up to max_stored_instances).
+  const uint32_t capacity = std::min(uint32_t(instances.size / sizeof(GlintFlareInstance)), m.max_stored_instances);
+  if (m.sprite_stores.empty() || m.sprite_stores.back()->capacity < capacity) {
+    // A new store for the larger buffer, twice the last one (at most the descriptor's limit), so
+    // that buffers growing one by one make few stores.
+    uint32_t c = m.sprite_stores.empty() ? 1u : m.sprite_stores.back()->capacity;
+    c = std::max(capacity, std::min(2 * c, m.max_stored_instances));
+    auto store = std::make_unique<Impl::SpriteStore>();
+    const VkDeviceSize bytes = VkDeviceSize(c) * kBlockBytes;
+    store->buffer = detail::OwnedBuffer(*m.context, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, false);
+    store->state =
+        Buffer{store->buffer.buffer(), 0, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, VK_PIPELINE_STAGE_2_NONE,
+               VK_ACCESS_2_NONE};
+    store->capacity = c;
+    m.sprite_stores.push_back(std::move(store));
+  }
+  Impl::SpriteStore& sprite_store = *m.sprite_stores.back();
+  Buffer& store = sprite_store.state;
+  // The instances buffer holds more than the store: the gather evaluates the rest itself.
+  const bool beyond = instances.size / sizeof(GlintFlareInstance) > sprite_store.capacity;
+  if (beyond && !m.gather_beyond_made) {
+    m.gather_beyond = m.make_gather(1);
+    m.gather_beyond_made = true;
+  }
+
+  GlintFlarePush p = m.push(config);
+  p.indirect_word = uint32_t((args_offset - bound_offset) / sizeof(uint32_t));
+  GlintFlareGatherArgsPush ap{p.indirect_word, m.tiles_x, m.tiles_y, std::min(capacity, sprite_store.capacity),
+                              m.max_groups_x};
+  detail::Barriers b;
+  // 1. The launch arguments: every tile when any instance is visible, none otherwise; the
+  //    pre-pass's groups for the instances.
+  b.use(indirect, kCompute, VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
+  b.use(m.gather_args_state, kCompute, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+  b.flush(cmd);
+  m.gather_args.dispatch(cmd, {indirect_words, m.gather_args_state}, ap, 1, 1);
+  // 2. The sprite pre-pass: every sprite of every instance, once.
+  b.use(m.gather_args_state, kIndirect, VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT);
+  b.use(instances, kCompute, VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
+  b.use(store, kCompute, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+  b.flush(cmd);
+  m.sprites.dispatch_indirect(cmd, {instances, indirect_words, store}, p, m.gather_args_buffer.buffer(), 16);
+  // 3. The gather, one workgroup per tile.
+  b.use(store, kCompute, VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
+  b.use(m.atlas_image.state, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, kCompute, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT,
+        GLINT_FLARE_ATLAS_LEVELS);
+  b.use(color, VK_IMAGE_LAYOUT_GENERAL, kCompute, kStorageRW);
+  b.flush(cmd);
+  (beyond ? m.gather_beyond : m.gather)
+      .dispatch_indirect(cmd,
+                         {instances, m.atlas_binding(), indirect_words, {color.view, VK_IMAGE_LAYOUT_GENERAL}, store},
+                         p, m.gather_args_buffer.buffer(), 0);
+  if (profiler) profiler->mark(cmd, "flare gather");
+}
+}  // namespace glint

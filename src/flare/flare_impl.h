@@ -1,0 +1,106 @@
+// LensFlare's state, shared by its three source files: flare.cpp (configuration, atlas, checks
+// and construction), flare_raster.cpp (the draw) and flare_compute.cpp (the gather). Internal.
+#pragma once
+
+#include <glint/flare.h>
+#include <glint/gpu/flare_types.h>
+#include <glint/occlusion.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/barriers.h"
+#include "core/check.h"
+#include "core/context_state.h"
+#include "core/kernel_table.h"
+#include "core/pipeline.h"
+#include "core/resources.h"
+#include "flare/shaders/flare_params.h"
+
+namespace glint::flare_detail {
+
+constexpr VkPipelineStageFlags2 kCompute = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
+constexpr VkPipelineStageFlags2 kIndirect = VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT;
+constexpr VkAccessFlags2 kStorageRW = VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT;
+
+// Bytes of the sprite pre-pass's block per instance (src/flare/shaders/flare_params.h).
+constexpr VkDeviceSize kBlockBytes = GLINT_FLARE_BLOCK_VEC4S * 16;
+
+}  // namespace glint::flare_detail
+
+namespace glint {
+
+struct LensFlare::Impl {
+  const Context* context = nullptr;
+  VkDevice device = VK_NULL_HANDLE;
+  VkFormat format = VK_FORMAT_UNDEFINED;
+  VkExtent2D extent{0, 0};
+  uint32_t max_compute_instances = 0;    // instances one storage-buffer descriptor can hold
+  uint32_t max_stored_instances = 0;     // instances whose sprite blocks one descriptor can hold
+  uint32_t max_groups_x = 65535;         // maxComputeWorkGroupCount[0]
+  VkDeviceSize storage_alignment = 256;  // minStorageBufferOffsetAlignment
+  detail::Workgroup2D workgroup;         // the gather's workgroup
+  uint32_t tiles_x = 0, tiles_y = 0;     // gather tiles: workgroup x by workgroup y * GATHER_ROWS
+
+  // Atlas: one image with every level, a view of all levels (sampling) and one per level (storage).
+  detail::OwnedImage atlas_image;      // state tracks all levels together
+  VkSampler sampler = VK_NULL_HANDLE;  // owned by the context
+  bool atlas_generated = false;
+  detail::ComputePipeline atlas_pipeline;
+
+  // Raster path (absent when the device cannot draw into `format` with blending).
+  std::string raster_unavailable;                            // empty when the raster path is available
+  VkDescriptorSetLayout raster_set_layout = VK_NULL_HANDLE;  // pushed: instances, atlas
+  std::vector<VkDescriptorType> raster_types = {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+                                                VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER};
+  VkPipelineLayout raster_layout = VK_NULL_HANDLE;
+  VkPipeline raster_pipeline = VK_NULL_HANDLE;
+
+  // Compute path: the sprite pre-pass and the gather, launched by vkCmdDispatchIndirect with
+  // arguments that flare_gather_args.comp writes from the instance count.
+  detail::ComputePipeline gather, gather_args, sprites;
+  // The gather for instances buffers larger than the sprite store (specialization constant 2 = 1),
+  // made at its first use.
+  detail::ComputePipeline gather_beyond;
+  bool gather_beyond_made = false;
+  detail::OwnedBuffer gather_args_buffer;  // the gather's VkDispatchIndirectCommand, then the pre-pass's
+  Buffer gather_args_state;
+  // The pre-pass's sprite blocks, one store per size: a larger instances buffer gets a new store,
+  // and the smaller ones stay (command buffers recorded with them may still be pending) until the
+  // LensFlare goes.
+  struct SpriteStore {
+    detail::OwnedBuffer buffer;
+    Buffer state;
+    uint32_t capacity = 0;  // instances
+  };
+  std::vector<std::unique_ptr<SpriteStore>> sprite_stores;
+
+  ~Impl() {
+    if (!device) return;
+    if (raster_pipeline) vkDestroyPipeline(device, raster_pipeline, nullptr);
+    if (raster_layout) vkDestroyPipelineLayout(device, raster_layout, nullptr);
+    if (raster_set_layout) vkDestroyDescriptorSetLayout(device, raster_set_layout, nullptr);
+  }
+
+  // The atlas as a combined image sampler binding (every level, trilinear).
+  detail::Binding atlas_binding() const {
+    return {atlas_image.state.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, sampler};
+  }
+
+  void make_atlas();
+  void make_raster_pipeline();
+  void make_compute_pipelines();
+  detail::ComputePipeline make_gather(uint32_t beyond_store) const;
+  void record_setup(VkCommandBuffer cmd);
+  GlintFlarePush push(const FlareConfig& c) const;
+  void check_inputs(const char* fn, const Image& color, VkImageUsageFlags usage, const char* usage_name,
+                    const Buffer& instances, const Buffer& indirect, const FlareConfig& config) const;
+};
+
+}  // namespace glint
