@@ -440,25 +440,16 @@ std::vector<ApiCase> api_cases() {
 
   // Context::adopt: the engine's device extension list must name VK_KHR_push_descriptor (every
   // kernel's descriptors are pushed); the test context's device has it, so only the list is wrong.
-  auto adopt_info = [] {
-    AdoptInfo a;
-    a.instance = context().instance();
-    a.api_version = VK_API_VERSION_1_3;
-    a.physical_device = context().physical_device();
-    a.device = context().device();
-    a.queue_family_index = context().queue_family_index();
-    return a;
-  };
   cases.push_back({"Context::adopt without an extension list",
                    ErrorCode::invalid_argument,
                    {"VK_KHR_push_descriptor is not in AdoptInfo::enabled_extensions"},
-                   [adopt_info](Fixture&, VkCommandBuffer, auto&, auto&) { Context::adopt(adopt_info()); }});
+                   [](Fixture&, VkCommandBuffer, auto&, auto&) { Context::adopt(adopt_info_of_context()); }});
   cases.push_back({"Context::adopt with a list that lacks VK_KHR_push_descriptor",
                    ErrorCode::invalid_argument,
                    {"VK_KHR_push_descriptor is not in AdoptInfo::enabled_extensions", "1 names given"},
-                   [adopt_info](Fixture&, VkCommandBuffer, auto&, auto&) {
+                   [](Fixture&, VkCommandBuffer, auto&, auto&) {
                      static const char* const other[] = {VK_KHR_SWAPCHAIN_EXTENSION_NAME};
-                     AdoptInfo a = adopt_info();
+                     AdoptInfo a = adopt_info_of_context();
                      a.enabled_extensions = other;
                      a.enabled_extension_count = 1;
                      Context::adopt(a);
@@ -466,8 +457,8 @@ std::vector<ApiCase> api_cases() {
   cases.push_back({"Context::adopt with a count and a null list",
                    ErrorCode::invalid_argument,
                    {"AdoptInfo::enabled_extension_count = 3", "null AdoptInfo::enabled_extensions"},
-                   [adopt_info](Fixture&, VkCommandBuffer, auto&, auto&) {
-                     AdoptInfo a = adopt_info();
+                   [](Fixture&, VkCommandBuffer, auto&, auto&) {
+                     AdoptInfo a = adopt_info_of_context();
                      a.enabled_extension_count = 3;
                      Context::adopt(a);
                    }});

@@ -44,14 +44,6 @@ CpuImage run_bloom(const BloomConfig& config, const CpuImage& input, VkFormat in
   return run_bloom(bloom, input, in_format, out_format);
 }
 
-// The value the GPU reads from an RGBA16F input: the reference must start from the same numbers.
-CpuImage as_stored(const CpuImage& img, VkFormat format) {
-  if (format != kF16) return img;
-  CpuImage out = img;
-  for (float& v : out.rgba) v = detail::round_to_half(v);
-  return out;
-}
-
 constexpr BloomFilter kFilters[] = {BloomFilter::cod13, BloomFilter::dual, BloomFilter::gauss9};
 
 // Light the bloom added: out - in, summed over RGB, per pixel.

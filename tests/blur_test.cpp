@@ -30,13 +30,6 @@ constexpr double kTolFp16 = 4e-3;
 
 class BlurTest : public GpuTest {};
 
-CpuImage as_stored(const CpuImage& img, VkFormat format) {
-  if (format != kF16) return img;
-  CpuImage out = img;
-  for (float& v : out.rgba) v = detail::round_to_half(v);
-  return out;
-}
-
 // Runs a Gaussian blur of `input` into a NaN-poisoned output and reads it back.
 CpuImage run_gauss(GaussianBlur& blur, const CpuImage& input, VkFormat format = kF32) {
   auto in = make_image(input, format);

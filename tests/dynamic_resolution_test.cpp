@@ -37,11 +37,6 @@ constexpr double kBlurTolFp16 = 4e-3;
 
 class DynamicResolutionTest : public GpuTest {};
 
-bool same_bits(const CpuImage& a, const CpuImage& b) {
-  return a.width == b.width && a.height == b.height &&
-         std::memcmp(a.rgba.data(), b.rgba.data(), a.rgba.size() * sizeof(float)) == 0;
-}
-
 blur_plan::Plan plan_of(const BlurChoice& c, float sigma_px) {
   blur_plan::Plan p;
   p.method =
@@ -102,7 +97,7 @@ TEST_F(DynamicResolutionTest, BloomTwoSizesInOneCommandBuffer) {
     const CpuImage got = detail::read_staged(staging[i], out[i].state);
     ASSERT_TRUE(all_finite(got)) << "unwritten (poisoned) texels remain";
     EXPECT_LT(reference::relative_l2(got, reference::bloom(inputs[i], config)), kBloomTol);
-    EXPECT_TRUE(same_bits(got, run_bloom_once(config, inputs[i], kF32)));
+    EXPECT_TRUE(bit_equal(got, run_bloom_once(config, inputs[i], kF32)));
   }
 }
 
@@ -203,8 +198,8 @@ TEST_F(DynamicResolutionTest, BloomShapeChangeInsideOneCommandBuffer) {
     bloom.record(cmd, in.state, out_b.state);
     detail::record_readback(cmd, out_b.state, stage_b);
   });
-  EXPECT_TRUE(same_bits(detail::read_staged(stage_a, out_a.state), run_bloom_once(a, input, kF32)));
-  EXPECT_TRUE(same_bits(detail::read_staged(stage_b, out_b.state), run_bloom_once(b, input, kF32)));
+  EXPECT_TRUE(bit_equal(detail::read_staged(stage_a, out_a.state), run_bloom_once(a, input, kF32)));
+  EXPECT_TRUE(bit_equal(detail::read_staged(stage_b, out_b.state), run_bloom_once(b, input, kF32)));
   // Retired lazily: the old shape's pyramid goes at the next call that may retire.
   EXPECT_EQ(bloom.cached_sizes(), 2u);
   bloom.release_unused();
@@ -383,10 +378,10 @@ TEST_F(DynamicResolutionTest, SizeChangesEveryFrameWithFramesInFlight) {
     if (s.frame < 0) return;
     const uint32_t i = size_of_frame(static_cast<uint32_t>(s.frame));
     SCOPED_TRACE(testing::Message() << "frame " << s.frame << ", size " << sizes[i].width << "x" << sizes[i].height);
-    EXPECT_TRUE(same_bits(detail::read_staged(s.bloom_stage[i], s.bloom_out[i].state), want_bloom[i])) << "bloom";
-    EXPECT_TRUE(same_bits(detail::read_staged(s.gauss_stage[i], s.gauss_out[i].state), want_gauss[i])) << "gauss";
+    EXPECT_TRUE(bit_equal(detail::read_staged(s.bloom_stage[i], s.bloom_out[i].state), want_bloom[i])) << "bloom";
+    EXPECT_TRUE(bit_equal(detail::read_staged(s.gauss_stage[i], s.gauss_out[i].state), want_gauss[i])) << "gauss";
     for (uint32_t k = 0; k < 3; ++k) {
-      EXPECT_TRUE(same_bits(detail::read_staged(s.level_stage[i][k], s.level_image[i][k]), want_levels[i][k]))
+      EXPECT_TRUE(bit_equal(detail::read_staged(s.level_stage[i][k], s.level_image[i][k]), want_levels[i][k]))
           << "pyramid level " << k + 1;
     }
     ++frames_checked;
@@ -484,12 +479,7 @@ TEST_F(DynamicResolutionTest, FramesInFlightIsChecked) {
       EXPECT_NE(std::string(e.what()).find("ContextOptions::frames_in_flight"), std::string::npos) << e.what();
       EXPECT_NE(std::string(e.what()).find("1 to 16"), std::string::npos) << e.what();
     }
-    AdoptInfo adopt;
-    adopt.instance = context().instance();
-    adopt.api_version = VK_API_VERSION_1_3;
-    adopt.physical_device = context().physical_device();
-    adopt.device = context().device();
-    adopt.queue_family_index = context().queue_family_index();
+    AdoptInfo adopt = adopt_info_of_context();
     adopt.frames_in_flight = bad;
     try {
       Context::adopt(adopt);
@@ -498,12 +488,7 @@ TEST_F(DynamicResolutionTest, FramesInFlightIsChecked) {
       EXPECT_NE(std::string(e.what()).find("AdoptInfo::frames_in_flight"), std::string::npos) << e.what();
     }
   }
-  AdoptInfo adopt;
-  adopt.instance = context().instance();
-  adopt.api_version = VK_API_VERSION_1_3;
-  adopt.physical_device = context().physical_device();
-  adopt.device = context().device();
-  adopt.queue_family_index = context().queue_family_index();
+  AdoptInfo adopt = adopt_info_of_context();
   adopt.frames_in_flight = 16;
   Context adopted = Context::adopt(with_glint_extensions(adopt));
   EXPECT_EQ(adopted.frames_in_flight(), 16u);

@@ -151,17 +151,6 @@ std::vector<GlintFlareLight> only(const std::vector<SceneLight>& s, std::initial
   return out;
 }
 
-// The image as an RGBA16F texture holds it.
-CpuImage as_half(const CpuImage& img) {
-  CpuImage out = img;
-  for (float& v : out.rgba) v = detail::round_to_half(v);
-  return out;
-}
-
-bool bit_equal(const CpuImage& a, const CpuImage& b) {
-  return a.rgba.size() == b.rgba.size() && std::memcmp(a.rgba.data(), b.rgba.data(), a.rgba.size() * 4) == 0;
-}
-
 // Sum of RGB over the (2r+1)^2 pixels around (cx, cy).
 double energy(const CpuImage& img, int cx, int cy, int r) {
   double sum = 0;
@@ -220,7 +209,7 @@ TEST_F(FlareEndToEndTest, CulledAndOccludedLightsAddNothingAndVisibleOnesAddLigh
     ASSERT_EQ(hidden.size(), 5u);
     const FrameResult none = run_frame(pass, background, depth, hidden, cam.view_proj(), look);
     EXPECT_EQ(none.stats.visible, 0u);
-    const CpuImage stored = as_half(background);
+    const CpuImage stored = as_stored(background, kF16);
     EXPECT_TRUE(bit_equal(none.image, stored)) << "a culled or occluded light changed the image";
 
     const FrameResult full = run_frame(pass, background, depth, all, cam.view_proj(), look);
@@ -328,7 +317,7 @@ TEST_F(FlareEndToEndTest, ZeroLightsLeaveTheImageBitForBitAndFramesCreateNothing
                                         FlareConfig::preset(FlarePreset::cinematic), 2);
     EXPECT_EQ(first.stats.total, 0u);
     EXPECT_EQ(first.indirect.instance_count, 0u);
-    const CpuImage stored = as_half(background);
+    const CpuImage stored = as_stored(background, kF16);
     EXPECT_TRUE(bit_equal(first.image, stored));
     // Same resources twice: the second record() of a known (lights, image) set creates nothing.
     detail::OwnedImage color(context(), {kW, kH}, kF16, kColorUsage);

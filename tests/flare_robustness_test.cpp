@@ -56,16 +56,6 @@ std::vector<T> as(const std::vector<uint8_t>& bytes, size_t n) {
   return out;
 }
 
-bool bit_equal(const CpuImage& a, const CpuImage& b) {
-  return a.rgba.size() == b.rgba.size() && std::memcmp(a.rgba.data(), b.rgba.data(), a.rgba.size() * 4) == 0;
-}
-
-CpuImage as_half(const CpuImage& img) {
-  CpuImage out = img;
-  for (float& v : out.rgba) v = detail::round_to_half(v);
-  return out;
-}
-
 bool finite_instance(const GlintFlareInstance& g) {
   for (float v : {g.center_x_px, g.center_y_px, g.size_px, g.visible_fraction, g.color_r, g.color_g, g.color_b,
                   g.intensity, g.ndc_depth}) {
@@ -367,7 +357,7 @@ TEST_F(FlareRobustnessTest, FlarePassImageIsBitIdenticalAcrossRuns) {
     ASSERT_GT(first.stats.visible, 200u) << path_name(path);
     EXPECT_TRUE(all_finite(first.image)) << path_name(path);
     size_t lit = 0;
-    const CpuImage stored = as_half(background);
+    const CpuImage stored = as_stored(background, kF16);
     for (size_t i = 0; i < first.image.rgba.size(); ++i) lit += first.image.rgba[i] != stored.rgba[i];
     EXPECT_GT(lit, first.image.rgba.size() / 4) << path_name(path) << ": the flares cover too little";
     for (int r = 1; r < kRuns; ++r) {
@@ -537,7 +527,7 @@ std::vector<EdgeCase> edge_cases(const Camera& cam) {
 TEST_F(FlareRobustnessTest, EdgeCaseLightsAreCulledAsDocumentedAndDrawFiniteImages) {
   const Camera cam{kW, kH};
   const reference::DepthImage depth = edge_depth(cam);
-  const CpuImage background = as_half(random_hdr(kW, kH, 31));
+  const CpuImage background = as_stored(random_hdr(kW, kH, 31), kF16);
   const FlareConfig look = FlareConfig::preset(FlarePreset::cinematic);
   for (const EdgeCase& c : edge_cases(cam)) {
     const auto n = static_cast<uint32_t>(c.lights.size());
@@ -647,7 +637,7 @@ TEST_F(FlareRobustnessTest, FlarePassHandlesDegenerateAndThinSizes) {
                                                ndc_light(3.0f, 0.0f, 0.5f, 4.0f)};  // off screen
   for (VkExtent2D e : sizes) {
     const reference::DepthImage depth{e.width, e.height, std::vector<float>(size_t(e.width) * e.height, 1.0f)};
-    const CpuImage background = as_half(random_hdr(e.width, e.height, e.width + 7 * e.height));
+    const CpuImage background = as_stored(random_hdr(e.width, e.height, e.width + 7 * e.height), kF16);
     for (FlareDrawPath path : {FlareDrawPath::raster, FlareDrawPath::compute}) {
       const std::string what = std::to_string(e.width) + "x" + std::to_string(e.height) + " " + path_name(path);
       LensFlarePass pass(context(), pass_config(e, path, 8, uint32_t(lights.size())));

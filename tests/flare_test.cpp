@@ -90,13 +90,6 @@ detail::OwnedImage make_color(const CpuImage& pixels, VkFormat format) {
   return img;
 }
 
-CpuImage as_stored(const CpuImage& img, VkFormat format) {
-  if (format != kF16) return img;
-  CpuImage out = img;
-  for (float& v : out.rgba) v = detail::round_to_half(v);
-  return out;
-}
-
 void record(LensFlare& flare, Path path, VkCommandBuffer cmd, Image& color, FlareInputs& in,
             const FlareConfig& config) {
   if (path == Path::raster) {

@@ -54,23 +54,6 @@ detail::OwnedImage poisoned(VkExtent2D extent, VkFormat format) {
   return img;
 }
 
-// The values the GPU reads from `img` stored in `format` (the reference starts from them).
-CpuImage as_stored(const CpuImage& img, VkFormat format) {
-  CpuImage out = img;
-  for (size_t i = 0; i < out.rgba.size(); i += 4) {
-    float* t = &out.rgba[i];
-    if (format == kF16) {
-      for (int c = 0; c < 4; ++c) t[c] = detail::round_to_half(t[c]);
-    } else if (format == kB10) {
-      detail::unpack_b10g11r11(detail::pack_b10g11r11(t[0], t[1], t[2]), t);
-      t[3] = 1.0f;  // no alpha: reads as 1
-    } else if (format == VK_FORMAT_R32G32B32_SFLOAT) {
-      t[3] = 1.0f;
-    }
-  }
-  return out;
-}
-
 // The store rounding of channel c of `format`, relative: a conversion may round to nearest or
 // toward zero (Vulkan, "Floating-Point Format Conversions"; the 11- and 10-bit formats name both),
 // so one unit in the last place of an M-bit mantissa, 2^-M. B10G11R11: 6 bits for R, G, 5 for B.

@@ -58,13 +58,6 @@ Buffer view(const detail::OwnedBuffer& b) {
   return v;
 }
 
-// Makes the device's writes to `b` visible to the host.
-void to_host(VkCommandBuffer cmd, Buffer& b) {
-  detail::Barriers barriers;
-  barriers.use(b, VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
-  barriers.flush(cmd);
-}
-
 std::vector<float> run_batch(const std::vector<LodQuery>& queries, const LodAtlasConfig& atlas) {
   auto qbuf = host_buffer(queries.size() * sizeof(LodQuery));
   auto lbuf = host_buffer(queries.size() * sizeof(float));

@@ -26,12 +26,6 @@ namespace {
 
 class ObjectCullTest : public GpuTest {};
 
-void to_host(VkCommandBuffer cmd, Buffer& b) {
-  detail::Barriers barriers;
-  barriers.use(b, VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
-  barriers.flush(cmd);
-}
-
 struct SceneSpec {
   uint32_t width = 160, height = 96;
   bool reversed = false;

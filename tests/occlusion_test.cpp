@@ -24,12 +24,6 @@ namespace {
 
 class OcclusionTest : public GpuTest {};
 
-void to_host(VkCommandBuffer cmd, Buffer& b) {
-  detail::Barriers barriers;
-  barriers.use(b, VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
-  barriers.flush(cmd);
-}
-
 reference::DepthImage random_depth(uint32_t w, uint32_t h, uint32_t stream) {
   std::mt19937 rng(stream);
   std::uniform_real_distribution<float> unit(0.0f, 1.0f);

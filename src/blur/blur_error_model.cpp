@@ -432,7 +432,7 @@ double dual_model_error(double sigma, uint32_t levels, double o) {
 
 double store_unit(uint32_t mantissa_bits) { return mantissa_bits >= 23 ? 0.0 : std::ldexp(1.0, -int(mantissa_bits)); }
 
-// docs/BLUR.md "Error model": the stores and multiply-adds on each method's path (src/blur/blur.cpp
+// docs/BLUR.md "Error model": the stores and multiply-adds on each method's path (src/blur/gaussian_blur.cpp
 // GaussianBlur::Impl::make() records the same steps).
 double rounding_bound(const Plan& plan, const Storage& st) {
   const double half = store_unit(10);

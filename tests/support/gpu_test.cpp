@@ -2,9 +2,13 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <memory>
 #include <string>
 
+#include "core/barriers.h"
+#include "core/half.h"
+#include "core/packed_float.h"
 #include "support/environment.h"
 
 namespace glint::test {
@@ -64,6 +68,43 @@ bool all_finite(const CpuImage& image) {
     if (!std::isfinite(v)) return false;
   }
   return true;
+}
+
+bool bit_equal(const CpuImage& a, const CpuImage& b) {
+  return a.width == b.width && a.height == b.height && a.rgba.size() == b.rgba.size() &&
+         std::memcmp(a.rgba.data(), b.rgba.data(), a.rgba.size() * sizeof(float)) == 0;
+}
+
+CpuImage as_stored(const CpuImage& img, VkFormat format) {
+  CpuImage out = img;
+  for (size_t i = 0; i < out.rgba.size(); i += 4) {
+    float* t = &out.rgba[i];
+    if (format == VK_FORMAT_R16G16B16A16_SFLOAT) {
+      for (int c = 0; c < 4; ++c) t[c] = detail::round_to_half(t[c]);
+    } else if (format == VK_FORMAT_B10G11R11_UFLOAT_PACK32) {
+      detail::unpack_b10g11r11(detail::pack_b10g11r11(t[0], t[1], t[2]), t);
+      t[3] = 1.0f;  // no alpha: reads as 1
+    } else if (format == VK_FORMAT_R32G32B32_SFLOAT) {
+      t[3] = 1.0f;
+    }
+  }
+  return out;
+}
+
+void to_host(VkCommandBuffer cmd, Buffer& b) {
+  detail::Barriers barriers;
+  barriers.use(b, VK_PIPELINE_STAGE_2_HOST_BIT, VK_ACCESS_2_HOST_READ_BIT);
+  barriers.flush(cmd);
+}
+
+AdoptInfo adopt_info_of_context() {
+  AdoptInfo a;
+  a.instance = context().instance();
+  a.api_version = VK_API_VERSION_1_3;
+  a.physical_device = context().physical_device();
+  a.device = context().device();
+  a.queue_family_index = context().queue_family_index();
+  return a;
 }
 
 }  // namespace glint::test

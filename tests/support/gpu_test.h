@@ -38,6 +38,23 @@ detail::OwnedImage make_poisoned(VkExtent2D extent, VkFormat format);
 /// True if every channel of every texel is finite (no NaN left from poisoning).
 bool all_finite(const CpuImage& image);
 
+/// True if `a` and `b` have the same size and the same bits in every channel.
+bool bit_equal(const CpuImage& a, const CpuImage& b);
+
+/// The values the GPU reads from `img` uploaded as `format` (the reference starts from them):
+/// RGBA16F rounds each channel to half (core/half.h), B10G11R11 packs and unpacks the colour
+/// (core/packed_float.h) and reads alpha as 1, R32G32B32 reads alpha as 1; other formats hold
+/// `img` as it is.
+CpuImage as_stored(const CpuImage& img, VkFormat format);
+
+/// Records a barrier that makes the device's writes to `b` visible to the host (read it after the
+/// submission completes).
+void to_host(VkCommandBuffer cmd, Buffer& b);
+
+/// Context::adopt's description of the test program's context (instance, Vulkan 1.3, physical
+/// device, device, queue family); no extension list (with_glint_extensions() adds it).
+AdoptInfo adopt_info_of_context();
+
 /// The device extensions glint needs (VK_KHR_push_descriptor): tests that create a device for
 /// Context::adopt() enable these, as glint's own devices do.
 inline const char* const kGlintDeviceExtensions[] = {VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME};

@@ -1,4 +1,4 @@
-// Push constants of the blur kernels (src/blur/shaders/blur_*.comp), shared with src/blur/blur.cpp
+// Push constants of the blur kernels (src/blur/shaders/blur_*.comp), shared with src/blur/blur_steps.h
 // (CONTRIBUTING.md, "Shared structs"). The algorithms are in docs/BLUR.md.
 #ifndef GLINT_BLUR_PARAMS_H
 #define GLINT_BLUR_PARAMS_H

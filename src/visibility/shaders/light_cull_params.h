@@ -4,8 +4,8 @@
 // the cull's per-workgroup visibility masks (compact_scan_tiles.comp per tile, light_cull_scan.comp
 // over the tile totals, which also writes the indirect arguments and statistics), then the scatter
 // of the visible lights into the instance buffer in light-index order (light_cull_scatter.comp).
-// Declared once for GLSL and C++ (CONTRIBUTING.md, "Shared structs"); src/visibility/occlusion.cpp
-// static_asserts the layouts. docs/OCCLUSION.md explains the algorithms. The
+// Declared once for GLSL and C++ (CONTRIBUTING.md, "Shared structs"); src/visibility/hiz_pyramid.cpp and
+// light_culler.cpp static_assert the layouts. docs/OCCLUSION.md explains the algorithms. The
 // public C++ API of the same stage is include/glint/occlusion.h.
 #ifndef GLINT_LIGHT_CULL_PARAMS_H
 #define GLINT_LIGHT_CULL_PARAMS_H
