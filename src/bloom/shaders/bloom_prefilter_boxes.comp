@@ -84,6 +84,45 @@ bool at_edge(int i, int n) { return i < 0 || i > n - 2; }
 #define BOX_MEAN(i) shared_at(i)
 #include "bloom_boxes.glsl"
 
+// Step 2's value n of this invocation: the horizontal 12-tap sum at one (window row, corner
+// column); `x0` is the absolute corner of column 0, `w` the source width.
+vec3 row_value(uint n, int x0, int w) {
+  uint q = min(gl_LocalInvocationIndex + n * kGroupSize, kRowValues - 1u);
+  uint row = q / kCornersW, col = q % kCornersW;
+  int i = x0 + int(col);
+  bool edge = at_edge(i, w);
+  uint first = row * kWindowW + uint(int(col) + edge_shift(i, w));
+  vec3 sum = vec3(0.0);
+  [[unroll]] for (uint k = 0u; k < 12u; ++k) sum += (edge ? kEdge[k] : kInner[k]) * shared_at(first + k);
+  return sum;
+}
+void put_row(uint n, vec3 v) {
+  uint q = gl_LocalInvocationIndex + n * kGroupSize;
+  if (q < kRowValues) shared_put(q, v);
+}
+
+// Step 3's value n: the vertical 12-tap sum at one corner whose two indices have the same parity;
+// `y0` is the absolute corner of row 0, `h` the source height.
+vec3 box_value(uint n, int y0, int h) {
+  uint q = min(gl_LocalInvocationIndex + n * kGroupSize, kBoxSlots - 1u);
+  uint cy = q / (kTileW + 2u);
+  uint cx = min(2u * (q % (kTileW + 2u)) + (cy & 1u), kCornersW - 1u);  // the unused slot repeats a corner
+  int j = y0 + int(cy);
+  bool edge = at_edge(j, h);
+  uint first = uint(int(cy) + edge_shift(j, h)) * kCornersW + cx;
+  vec3 sum = vec3(0.0);
+  [[unroll]] for (uint k = 0u; k < 12u; ++k) sum += (edge ? kEdge[k] : kInner[k]) * shared_at(first + k * kCornersW);
+  return sum;
+}
+void put_box(uint n, vec3 v) {
+  uint q = gl_LocalInvocationIndex + n * kGroupSize;
+  if (q < kBoxSlots) {
+    uint cy = q / (kTileW + 2u);
+    uint cx = 2u * (q % (kTileW + 2u)) + (cy & 1u);
+    if (cx < kCornersW) shared_put(cy * kCornersW + cx, v);
+  }
+}
+
 void main() {
   ivec2 src_size = ivec2(p.src_width, p.src_height);
   ivec2 dst_size = ivec2(p.dst_width, p.dst_height);
@@ -93,58 +132,54 @@ void main() {
   ivec2 corner0 = 2 * tile - 2;                 // absolute corner of corner entry (0, 0)
   ivec2 window0 = corner0 - kRadius;            // absolute texel of window entry (0, 0)
 
-  // 1. P over the window, clamped to the image. Every fetch is issued before the first store.
-  vec3 fetched[kLoads];
-  [[unroll]] for (uint n = 0u; n < kLoads; ++n) {
-    uint i = min(gl_LocalInvocationIndex + n * kGroupSize, kWindowW * kWindowH - 1u);
-    fetched[n] = source_texel(scene, bright, window0 + ivec2(i % kWindowW, i / kWindowW));
-  }
-  [[unroll]] for (uint n = 0u; n < kLoads; ++n) {
-    uint i = gl_LocalInvocationIndex + n * kGroupSize;
-    if (i < kWindowW * kWindowH) shared_put(i, fetched[n]);
+  // 1. P over the window, clamped to the image. On GPUs every fetch is issued before the first
+  // store; CPU devices take a plain loop (bloom.glsl, PREFETCH), which they compile far faster.
+  if (PREFETCH) {
+    vec3 fetched[kLoads];
+    [[unroll]] for (uint n = 0u; n < kLoads; ++n) {
+      uint i = min(gl_LocalInvocationIndex + n * kGroupSize, kWindowW * kWindowH - 1u);
+      fetched[n] = source_texel(scene, bright, window0 + ivec2(i % kWindowW, i / kWindowW));
+    }
+    [[unroll]] for (uint n = 0u; n < kLoads; ++n) {
+      uint i = gl_LocalInvocationIndex + n * kGroupSize;
+      if (i < kWindowW * kWindowH) shared_put(i, fetched[n]);
+    }
+  } else {
+    [[dont_unroll]] for (uint i = gl_LocalInvocationIndex; i < kWindowW * kWindowH; i += kGroupSize) {
+      shared_put(i, source_texel(scene, bright, window0 + ivec2(i % kWindowW, i / kWindowW)));
+    }
   }
   barrier();
 
   // 2. Horizontal: every window row at every corner column, stored with row stride kCornersW.
+  // Results stay in registers until every invocation has read the window (it is reused in place).
+  // CPU devices run the same loops without unrolling (PREFETCH, as above).
   vec3 rows[kRowsPerInvocation];
-  [[unroll]] for (uint n = 0u; n < kRowsPerInvocation; ++n) {
-    uint q = min(gl_LocalInvocationIndex + n * kGroupSize, kRowValues - 1u);
-    uint row = q / kCornersW, col = q % kCornersW;
-    int i = corner0.x + int(col);
-    bool edge = at_edge(i, src_size.x);
-    uint first = row * kWindowW + uint(int(col) + edge_shift(i, src_size.x));
-    vec3 sum = vec3(0.0);
-    [[unroll]] for (uint k = 0u; k < 12u; ++k) sum += (edge ? kEdge[k] : kInner[k]) * shared_at(first + k);
-    rows[n] = sum;
+  if (PREFETCH) {
+    [[unroll]] for (uint n = 0u; n < kRowsPerInvocation; ++n) rows[n] = row_value(n, corner0.x, src_size.x);
+  } else {
+    [[dont_unroll]] for (uint n = 0u; n < kRowsPerInvocation; ++n) rows[n] = row_value(n, corner0.x, src_size.x);
   }
   barrier();
-  [[unroll]] for (uint n = 0u; n < kRowsPerInvocation; ++n) {
-    uint q = gl_LocalInvocationIndex + n * kGroupSize;
-    if (q < kRowValues) shared_put(q, rows[n]);
+  if (PREFETCH) {
+    [[unroll]] for (uint n = 0u; n < kRowsPerInvocation; ++n) put_row(n, rows[n]);
+  } else {
+    [[dont_unroll]] for (uint n = 0u; n < kRowsPerInvocation; ++n) put_row(n, rows[n]);
   }
   barrier();
 
   // 3. Vertical, at the corners the taps read, stored at their place in the kCornersW x kCornersH grid.
   vec3 boxes[kBoxesPerInvocation];
-  [[unroll]] for (uint n = 0u; n < kBoxesPerInvocation; ++n) {
-    uint q = min(gl_LocalInvocationIndex + n * kGroupSize, kBoxSlots - 1u);
-    uint cy = q / (kTileW + 2u);
-    uint cx = min(2u * (q % (kTileW + 2u)) + (cy & 1u), kCornersW - 1u);  // the unused slot repeats a corner
-    int j = corner0.y + int(cy);
-    bool edge = at_edge(j, src_size.y);
-    uint first = uint(int(cy) + edge_shift(j, src_size.y)) * kCornersW + cx;
-    vec3 sum = vec3(0.0);
-    [[unroll]] for (uint k = 0u; k < 12u; ++k) sum += (edge ? kEdge[k] : kInner[k]) * shared_at(first + k * kCornersW);
-    boxes[n] = sum;
+  if (PREFETCH) {
+    [[unroll]] for (uint n = 0u; n < kBoxesPerInvocation; ++n) boxes[n] = box_value(n, corner0.y, src_size.y);
+  } else {
+    [[dont_unroll]] for (uint n = 0u; n < kBoxesPerInvocation; ++n) boxes[n] = box_value(n, corner0.y, src_size.y);
   }
   barrier();
-  [[unroll]] for (uint n = 0u; n < kBoxesPerInvocation; ++n) {
-    uint q = gl_LocalInvocationIndex + n * kGroupSize;
-    if (q < kBoxSlots) {
-      uint cy = q / (kTileW + 2u);
-      uint cx = 2u * (q % (kTileW + 2u)) + (cy & 1u);
-      if (cx < kCornersW) shared_put(cy * kCornersW + cx, boxes[n]);
-    }
+  if (PREFETCH) {
+    [[unroll]] for (uint n = 0u; n < kBoxesPerInvocation; ++n) put_box(n, boxes[n]);
+  } else {
+    [[dont_unroll]] for (uint n = 0u; n < kBoxesPerInvocation; ++n) put_box(n, boxes[n]);
   }
   barrier();
 
