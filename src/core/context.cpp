@@ -275,6 +275,8 @@ void fill_info(ContextState& s) {
   for (const VkExtensionProperties& e : extensions) {
     if (std::strcmp(e.extensionName, VK_EXT_MEMORY_BUDGET_EXTENSION_NAME) == 0) s.memory_budget = true;
     if (std::strcmp(e.extensionName, VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME) == 0) s.push_descriptor_supported = true;
+    if (std::strcmp(e.extensionName, VK_KHR_PIPELINE_EXECUTABLE_PROPERTIES_EXTENSION_NAME) == 0)
+      s.executable_properties_supported = true;
   }
   s.max_push_descriptors = s.push_descriptor_supported ? push.maxPushDescriptors : 0;
 }
@@ -436,7 +438,21 @@ Context Context::create(const ContextOptions& options) {
                 concat("device '", props.deviceName, "' does not support ", VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME,
                        ", which glint needs (every kernel's descriptors are pushed)"));
   }
-  const char* device_extensions[] = {VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME};
+  const char* device_extensions[] = {VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME,
+                                     VK_KHR_PIPELINE_EXECUTABLE_PROPERTIES_EXTENSION_NAME};
+  // Kernel statistics (ContextOptions::kernel_statistics): the extension and its feature only where
+  // the device has both; otherwise the device is made as without the option.
+  VkPhysicalDevicePipelineExecutablePropertiesFeaturesKHR exec_supported{
+      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PIPELINE_EXECUTABLE_PROPERTIES_FEATURES_KHR};
+  if (options.kernel_statistics && s.executable_properties_supported) {
+    VkPhysicalDeviceFeatures2 query{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
+    query.pNext = &exec_supported;
+    vkGetPhysicalDeviceFeatures2(s.physical_device, &query);
+  }
+  s.kernel_statistics = exec_supported.pipelineExecutableInfo == VK_TRUE;
+  VkPhysicalDevicePipelineExecutablePropertiesFeaturesKHR exec_enabled{
+      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PIPELINE_EXECUTABLE_PROPERTIES_FEATURES_KHR};
+  exec_enabled.pipelineExecutableInfo = VK_TRUE;
 
   VkPhysicalDeviceVulkan13Features e13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
   e13.synchronization2 = VK_TRUE;
@@ -446,6 +462,7 @@ Context Context::create(const ContextOptions& options) {
   e13.maintenance4 = VK_TRUE;
   VkPhysicalDeviceVulkan12Features e12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
   e12.pNext = &e13;
+  if (s.kernel_statistics) e13.pNext = &exec_enabled;
   e12.hostQueryReset = f12.hostQueryReset;
   e12.timelineSemaphore = f12.timelineSemaphore;
   e12.shaderFloat16 = f12.shaderFloat16;
@@ -463,7 +480,7 @@ Context Context::create(const ContextOptions& options) {
   info.pNext = &enabled;
   info.queueCreateInfoCount = 1;
   info.pQueueCreateInfos = &queue;
-  info.enabledExtensionCount = 1;
+  info.enabledExtensionCount = s.kernel_statistics ? 2 : 1;
   info.ppEnabledExtensionNames = device_extensions;
   vk_check(vkCreateDevice(s.physical_device, &info, nullptr, &s.device), "vkCreateDevice");
   detail::load_push_descriptor(s);

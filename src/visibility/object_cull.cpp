@@ -16,6 +16,7 @@
 #include "core/context_state.h"
 #include "core/pipeline.h"
 #include "core/resources.h"
+#include "visibility/object_cull_internal.h"
 #include "visibility/shaders/object_cull_params.h"
 
 namespace glint {
@@ -200,7 +201,14 @@ struct ObjectCuller::Impl {
   const Context* context = nullptr;
   ObjectCullConfig config;
   uint64_t max_range = 1u << 27;  // the device's maxStorageBufferRange
-  detail::ComputePipeline cull, phase1;
+  // The test kernel of each mode: cull (single phase and phase 2) and phase1, the subgroup variants
+  // where the device supports them; cull_atomic / phase1_atomic count with shared atomics alone.
+  detail::ComputePipeline cull, phase1, cull_atomic, phase1_atomic;
+  // The previous single-phase test kernel (object_cull_v1.comp), made on first use by
+  // detail::object_cull_select_kernel (benchmarks time it against `cull`).
+  detail::ComputePipeline cull_v1;
+  bool subgroup = false;
+  detail::ObjectCullKernel kernel = detail::ObjectCullKernel::current;
   // The ordered compaction of the emitted objects (core/compaction.h): its group buffer holds the
   // test's masks and counters; object_cull_scan.comp finishes the scan, compact_scatter.comp
   // writes the payloads.
@@ -294,12 +302,20 @@ ObjectCuller::ObjectCuller(const Context& context, const ObjectCullConfig& confi
   const auto S = VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE;
   const auto B = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
   detail::PipelineDesc d;
-  d.kernel_id = "object_cull_main";
+  // The subgroup variants reduce the per-group counts with subgroupOr / subgroupAdd / subgroupElect
+  // (Vulkan 1.1 guarantees only the basic operations in compute; arithmetic is checked).
+  VkPhysicalDeviceSubgroupProperties sub{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES};
+  VkPhysicalDeviceProperties2 props2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
+  props2.pNext = &sub;
+  vkGetPhysicalDeviceProperties2(context.physical_device(), &props2);
+  const VkSubgroupFeatureFlags need = VK_SUBGROUP_FEATURE_BASIC_BIT | VK_SUBGROUP_FEATURE_ARITHMETIC_BIT;
+  m.subgroup = (sub.supportedStages & VK_SHADER_STAGE_COMPUTE_BIT) != 0 && (sub.supportedOperations & need) == need;
+  d.kernel_id = m.subgroup ? "object_cull_main_subgroup" : "object_cull_main";
   d.bindings = {S, S, B, B, B};
   d.push_constant_bytes = sizeof(GlintObjectCullPush);
   d.workgroup = {kGroup, 1};
   m.cull = detail::ComputePipeline(context, d);
-  d.kernel_id = "object_cull_phase1";
+  d.kernel_id = m.subgroup ? "object_cull_phase1_subgroup" : "object_cull_phase1";
   d.bindings = {B, B, B};
   m.phase1 = detail::ComputePipeline(context, d);
   detail::Compaction::Desc cd;
@@ -366,7 +382,14 @@ void ObjectCuller::Impl::run(VkCommandBuffer cmd, HiZPyramid* hiz, Image* depth,
       push.height = static_cast<int32_t>(hiz->config().extent.height);
       push.levels = hiz->levels();
     }
-    (images ? cull : phase1).dispatch(cmd, test, push, gx * kGroup, gy);
+    using detail::ObjectCullKernel;
+    const bool atomic = kernel == ObjectCullKernel::shared_atomics;
+    const bool v1 = kernel == ObjectCullKernel::previous && mode == GLINT_OBJECT_MODE_SINGLE;
+    const detail::ComputePipeline& test_pipeline = !images  ? (atomic ? phase1_atomic : phase1)
+                                                   : v1     ? cull_v1
+                                                   : atomic ? cull_atomic
+                                                            : cull;
+    test_pipeline.dispatch(cmd, test, push, gx * kGroup, gy);
   }
   if (profiler) profiler->mark(cmd, "object cull");
   // 2. Scan: slots, arguments, statistics; counters reset. 3. Scatter: payloads in object order.
@@ -423,4 +446,37 @@ void ObjectCuller::record_clear_history(VkCommandBuffer cmd, Buffer& visibility,
   detail::count_recorded_command();
 }
 
+namespace detail {
+
+struct ObjectCullerAccess {
+  static ObjectCuller::Impl& impl(ObjectCuller& c) { return *c.impl_; }
+  static const ObjectCuller::Impl& impl(const ObjectCuller& c) { return *c.impl_; }
+};
+
+void object_cull_select_kernel(ObjectCuller& culler, ObjectCullKernel kernel) {
+  ObjectCuller::Impl& m = ObjectCullerAccess::impl(culler);
+  const auto S = VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE;
+  const auto B = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+  PipelineDesc d;
+  d.push_constant_bytes = sizeof(GlintObjectCullPush);
+  d.workgroup = {kGroup, 1};
+  if (kernel == ObjectCullKernel::previous && !m.cull_v1) {
+    d.kernel_id = "object_cull_v1_main";
+    d.bindings = {S, S, B, B, B};
+    m.cull_v1 = ComputePipeline(*m.context, d);
+  }
+  if (kernel == ObjectCullKernel::shared_atomics && !m.cull_atomic) {
+    d.kernel_id = "object_cull_main";
+    d.bindings = {S, S, B, B, B};
+    m.cull_atomic = ComputePipeline(*m.context, d);
+    d.kernel_id = "object_cull_phase1";
+    d.bindings = {B, B, B};
+    m.phase1_atomic = ComputePipeline(*m.context, d);
+  }
+  m.kernel = kernel;
+}
+
+bool object_cull_has_subgroup_variant(const ObjectCuller& culler) { return ObjectCullerAccess::impl(culler).subgroup; }
+
+}  // namespace detail
 }  // namespace glint
