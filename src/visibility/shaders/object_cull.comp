@@ -63,12 +63,21 @@ layout(std430, binding = BINDING_VISIBILITY) readonly buffer Visibility { uint v
 layout(std430, binding = BINDING_VISIBILITY) buffer Visibility { uint visibility[]; };
 #endif
 #define COMPACT_GROUPS_BINDING BINDING_GROUPS  // the compaction's group buffer: this writes the masks (x, y)
+// and, in the last workgroup of each tile, scans the tile (so the separate tile-scan dispatch is
+// not needed). Coherent: the last workgroup reads records other workgroups wrote in this dispatch.
+#define COMPACT_GROUPS_COHERENT
 #define COMPACT_NO_SCAN
 #include "compact.glsl"
+// Per tile of the scan: the workgroups of the tile that have written their record. Zero between
+// culls (zero-filled once; object_cull_scan.comp zeroes it after every cull).
+layout(std430, binding = BINDING_GROUPS + 1) coherent buffer TileDone { uint tile_done[]; };
 layout(push_constant) uniform Push { GlintObjectCullPush pc; };
 
 shared uint s_mask[2];
 shared uint s_counts;  // the group's counts, packed as compact_pack_counts packs them
+shared bool s_last;    // this workgroup is the last of its tile to write its record
+shared uint s_scan[2][GLINT_OBJECT_GROUP];
+shared uint s_tile_counts[4];
 
 const float kEps = float(GLINT_OBJECT_EPS);
 
@@ -270,13 +279,56 @@ uint test_object(vec4 w0, vec4 w1, bool frustum_only, out bool invalid, out vec4
   return GLINT_OBJECT_STATE_NONE;
 }
 
+// The first level of the ordered compaction's scan (compact.glsl, compact_tile_scan), run by the
+// last workgroup of a tile to write its record: for each of the tile's `n` groups from `first`,
+// the emitted objects of the tile before it (z, replacing the packed counts); the tile's total in
+// its first group's w; the packed counts added to the header, one atomic per tile and counter.
+// Invocation t takes a run of consecutive groups (ceil(n / 64) of them, at most 16 for tiles of
+// 1024 groups); the runs' totals are scanned in shared memory (Hillis & Steele 1986).
+void scan_tile(uint first, uint n) {
+  const uint lid = gl_LocalInvocationIndex;
+  const uint per = (n + GLINT_OBJECT_GROUP - 1u) / GLINT_OBJECT_GROUP;
+  const uint g0 = first + min(lid * per, n), g1 = first + min(lid * per + per, n);
+  uint run = 0u;
+  uvec4 c = uvec4(0u);
+  for (uint g = g0; g < g1; ++g) {
+    const uvec4 v = groups[g];
+    run += uint(bitCount(v.x) + bitCount(v.y));
+    c += (uvec4(v.z) >> uvec4(0u, 8u, 16u, 24u)) & 0xffu;
+  }
+  s_scan[0][lid] = run;
+  barrier();
+  uint src = 0u;
+  for (uint d = 1u; d < GLINT_OBJECT_GROUP; d <<= 1u) {
+    uint v = s_scan[src][lid];
+    if (lid >= d) v += s_scan[src][lid - d];
+    s_scan[src ^ 1u][lid] = v;
+    barrier();
+    src ^= 1u;
+  }
+  uint before = s_scan[src][lid] - run;  // exclusive
+  for (uint g = g0; g < g1; ++g) {
+    const uvec4 v = groups[g];
+    groups[g].z = before;
+    before += uint(bitCount(v.x) + bitCount(v.y));
+  }
+  if (lid == 0u) groups[first].w = s_scan[src][GLINT_OBJECT_GROUP - 1u];
+  for (uint f = 0u; f < 4u; ++f) {
+    if (c[f] != 0u) atomicAdd(s_tile_counts[f], c[f]);
+  }
+  barrier();
+  if (lid < 4u && s_tile_counts[lid] != 0u) atomicAdd(counters[1u + lid], s_tile_counts[lid]);
+}
+
 void main() {
   const uint lid = gl_LocalInvocationIndex;  // < GLINT_OBJECT_GROUP: the bit of this object
   if (lid == 0u) {
     s_mask[0] = 0u;
     s_mask[1] = 0u;
     s_counts = 0u;
+    s_last = false;
   }
+  if (lid < 4u) s_tile_counts[lid] = 0u;
   barrier();
   const uint group = gl_WorkGroupID.y * pc.groups_x + gl_WorkGroupID.x;
   const uint group_count = (pc.count + GLINT_OBJECT_GROUP - 1u) / GLINT_OBJECT_GROUP;
@@ -326,7 +378,17 @@ void main() {
   if (packed != 0u) atomicAdd(s_counts, packed);
 #endif
   barrier();
+  const uint tile = group / pc.tile_groups, first = tile * pc.tile_groups;
+  const uint tile_size = group < group_count ? min(pc.tile_groups, group_count - first) : 0u;
   if (lid == 0u && group < group_count) {  // the counts go to the header through the tile scan
     groups[group] = uvec4(s_mask[0], s_mask[1], s_counts, 0u);
+    // The record, then the count that announces it (the "last block" pattern: the workgroup that
+    // brings the count to the tile's size sees every record of the tile).
+    memoryBarrierBuffer();
+    s_last = atomicAdd(tile_done[tile], 1u) == tile_size - 1u;
   }
+  barrier();
+  if (!s_last) return;  // uniform in the workgroup
+  memoryBarrierBuffer();
+  scan_tile(first, tile_size);
 }

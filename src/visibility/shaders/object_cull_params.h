@@ -59,7 +59,7 @@ struct GlintObjectCullPush {
   GLINT_UINT levels;    // Hi-Z levels built above level 0
   GLINT_UINT flags;     // GLINT_OBJECT_MODE_* | GLINT_OBJECT_REVERSED_Z
   GLINT_UINT groups_x;  // workgroups per row of the 2D dispatch (group = y * groups_x + x)
-  GLINT_UINT reserved;
+  GLINT_UINT tile_groups;  // groups per tile of the compaction's scan (object_cull.comp scans its tiles)
   // Lengths of the side planes' normals (proj_x, 1 + proj_ox), (-proj_x, 1 - proj_ox), then the
   // same of y, computed in double and rounded up (a per-frame constant the test would otherwise
   // take 2 square roots per plane evaluation for).
