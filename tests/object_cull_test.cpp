@@ -523,8 +523,9 @@ TEST_F(ObjectCullTest, TwoPhaseMovingCameraMissesNothing) {
   }
 }
 
-// Payload copies (a VkDrawIndexedIndirectCommand per object), capacity overflow keeping the lowest
-// indices, the count and dispatch arguments clamped, bytes past the capacity untouched.
+// Payload copies (a VkDrawIndexedIndirectCommand per object) and index lists (no payload: the
+// scatter's path without the copy loop), capacity overflow keeping the lowest indices, the count
+// and dispatch arguments clamped, bytes past the capacity untouched.
 TEST_F(ObjectCullTest, PayloadsAndOverflow) {
   SceneSpec s;
   s.objects = 700;
@@ -533,45 +534,49 @@ TEST_F(ObjectCullTest, PayloadsAndOverflow) {
   const auto depth = make_depth_image(rng, cam, s);
   const auto objs = make_objects(rng, cam, s);
   GpuScene g(depth, false, objs);
-  const uint32_t words = 5;
-  HostBuffer payloads(objs.size() * words * 4);
+  HostBuffer payloads(objs.size() * 5 * 4);
   auto* pw = static_cast<uint32_t*>(payloads.owned.mapped());
-  for (uint32_t i = 0; i < objs.size() * words; ++i) pw[i] = i * 2654435761u;
+  for (uint32_t i = 0; i < objs.size() * 5; ++i) pw[i] = i * 2654435761u;
   payloads.owned.flush();
-  g.buffers.payloads = payloads.view;
-  for (uint32_t capacity : {700u, 40u}) {
-    ObjectCullConfig cc;
-    cc.max_objects = s.objects;
-    cc.capacity = capacity;
-    cc.payload_words = words;
-    ObjectCuller culler(context(), cc);
-    Outputs out(capacity, words);
-    const ObjectCullFrame frame = frame_of(cam.cam, s.objects);
-    context().run_once([&](VkCommandBuffer cmd) {
-      g.hiz.record(cmd, g.depth_image.state);
-      culler.record(cmd, g.hiz, g.depth_image.state, frame, g.buffers, out.out);
-      out.host(cmd);
-      to_host(cmd, g.buffers.visibility);
-    });
-    const auto states = g.states(objs.size());
-    std::vector<uint32_t> expected;
-    uint32_t visible = 0;
-    for (uint32_t i = 0; i < objs.size(); ++i) {
-      if (states[i] != GLINT_OBJECT_STATE_VISIBLE) continue;
-      if (visible++ < capacity)
+  for (uint32_t words : {5u, 0u}) {
+    g.buffers.payloads = words ? payloads.view : Buffer{};
+    for (uint32_t capacity : {700u, 40u}) {
+      ObjectCullConfig cc;
+      cc.max_objects = s.objects;
+      cc.capacity = capacity;
+      cc.payload_words = words;
+      ObjectCuller culler(context(), cc);
+      Outputs out(capacity, words);
+      const ObjectCullFrame frame = frame_of(cam.cam, s.objects);
+      context().run_once([&](VkCommandBuffer cmd) {
+        g.hiz.record(cmd, g.depth_image.state);
+        culler.record(cmd, g.hiz, g.depth_image.state, frame, g.buffers, out.out);
+        out.host(cmd);
+        to_host(cmd, g.buffers.visibility);
+      });
+      const auto states = g.states(objs.size());
+      std::vector<uint32_t> expected;
+      uint32_t visible = 0;
+      for (uint32_t i = 0; i < objs.size(); ++i) {
+        if (states[i] != GLINT_OBJECT_STATE_VISIBLE) continue;
+        if (visible++ >= capacity) continue;
+        if (words == 0) expected.push_back(i);
         for (uint32_t w = 0; w < words; ++w) expected.push_back((i * words + w) * 2654435761u);
+      }
+      ASSERT_GT(visible, 40u);
+      const uint32_t written = std::min(visible, capacity);
+      EXPECT_EQ(out.args().draw_count, written);
+      EXPECT_EQ(out.args().group_count_x, (written + 63) / 64);
+      const auto st = out.st();
+      EXPECT_EQ(st.emitted, visible);
+      EXPECT_EQ(st.written, written);
+      EXPECT_EQ(st.overflow, visible - written);
+      const size_t slots_words = size_t(capacity) * std::max(1u, words);
+      const auto list = out.words(slots_words + 16);
+      EXPECT_EQ(std::vector<uint32_t>(list.begin(), list.begin() + expected.size()), expected)
+          << capacity << " slots, " << words << " words";
+      for (size_t k = slots_words; k < list.size(); ++k) EXPECT_EQ(list[k], 0xFFFFFFFFu) << "canary " << k;
     }
-    ASSERT_GT(visible, 40u);
-    const uint32_t written = std::min(visible, capacity);
-    EXPECT_EQ(out.args().draw_count, written);
-    EXPECT_EQ(out.args().group_count_x, (written + 63) / 64);
-    const auto st = out.st();
-    EXPECT_EQ(st.emitted, visible);
-    EXPECT_EQ(st.written, written);
-    EXPECT_EQ(st.overflow, visible - written);
-    const auto list = out.words(size_t(capacity) * words + 16);
-    EXPECT_EQ(std::vector<uint32_t>(list.begin(), list.begin() + expected.size()), expected) << capacity;
-    for (size_t k = size_t(capacity) * words; k < list.size(); ++k) EXPECT_EQ(list[k], 0xFFFFFFFFu) << "canary " << k;
   }
 }
 
