@@ -27,6 +27,8 @@
 //    pyramid, writes its state and emits the visible ones phase 1 did not. Emission is a bit in the
 //    workgroup's mask; the ordered compaction (compact.glsl) turns the masks into
 //    slots in object order, so the list is the same bits on every run.
+// 6. The compaction's first level: the last workgroup of each tile to write its record (a per-tile
+//    count after a buffer memory barrier) scans the tile (scan_tile), so no separate dispatch does.
 // GLINT_OBJECT_PHASE1 builds the phase-1 variant, which binds no image (the depth image may be a
 // render target while phase 1 runs).
 // Cost (docs/OCCLUSION.md, "Cost"): one wave of latency-bound invocations, so the kernel keeps

@@ -1,7 +1,8 @@
 // Internal layouts of the object occlusion cull (not installed): the push constants of its
-// dispatches (object_cull.comp: frustum + Hi-Z test; then the ordered compaction of
-// compact_params.h: compact_scan_tiles.comp, object_cull_scan.comp (tile totals, indirect
-// arguments and statistics) and compact_scatter.comp (payloads into their slots in object order)).
+// dispatches (object_cull.comp: frustum + Hi-Z test, whose last workgroup per tile runs the first
+// level of the scan; then the ordered compaction of compact_params.h: object_cull_scan.comp (tile
+// totals, indirect arguments and statistics) and compact_scatter.comp (payloads into their slots
+// in object order); compact_scan_tiles.comp runs the first level after object_cull_v1.comp).
 // Declared once for GLSL and C++; src/visibility/object_cull.cpp static_asserts the layouts.
 #ifndef GLINT_OBJECT_CULL_PARAMS_H
 #define GLINT_OBJECT_CULL_PARAMS_H
