@@ -11,9 +11,17 @@
 
 namespace glint::bench {
 
+namespace {
+bool g_kernel_statistics = false;
+}  // namespace
+
+void set_kernel_statistics(bool on) { g_kernel_statistics = on; }
+
 const Context& context() {
   static std::unique_ptr<Context> ctx = [] {
-    auto c = std::make_unique<Context>(Context::create(tools::context_options_from_environment()));
+    ContextOptions options;
+    options.kernel_statistics = g_kernel_statistics;
+    auto c = std::make_unique<Context>(Context::create(tools::context_options_from_environment(options)));
     std::fprintf(stderr, "glint_bench: device %s\n", c->info().name.c_str());
     return c;
   }();

@@ -13,6 +13,9 @@
 namespace glint::bench {
 
 const Context& context();
+/// Sets ContextOptions::kernel_statistics for the context (glint_bench --kernel_stats); call before
+/// the first context().
+void set_kernel_statistics(bool on);
 /// Random HDR RGBA: values in [0, 1.5) with 2% of pixels between 2 and 40.
 CpuImage random_hdr(uint32_t width, uint32_t height, uint32_t stream);
 double median_of(std::vector<double> values);

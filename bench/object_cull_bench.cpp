@@ -17,6 +17,7 @@
 #include "core/barriers.h"
 #include "core/resources.h"
 #include "reference/object_cull_reference.h"
+#include "visibility/object_cull_internal.h"
 
 namespace glint::bench {
 namespace {
@@ -26,8 +27,9 @@ constexpr VkBufferUsageFlags kUsage =
 const char* const kBounds[] = {"mixed", "spheres", "boxes"};
 
 // `count` objects; bounds 0: 1/4 boxes, 1: all spheres, 2: all boxes (the same centres and sizes,
-// so the bounds' false-positive shares and times compare).
-void run_object_cull(benchmark::State& state, uint32_t count, int bounds) {
+// so the bounds' false-positive shares and times compare). `previous`: the previous test kernel
+// (object_cull_v1.comp), for the comparison with the current one in one run.
+void run_object_cull(benchmark::State& state, uint32_t count, int bounds, bool previous = false) {
   const Context& ctx = context();
   VkPhysicalDeviceProperties props;
   vkGetPhysicalDeviceProperties(ctx.physical_device(), &props);
@@ -74,6 +76,8 @@ void run_object_cull(benchmark::State& state, uint32_t count, int bounds) {
   cc.max_objects = count;
   cc.capacity = count;
   ObjectCuller culler(ctx, cc);
+  detail::object_cull_select_kernel(culler,
+                                    previous ? detail::ObjectCullKernel::previous : detail::ObjectCullKernel::current);
   auto obj_buf = device_buffer(ctx, objects.data(), VkDeviceSize(count) * sizeof(GlintCullObject), kUsage);
   auto vis = device_buffer(ctx, nullptr, VkDeviceSize(count) * 4, kUsage);
   auto list = device_buffer(ctx, nullptr, VkDeviceSize(count) * 4, kUsage);
@@ -149,7 +153,8 @@ void run_object_cull(benchmark::State& state, uint32_t count, int bounds) {
   // Of the first objects that are hidden by brute force, the share the cull keeps (draws anyway).
   state.counters["false_positive_share"] = hidden ? double(false_positives) / double(hidden) : 0.0;
   state.counters["checked_hidden"] = double(hidden);
-  state.SetLabel(std::string("1920x1080 D32, ") + kBounds[bounds] + " on " + ctx.info().name);
+  state.SetLabel(std::string("1920x1080 D32, ") + kBounds[bounds] + (previous ? ", previous kernel" : "") + " on " +
+                 ctx.info().name);
 }
 
 // Args: objects (1/4 boxes).
@@ -160,6 +165,12 @@ void BM_ObjectCullBounds(benchmark::State& state) {
   run_object_cull(state, static_cast<uint32_t>(state.range(0)), static_cast<int>(state.range(1)));
 }
 
+// Args: objects, bounds (0: 1/4 boxes, 1: spheres, 2: boxes); the previous test kernel
+// (object_cull_v1.comp), to compare with BM_ObjectCull / BM_ObjectCullBounds in the same run.
+void BM_ObjectCullPrevious(benchmark::State& state) {
+  run_object_cull(state, static_cast<uint32_t>(state.range(0)), static_cast<int>(state.range(1)), true);
+}
+
 BENCHMARK(BM_ObjectCull)
     ->Arg(1000000)
     ->Arg(10000000)
@@ -168,6 +179,15 @@ BENCHMARK(BM_ObjectCull)
     ->Unit(benchmark::kMicrosecond);
 
 BENCHMARK(BM_ObjectCullBounds)
+    ->Args({1000000, 1})
+    ->Args({1000000, 2})
+    ->ArgNames({"objects", "bounds"})
+    ->UseManualTime()
+    ->Unit(benchmark::kMicrosecond);
+
+BENCHMARK(BM_ObjectCullPrevious)
+    ->Args({1000000, 0})
+    ->Args({10000000, 0})
     ->Args({1000000, 1})
     ->Args({1000000, 2})
     ->ArgNames({"objects", "bounds"})

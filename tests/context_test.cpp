@@ -4,6 +4,7 @@
 
 #include <cstdlib>
 #include <cstring>
+#include <vector>
 
 #include "core/context_state.h"
 #include "core/pipeline.h"
@@ -408,6 +409,58 @@ TEST_F(ContextTest, PipelinesAreSharedAndACachedHelperCanMakeOne) {
     peak = std::max(peak, v);
   }
   EXPECT_GT(peak, 0.0f);
+}
+
+// ContextOptions::kernel_statistics: off, nothing is captured; on, the pipelines made are captured
+// with the driver's statistics exactly when the device has VK_KHR_pipeline_executable_properties
+// and its pipelineExecutableInfo feature (lavapipe has both), and the validation layer sees a
+// correct use of the extension.
+TEST_F(ContextTest, KernelStatisticsAreCapturedOnlyWhenAskedAndSupported) {
+  EXPECT_FALSE(context().kernel_statistics_enabled());
+  EXPECT_TRUE(context().kernel_statistics().empty());
+  ContextOptions options = tools::context_options_from_environment();
+  options.validation = true;
+  options.kernel_statistics = true;
+  Context c = Context::create(options);
+  uint32_t n = 0;
+  vkEnumerateDeviceExtensionProperties(c.physical_device(), nullptr, &n, nullptr);
+  std::vector<VkExtensionProperties> extensions(n);
+  vkEnumerateDeviceExtensionProperties(c.physical_device(), nullptr, &n, extensions.data());
+  bool has = false;
+  for (const auto& e : extensions) has |= std::strcmp(e.extensionName, "VK_KHR_pipeline_executable_properties") == 0;
+  VkPhysicalDevicePipelineExecutablePropertiesFeaturesKHR feature{
+      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PIPELINE_EXECUTABLE_PROPERTIES_FEATURES_KHR};
+  VkPhysicalDeviceFeatures2 features{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
+  if (has) features.pNext = &feature;
+  vkGetPhysicalDeviceFeatures2(c.physical_device(), &features);
+  const bool supported = has && feature.pipelineExecutableInfo == VK_TRUE;
+  EXPECT_EQ(c.kernel_statistics_enabled(), supported);
+  EXPECT_TRUE(c.kernel_statistics().empty());  // no pipeline made yet
+  detail::PipelineDesc d;
+  d.kernel_id = "image_copy_rgba16f";
+  d.bindings = {VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE};
+  d.push_constant_bytes = 48;
+  d.workgroup = {8, 8};
+  detail::ComputePipeline pipeline(c, d);
+  const auto stats = c.kernel_statistics();
+  if (!supported) {
+    EXPECT_TRUE(stats.empty());
+  } else {
+    ASSERT_FALSE(stats.empty());
+    for (const auto& k : stats) {
+      EXPECT_EQ(k.kernel, "image_copy_rgba16f");
+      EXPECT_EQ(k.variant.rfind("8x8|48|", 0), 0u) << k.variant;
+      EXPECT_FALSE(k.executable.empty());
+      for (const auto& st : k.statistics) {
+        EXPECT_FALSE(st.name.empty());
+        EXPECT_FALSE(st.value.empty()) << st.name;
+      }
+    }
+    size_t values = 0;
+    for (const auto& k : stats) values += k.statistics.size();
+    EXPECT_GT(values, 0u) << "the driver reports no statistic";
+  }
+  EXPECT_EQ(c.validation_messages(), 0u);
 }
 
 }  // namespace

@@ -20,6 +20,7 @@
 #include "reference/object_cull_reference.h"
 #include "support/flare_scene.h"
 #include "support/gpu_test.h"
+#include "visibility/object_cull_internal.h"
 
 namespace glint::test {
 namespace {
@@ -339,6 +340,79 @@ TEST_F(ObjectCullTest, RandomScenesMatchReference) {
               total_fp, total_visible_gpu, 100.0 * total_fp / std::max(1u, total_visible_gpu), total_hidden);
 }
 
+// Every test kernel an ObjectCuller can run matches the float64 reference on the same scenes, and
+// its statistics agree with the states it wrote: the current one (with subgroup counting where the
+// device supports it), the current one counting with shared atomics alone (devices without
+// subgroup arithmetic), and the previous one (object_cull_v1.comp, kept so that glint_bench times
+// both in one run).
+TEST_F(ObjectCullTest, EveryTestKernelMatchesReference) {
+  using detail::ObjectCullKernel;
+  const ObjectCullKernel kernels[] = {ObjectCullKernel::current, ObjectCullKernel::shared_atomics,
+                                      ObjectCullKernel::previous};
+  const char* const names[] = {"current", "shared atomics", "previous"};
+  uint32_t stream = 41;
+  for (bool reversed : {false, true}) {
+    SceneSpec s;
+    s.reversed = reversed;
+    s.infinite = !reversed;
+    s.width = 160;
+    s.height = 96;
+    s.stream = stream++;
+    std::mt19937 rng(s.stream);
+    const TestCamera cam = make_camera(rng, s);
+    const auto depth = make_depth_image(rng, cam, s);
+    const auto objs = make_objects(rng, cam, s);
+    GpuScene g(depth, reversed, objs);
+    ObjectCullConfig cc;
+    cc.max_objects = s.objects;
+    cc.capacity = s.objects;
+    cc.reversed_z = reversed;
+    ObjectCuller culler(context(), cc);
+    const auto pyramid = reference::hiz_pyramid(depth, reversed, g.hiz.levels());
+    const ObjectCullFrame frame = frame_of(cam.cam, s.objects);
+    std::vector<uint32_t> states[3];
+    for (int k = 0; k < 3; ++k) {
+      detail::object_cull_select_kernel(culler, kernels[k]);
+      Outputs out(cc.capacity, 0);
+      context().run_once([&](VkCommandBuffer cmd) {
+        g.hiz.record(cmd, g.depth_image.state);
+        culler.record(cmd, g.hiz, g.depth_image.state, frame, g.buffers, out.out);
+        out.host(cmd);
+        to_host(cmd, g.buffers.visibility);
+      });
+      const std::string what = std::string(names[k]) + (reversed ? " reversed" : " standard");
+      states[k] = g.states(s.objects);
+      uint32_t invalid = 0;
+      expect_states(states[k], objs, cam.cam, depth, pyramid, what, &invalid);
+      uint32_t counts[4] = {};
+      std::vector<uint32_t> visible;
+      for (uint32_t i = 0; i < s.objects; ++i) {
+        counts[std::min(states[k][i], 3u)]++;
+        if (states[k][i] == GLINT_OBJECT_STATE_VISIBLE) visible.push_back(i);
+      }
+      EXPECT_EQ(out.words(visible.size()), visible) << what;
+      const auto st = out.st();
+      EXPECT_EQ(st.visible, counts[1]) << what;
+      EXPECT_EQ(st.occluded, counts[2]) << what;
+      EXPECT_EQ(st.frustum_culled, counts[3]) << what;
+      EXPECT_EQ(st.invalid, invalid) << what;
+      EXPECT_GT(invalid, 0u) << what << ": the scene has no malformed bound; the count would prove little";
+      EXPECT_EQ(st.emitted, counts[1]) << what;
+      EXPECT_GT(counts[2], 0u) << what;
+      EXPECT_GT(counts[3], 0u) << what;
+    }
+    // The current kernel's two ways of counting change no state; the previous kernel evaluates
+    // the same bounds and may differ only where the reference calls a decision ambiguous.
+    EXPECT_EQ(states[0], states[1]);
+    uint32_t differ = 0;
+    for (uint32_t i = 0; i < s.objects; ++i) differ += states[0][i] != states[2][i];
+    EXPECT_LE(differ, s.objects / 50 + 2);
+    std::printf("object cull kernels (%s Z): the current one %s subgroups; the previous one differs on %u of %u\n",
+                reversed ? "reversed" : "standard",
+                detail::object_cull_has_subgroup_variant(culler) ? "counts with" : "has no", differ, s.objects);
+  }
+}
+
 // Two-phase culling over a moving camera: phase 1 emits last frame's visible objects inside the
 // frustum, phase 2 the newly visible ones; their union covers every brute-force visible object,
 // they never overlap, and the states written equal a single-phase cull's.
@@ -443,8 +517,9 @@ TEST_F(ObjectCullTest, TwoPhaseMovingCameraMissesNothing) {
   }
 }
 
-// Payload copies (a VkDrawIndexedIndirectCommand per object), capacity overflow keeping the lowest
-// indices, the count and dispatch arguments clamped, bytes past the capacity untouched.
+// Payload copies (a VkDrawIndexedIndirectCommand per object) and index lists (no payload: the
+// scatter's path without the copy loop), capacity overflow keeping the lowest indices, the count
+// and dispatch arguments clamped, bytes past the capacity untouched.
 TEST_F(ObjectCullTest, PayloadsAndOverflow) {
   SceneSpec s;
   s.objects = 700;
@@ -453,45 +528,49 @@ TEST_F(ObjectCullTest, PayloadsAndOverflow) {
   const auto depth = make_depth_image(rng, cam, s);
   const auto objs = make_objects(rng, cam, s);
   GpuScene g(depth, false, objs);
-  const uint32_t words = 5;
-  HostBuffer payloads(objs.size() * words * 4);
+  HostBuffer payloads(objs.size() * 5 * 4);
   auto* pw = static_cast<uint32_t*>(payloads.owned.mapped());
-  for (uint32_t i = 0; i < objs.size() * words; ++i) pw[i] = i * 2654435761u;
+  for (uint32_t i = 0; i < objs.size() * 5; ++i) pw[i] = i * 2654435761u;
   payloads.owned.flush();
-  g.buffers.payloads = payloads.view;
-  for (uint32_t capacity : {700u, 40u}) {
-    ObjectCullConfig cc;
-    cc.max_objects = s.objects;
-    cc.capacity = capacity;
-    cc.payload_words = words;
-    ObjectCuller culler(context(), cc);
-    Outputs out(capacity, words);
-    const ObjectCullFrame frame = frame_of(cam.cam, s.objects);
-    context().run_once([&](VkCommandBuffer cmd) {
-      g.hiz.record(cmd, g.depth_image.state);
-      culler.record(cmd, g.hiz, g.depth_image.state, frame, g.buffers, out.out);
-      out.host(cmd);
-      to_host(cmd, g.buffers.visibility);
-    });
-    const auto states = g.states(objs.size());
-    std::vector<uint32_t> expected;
-    uint32_t visible = 0;
-    for (uint32_t i = 0; i < objs.size(); ++i) {
-      if (states[i] != GLINT_OBJECT_STATE_VISIBLE) continue;
-      if (visible++ < capacity)
+  for (uint32_t words : {5u, 0u}) {
+    g.buffers.payloads = words ? payloads.view : Buffer{};
+    for (uint32_t capacity : {700u, 40u}) {
+      ObjectCullConfig cc;
+      cc.max_objects = s.objects;
+      cc.capacity = capacity;
+      cc.payload_words = words;
+      ObjectCuller culler(context(), cc);
+      Outputs out(capacity, words);
+      const ObjectCullFrame frame = frame_of(cam.cam, s.objects);
+      context().run_once([&](VkCommandBuffer cmd) {
+        g.hiz.record(cmd, g.depth_image.state);
+        culler.record(cmd, g.hiz, g.depth_image.state, frame, g.buffers, out.out);
+        out.host(cmd);
+        to_host(cmd, g.buffers.visibility);
+      });
+      const auto states = g.states(objs.size());
+      std::vector<uint32_t> expected;
+      uint32_t visible = 0;
+      for (uint32_t i = 0; i < objs.size(); ++i) {
+        if (states[i] != GLINT_OBJECT_STATE_VISIBLE) continue;
+        if (visible++ >= capacity) continue;
+        if (words == 0) expected.push_back(i);
         for (uint32_t w = 0; w < words; ++w) expected.push_back((i * words + w) * 2654435761u);
+      }
+      ASSERT_GT(visible, 40u);
+      const uint32_t written = std::min(visible, capacity);
+      EXPECT_EQ(out.args().draw_count, written);
+      EXPECT_EQ(out.args().group_count_x, (written + 63) / 64);
+      const auto st = out.st();
+      EXPECT_EQ(st.emitted, visible);
+      EXPECT_EQ(st.written, written);
+      EXPECT_EQ(st.overflow, visible - written);
+      const size_t slots_words = size_t(capacity) * std::max(1u, words);
+      const auto list = out.words(slots_words + 16);
+      EXPECT_EQ(std::vector<uint32_t>(list.begin(), list.begin() + expected.size()), expected)
+          << capacity << " slots, " << words << " words";
+      for (size_t k = slots_words; k < list.size(); ++k) EXPECT_EQ(list[k], 0xFFFFFFFFu) << "canary " << k;
     }
-    ASSERT_GT(visible, 40u);
-    const uint32_t written = std::min(visible, capacity);
-    EXPECT_EQ(out.args().draw_count, written);
-    EXPECT_EQ(out.args().group_count_x, (written + 63) / 64);
-    const auto st = out.st();
-    EXPECT_EQ(st.emitted, visible);
-    EXPECT_EQ(st.written, written);
-    EXPECT_EQ(st.overflow, visible - written);
-    const auto list = out.words(size_t(capacity) * words + 16);
-    EXPECT_EQ(std::vector<uint32_t>(list.begin(), list.begin() + expected.size()), expected) << capacity;
-    for (size_t k = size_t(capacity) * words; k < list.size(); ++k) EXPECT_EQ(list[k], 0xFFFFFFFFu) << "canary " << k;
   }
 }
 
@@ -544,6 +623,58 @@ TEST_F(ObjectCullTest, ManyTilesCompactInObjectOrder) {
     EXPECT_EQ(out.st().total, count);
     const auto list = out.words(expected.size());
     EXPECT_TRUE(list == expected) << count << ": the list is not the visible objects in order";
+  }
+}
+
+// The test kernel's last workgroup of each tile scans the tile, found by a per-tile count of
+// written records. A count that is wrong at the start of a cull (here: far above any tile's size,
+// so no workgroup sees itself last) leaves every tile unscanned: nothing is emitted and the
+// statistics count nothing, which the checks of the other tests catch. The top-level scan zeroes
+// the counts, so the next cull is right again.
+TEST_F(ObjectCullTest, BrokenTileCountIsCaughtAndTheNextCullHeals) {
+  SceneSpec s;
+  s.objects = 1500;
+  std::mt19937 rng(23);
+  const TestCamera cam = make_camera(rng, s);
+  const auto depth = make_depth_image(rng, cam, s);
+  const auto base = make_objects(rng, cam, s);
+  const uint32_t count = 9000;  // 3 tiles of 64 groups on CPU devices, 1 of 1024 on GPUs
+  std::vector<GlintCullObject> objs(count);
+  for (uint32_t i = 0; i < count; ++i) objs[i] = base[(i * 2654435761u) % base.size()];
+  GpuScene g(depth, false, objs);
+  ObjectCullConfig cc;
+  cc.max_objects = count;
+  cc.capacity = count;
+  ObjectCuller culler(context(), cc);
+  const ObjectCullFrame frame = frame_of(cam.cam, count);
+  for (bool broken : {true, false}) {
+    Outputs out(count, 0);
+    g.visibility.poison();
+    context().run_once([&](VkCommandBuffer cmd) {
+      if (broken) detail::object_cull_fill_tile_counts(culler, cmd, 0x40000000u);
+      g.hiz.record(cmd, g.depth_image.state);
+      culler.record(cmd, g.hiz, g.depth_image.state, frame, g.buffers, out.out);
+      out.host(cmd);
+      to_host(cmd, g.buffers.visibility);
+    });
+    const auto states = g.states(count);
+    std::vector<uint32_t> expected;
+    for (uint32_t i = 0; i < count; ++i) {
+      ASSERT_GE(states[i], 1u) << i;  // the states do not depend on the scan
+      ASSERT_LE(states[i], 3u) << i;
+      if (states[i] == GLINT_OBJECT_STATE_VISIBLE) expected.push_back(i);
+    }
+    ASSERT_GT(expected.size(), count / 100);
+    if (broken) {
+      EXPECT_EQ(out.st().emitted, 0u) << "a tile was scanned although its count never reached its size";
+      EXPECT_EQ(out.st().visible, 0u);
+      EXPECT_EQ(out.args().draw_count, 0u);
+    } else {
+      EXPECT_EQ(out.st().emitted, expected.size());
+      EXPECT_EQ(out.st().visible, expected.size());
+      EXPECT_EQ(out.args().draw_count, expected.size());
+      EXPECT_TRUE(out.words(expected.size()) == expected) << "the list is not the visible objects in order";
+    }
   }
 }
 

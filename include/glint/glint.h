@@ -101,6 +101,30 @@ struct ContextOptions {
   /// F - frames_in_flight or earlier has completed. Effects keep a size's images for this many
   /// frames after its last use (see Context::begin_frame()).
   uint32_t frames_in_flight = 3;
+  /// Capture the driver's statistics of every compute pipeline glint makes (register count,
+  /// shared memory, spills, instruction count: whatever the driver reports), for
+  /// Context::kernel_statistics(). VK_KHR_pipeline_executable_properties and its
+  /// pipelineExecutableInfo feature are enabled only where the device supports them
+  /// (Context::kernel_statistics_enabled() says whether they were); off (the default), the device
+  /// and the pipelines are made exactly as without this option. For tuning tools (glint_bench
+  /// --kernel_stats).
+  bool kernel_statistics = false;
+};
+
+/// One statistic of a pipeline executable (VkPipelineExecutableStatisticKHR), as the driver names it.
+struct KernelStatistic {
+  std::string name;         //!< e.g. "Register count" (driver-specific)
+  std::string description;  //!< the driver's description
+  std::string value;        //!< the value as text (bool32, int64, uint64 or float64 in the driver's unit)
+};
+
+/// The statistics of one executable (shader stage or driver-internal part) of one compute pipeline.
+struct KernelStatistics {
+  std::string kernel;      //!< the kernel id, e.g. "object_cull_main"
+  std::string variant;     //!< workgroup, specialization and bindings of this pipeline of the kernel
+  std::string executable;  //!< VkPipelineExecutablePropertiesKHR::name
+  uint32_t subgroup_size = 0;
+  std::vector<KernelStatistic> statistics;
 };
 
 /// What an engine hands glint when it adopts the engine's own Vulkan objects. glint never
@@ -222,6 +246,13 @@ class Context {
   /// run_once()), then mark_idle(). Throws Error(invalid_argument) in adopted mode, where the
   /// engine owns the queues: wait there and call mark_idle().
   void wait_idle() const;
+
+  /// Whether pipeline statistics are captured: ContextOptions::kernel_statistics was set and the
+  /// device supports VK_KHR_pipeline_executable_properties (never for an adopted device).
+  bool kernel_statistics_enabled() const;
+  /// The driver's statistics of every compute pipeline this context has made so far, in kernel
+  /// order; empty unless kernel_statistics_enabled().
+  std::vector<KernelStatistics> kernel_statistics() const;
 
   detail::ContextState& state() const { return *state_; }
 

@@ -35,6 +35,10 @@
 
 namespace glint {
 
+namespace detail {
+struct ObjectCullerAccess;  // benchmark and test switches (src/visibility/object_cull_internal.h)
+}  // namespace detail
+
 /// Creation-time settings of an ObjectCuller. Checked by validate().
 struct ObjectCullConfig {
   uint32_t max_objects = 1u << 20;  //!< most objects per record (1 to 268435456 = 2^28); the culler
@@ -138,6 +142,7 @@ class ObjectCuller {
   struct Impl;
 
  private:
+  friend struct detail::ObjectCullerAccess;
   std::unique_ptr<Impl> impl_;
 };
 

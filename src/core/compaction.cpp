@@ -71,14 +71,14 @@ void Compaction::record_clear_once(VkCommandBuffer cmd, Barriers& b) {
 }
 
 void Compaction::record_scan(VkCommandBuffer cmd, Barriers& b, GlintCompactPush push,
-                             std::initializer_list<Buffer*> outputs) {
+                             std::initializer_list<Buffer*> outputs, bool tiles_scanned) {
   // The top-level scan's descriptors: the group buffer, then the user's outputs.
   Bindings top{groups_state_};
   for (Buffer* o : outputs) top.push_back(*o);
   push.tile_groups = scan_threads_;
   // 1. Tiles of scan_threads groups in parallel: slots within each tile, tile totals.
   const uint32_t group_count = (push.count + kGroup - 1) / kGroup;
-  if (group_count > 0) {
+  if (group_count > 0 && !tiles_scanned) {
     b.use(groups_state_, kCompute, kRead | kWrite);
     b.flush(cmd);
     scan_tiles_.dispatch(cmd, {groups_state_}, push, (group_count + scan_threads_ - 1) / scan_threads_ * scan_threads_,

@@ -53,8 +53,11 @@ class Compaction {
   /// Zeroes the header's counters the first time (the top-level scan resets them after every run).
   void record_clear_once(VkCommandBuffer cmd, Barriers& b);
   /// The two-level scan of `push.count` items; `outputs` are the top-level scan's buffers (written).
-  /// Fills push.tile_groups.
-  void record_scan(VkCommandBuffer cmd, Barriers& b, GlintCompactPush push, std::initializer_list<Buffer*> outputs);
+  /// Fills push.tile_groups. `tiles_scanned`: the user's test kernel already ran the first level
+  /// (its last workgroup per tile scans the tile, as object_cull.comp does), so only the top level
+  /// is recorded.
+  void record_scan(VkCommandBuffer cmd, Barriers& b, GlintCompactPush push, std::initializer_list<Buffer*> outputs,
+                   bool tiles_scanned = false);
   /// The scatter of `push.count` items: `inputs` read, `outputs` written. Fills push.tile_groups and
   /// push.groups_x.
   void record_scatter(VkCommandBuffer cmd, Barriers& b, GlintCompactPush push, std::initializer_list<Buffer*> inputs,

@@ -166,7 +166,21 @@ Context Context::create(const ContextOptions& options) {
                 concat("device '", props.deviceName, "' does not support ", VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME,
                        ", which glint needs (every kernel's descriptors are pushed)"));
   }
-  const char* device_extensions[] = {VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME};
+  const char* device_extensions[] = {VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME,
+                                     VK_KHR_PIPELINE_EXECUTABLE_PROPERTIES_EXTENSION_NAME};
+  // Kernel statistics (ContextOptions::kernel_statistics): the extension and its feature only where
+  // the device has both; otherwise the device is made as without the option.
+  VkPhysicalDevicePipelineExecutablePropertiesFeaturesKHR exec_supported{
+      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PIPELINE_EXECUTABLE_PROPERTIES_FEATURES_KHR};
+  if (options.kernel_statistics && s.executable_properties_supported) {
+    VkPhysicalDeviceFeatures2 query{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
+    query.pNext = &exec_supported;
+    vkGetPhysicalDeviceFeatures2(s.physical_device, &query);
+  }
+  s.kernel_statistics = exec_supported.pipelineExecutableInfo == VK_TRUE;
+  VkPhysicalDevicePipelineExecutablePropertiesFeaturesKHR exec_enabled{
+      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PIPELINE_EXECUTABLE_PROPERTIES_FEATURES_KHR};
+  exec_enabled.pipelineExecutableInfo = VK_TRUE;
 
   VkPhysicalDeviceVulkan13Features e13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
   e13.synchronization2 = VK_TRUE;
@@ -176,6 +190,7 @@ Context Context::create(const ContextOptions& options) {
   e13.maintenance4 = VK_TRUE;
   VkPhysicalDeviceVulkan12Features e12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
   e12.pNext = &e13;
+  if (s.kernel_statistics) e13.pNext = &exec_enabled;
   e12.hostQueryReset = f12.hostQueryReset;
   e12.timelineSemaphore = f12.timelineSemaphore;
   e12.shaderFloat16 = f12.shaderFloat16;
@@ -193,7 +208,7 @@ Context Context::create(const ContextOptions& options) {
   info.pNext = &enabled;
   info.queueCreateInfoCount = 1;
   info.pQueueCreateInfos = &queue;
-  info.enabledExtensionCount = 1;
+  info.enabledExtensionCount = s.kernel_statistics ? 2 : 1;
   info.ppEnabledExtensionNames = device_extensions;
   vk_check(vkCreateDevice(s.physical_device, &info, nullptr, &s.device), "vkCreateDevice");
   detail::load_push_descriptor(s);

@@ -42,6 +42,12 @@ struct ContextState {
   bool push_descriptor_supported = false;
   uint32_t max_push_descriptors = 0;
   PFN_vkCmdPushDescriptorSetKHR cmd_push_descriptor_set = nullptr;
+  // VK_KHR_pipeline_executable_properties (ContextOptions::kernel_statistics): whether the
+  // physical device has it (fill_info()), and whether it was enabled with pipelineExecutableInfo;
+  // then pipelines are made with VK_PIPELINE_CREATE_CAPTURE_STATISTICS_BIT_KHR
+  // (Context::kernel_statistics(), core/pipeline.cpp).
+  bool executable_properties_supported = false;
+  bool kernel_statistics = false;
 
   // Standalone helpers for run_once(). The pool, the fence and the queue need external
   // synchronization (Vulkan, "Threading Behavior"): run_once() holds submit_mutex from allocating

@@ -40,6 +40,8 @@ void fill_info(ContextState& s) {
   for (const VkExtensionProperties& e : extensions) {
     if (std::strcmp(e.extensionName, VK_EXT_MEMORY_BUDGET_EXTENSION_NAME) == 0) s.memory_budget = true;
     if (std::strcmp(e.extensionName, VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME) == 0) s.push_descriptor_supported = true;
+    if (std::strcmp(e.extensionName, VK_KHR_PIPELINE_EXECUTABLE_PROPERTIES_EXTENSION_NAME) == 0)
+      s.executable_properties_supported = true;
   }
   s.max_push_descriptors = s.push_descriptor_supported ? push.maxPushDescriptors : 0;
   s.format_features = fill_format_features(s.physical_device);

@@ -73,6 +73,7 @@ std::shared_ptr<CompiledPipeline> compile(const Context& context, const Pipeline
   cp.stage.pName = "main";
   cp.stage.pSpecializationInfo = &spec;
   cp.layout = c->layout;
+  if (s.kernel_statistics) cp.flags |= VK_PIPELINE_CREATE_CAPTURE_STATISTICS_BIT_KHR;
   const VkResult r = vkCreateComputePipelines(s.device, VK_NULL_HANDLE, 1, &cp, nullptr, &c->pipeline);
   vkDestroyShaderModule(s.device, module, nullptr);
   vk_check(r, "vkCreateComputePipelines");
@@ -206,3 +207,72 @@ void ComputePipeline::dispatch_raw(VkCommandBuffer cmd, const Bindings& bindings
 }
 
 }  // namespace glint::detail
+
+namespace glint {
+
+bool Context::kernel_statistics_enabled() const { return state().kernel_statistics; }
+
+std::vector<KernelStatistics> Context::kernel_statistics() const {
+  std::vector<KernelStatistics> out;
+  detail::ContextState& s = state();
+  if (!s.kernel_statistics) return out;
+  const auto get_properties = reinterpret_cast<PFN_vkGetPipelineExecutablePropertiesKHR>(
+      vkGetDeviceProcAddr(s.device, "vkGetPipelineExecutablePropertiesKHR"));
+  const auto get_statistics = reinterpret_cast<PFN_vkGetPipelineExecutableStatisticsKHR>(
+      vkGetDeviceProcAddr(s.device, "vkGetPipelineExecutableStatisticsKHR"));
+  if (!get_properties || !get_statistics) {
+    throw Error(ErrorCode::vulkan_failure,
+                "VK_KHR_pipeline_executable_properties is enabled but its commands are not loadable");
+  }
+  std::lock_guard<std::mutex> lock(s.pipeline_mutex);
+  for (const auto& [key, slot] : s.pipelines) {
+    // key: "pipeline|<kernel>|<workgroup>|<push bytes>|<specialization>|<bindings>" (ComputePipeline).
+    const auto* c = static_cast<const detail::CompiledPipeline*>(slot.get());
+    if (!c || !c->pipeline) continue;
+    const size_t k0 = key.find('|') + 1, k1 = key.find('|', k0);
+    VkPipelineInfoKHR info{VK_STRUCTURE_TYPE_PIPELINE_INFO_KHR};
+    info.pipeline = c->pipeline;
+    uint32_t n = 0;
+    detail::vk_check(get_properties(s.device, &info, &n, nullptr), "vkGetPipelineExecutablePropertiesKHR");
+    std::vector<VkPipelineExecutablePropertiesKHR> props(n, {VK_STRUCTURE_TYPE_PIPELINE_EXECUTABLE_PROPERTIES_KHR});
+    detail::vk_check(get_properties(s.device, &info, &n, props.data()), "vkGetPipelineExecutablePropertiesKHR");
+    for (uint32_t e = 0; e < n; ++e) {
+      KernelStatistics ks;
+      ks.kernel = key.substr(k0, k1 - k0);
+      ks.variant = key.substr(k1 + 1);
+      ks.executable = props[e].name;
+      ks.subgroup_size = props[e].subgroupSize;
+      VkPipelineExecutableInfoKHR ei{VK_STRUCTURE_TYPE_PIPELINE_EXECUTABLE_INFO_KHR};
+      ei.pipeline = c->pipeline;
+      ei.executableIndex = e;
+      uint32_t m = 0;
+      detail::vk_check(get_statistics(s.device, &ei, &m, nullptr), "vkGetPipelineExecutableStatisticsKHR");
+      std::vector<VkPipelineExecutableStatisticKHR> stats(m, {VK_STRUCTURE_TYPE_PIPELINE_EXECUTABLE_STATISTIC_KHR});
+      detail::vk_check(get_statistics(s.device, &ei, &m, stats.data()), "vkGetPipelineExecutableStatisticsKHR");
+      for (uint32_t i = 0; i < m; ++i) {
+        KernelStatistic st;
+        st.name = stats[i].name;
+        st.description = stats[i].description;
+        switch (stats[i].format) {
+          case VK_PIPELINE_EXECUTABLE_STATISTIC_FORMAT_BOOL32_KHR:
+            st.value = stats[i].value.b32 ? "true" : "false";
+            break;
+          case VK_PIPELINE_EXECUTABLE_STATISTIC_FORMAT_INT64_KHR:
+            st.value = std::to_string(stats[i].value.i64);
+            break;
+          case VK_PIPELINE_EXECUTABLE_STATISTIC_FORMAT_UINT64_KHR:
+            st.value = std::to_string(stats[i].value.u64);
+            break;
+          default:
+            st.value = detail::concat(stats[i].value.f64);
+            break;
+        }
+        ks.statistics.push_back(std::move(st));
+      }
+      out.push_back(std::move(ks));
+    }
+  }
+  return out;
+}
+
+}  // namespace glint

@@ -13,5 +13,8 @@ set(GLINT_EFFECT_KERNELS
   "shaders/light_cull_scatter|main|"
   "shaders/object_cull|main|"
   "shaders/object_cull|phase1|GLINT_OBJECT_PHASE1=1"
+  "shaders/object_cull|main_subgroup|GLINT_OBJECT_SUBGROUP=1"
+  "shaders/object_cull|phase1_subgroup|GLINT_OBJECT_PHASE1=1+GLINT_OBJECT_SUBGROUP=1"
+  "shaders/object_cull_v1|main|"
   "shaders/object_cull_scan|main|"
 )

@@ -16,6 +16,7 @@
 #include "core/context_state.h"
 #include "core/pipeline.h"
 #include "core/resources.h"
+#include "visibility/object_cull_internal.h"
 #include "visibility/shaders/object_cull_params.h"
 
 namespace glint {
@@ -200,13 +201,26 @@ struct ObjectCuller::Impl {
   const Context* context = nullptr;
   ObjectCullConfig config;
   uint64_t max_range = 1u << 27;  // the device's maxStorageBufferRange
-  detail::ComputePipeline cull, phase1;
+  // The test kernel of each mode: cull (single phase and phase 2) and phase1, the subgroup variants
+  // where the device supports them; cull_atomic / phase1_atomic count with shared atomics alone.
+  detail::ComputePipeline cull, phase1, cull_atomic, phase1_atomic;
+  // The previous single-phase test kernel (object_cull_v1.comp), made on first use by
+  // detail::object_cull_select_kernel (benchmarks time it against `cull`).
+  detail::ComputePipeline cull_v1;
+  bool subgroup = false;
+  detail::ObjectCullKernel kernel = detail::ObjectCullKernel::current;
   // The ordered compaction of the emitted objects (core/compaction.h): its group buffer holds the
   // test's masks and counters; object_cull_scan.comp finishes the scan, compact_scatter.comp
   // writes the payloads.
   detail::Compaction compact;
   detail::OwnedBuffer dummy;
   Buffer dummy_state;
+  // Per tile of the scan, the test's workgroups that have written their record (object_cull.comp:
+  // the last one scans the tile); zero-filled at the first record, zeroed by the top-level scan
+  // after every cull.
+  detail::OwnedBuffer tile_done;
+  Buffer tile_done_state;
+  bool tile_done_cleared = false;
 
   void check_common(const char* where, const ObjectCullFrame& frame, ObjectCullBuffers& in, ObjectCullOutputs& out,
                     GlintObjectCullPush& push) const {
@@ -294,22 +308,34 @@ ObjectCuller::ObjectCuller(const Context& context, const ObjectCullConfig& confi
   const auto S = VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE;
   const auto B = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
   detail::PipelineDesc d;
-  d.kernel_id = "object_cull_main";
-  d.bindings = {S, S, B, B, B};
+  // The subgroup variants reduce the per-group counts with subgroupOr / subgroupAdd / subgroupElect
+  // (Vulkan 1.1 guarantees only the basic operations in compute; arithmetic is checked).
+  VkPhysicalDeviceSubgroupProperties sub{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES};
+  VkPhysicalDeviceProperties2 props2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
+  props2.pNext = &sub;
+  vkGetPhysicalDeviceProperties2(context.physical_device(), &props2);
+  const VkSubgroupFeatureFlags need = VK_SUBGROUP_FEATURE_BASIC_BIT | VK_SUBGROUP_FEATURE_ARITHMETIC_BIT;
+  m.subgroup = (sub.supportedStages & VK_SHADER_STAGE_COMPUTE_BIT) != 0 && (sub.supportedOperations & need) == need;
+  d.kernel_id = m.subgroup ? "object_cull_main_subgroup" : "object_cull_main";
+  d.bindings = {S, S, B, B, B, B};
   d.push_constant_bytes = sizeof(GlintObjectCullPush);
   d.workgroup = {kGroup, 1};
   m.cull = detail::ComputePipeline(context, d);
-  d.kernel_id = "object_cull_phase1";
-  d.bindings = {B, B, B};
+  d.kernel_id = m.subgroup ? "object_cull_phase1_subgroup" : "object_cull_phase1";
+  d.bindings = {B, B, B, B};
   m.phase1 = detail::ComputePipeline(context, d);
   detail::Compaction::Desc cd;
   cd.max_items = config.max_objects;
-  cd.scan_kernel = "object_cull_scan_main";  // writes the indirect arguments and statistics
-  cd.scan_outputs = 2;
+  cd.scan_kernel = "object_cull_scan_main";    // writes the indirect arguments and statistics
+  cd.scan_outputs = 3;                         // and zeroes the test's tile counts
   cd.scatter_kernel = "compact_scatter_main";  // payloads (or indices) into the list
   cd.scatter_inputs = 1;
   cd.scatter_outputs = 1;
   m.compact = detail::Compaction(context, cd);
+  const VkBufferUsageFlags tile_usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+  const uint64_t tiles = (groups + m.compact.tile_groups() - 1) / m.compact.tile_groups();
+  m.tile_done = detail::OwnedBuffer(context, std::max<uint64_t>(1, tiles) * 4, tile_usage, false);
+  m.tile_done_state = view_of(m.tile_done, tile_usage);
   m.dummy = detail::OwnedBuffer(context, 16, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, false);
   m.dummy_state = view_of(m.dummy, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
 }
@@ -334,7 +360,12 @@ void ObjectCuller::Impl::run(VkCommandBuffer cmd, HiZPyramid* hiz, Image* depth,
   Buffer& payloads = config.payload_words > 0 ? in.payloads : dummy_state;
   Buffer& groups_state = compact.groups();
   const bool images = mode != GLINT_OBJECT_MODE_PHASE1;
-  // The test's descriptors: depth and Hi-Z (not in phase 1), objects, visibility, counters.
+  using detail::ObjectCullKernel;
+  const bool atomic = kernel == ObjectCullKernel::shared_atomics;
+  // The previous kernel leaves the first level of the scan to compact_scan_tiles.comp.
+  const bool v1 = kernel == ObjectCullKernel::previous && mode == GLINT_OBJECT_MODE_SINGLE;
+  // The test's descriptors: depth and Hi-Z (not in phase 1), objects, visibility, counters, the
+  // tiles' counts of written records (not in the previous kernel).
   detail::Bindings test;
   if (images) {
     test.push_back({depth->view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL});
@@ -343,12 +374,20 @@ void ObjectCuller::Impl::run(VkCommandBuffer cmd, HiZPyramid* hiz, Image* depth,
   test.push_back(in.objects);
   test.push_back(in.visibility);
   test.push_back(groups_state);
+  if (!v1) test.push_back(tile_done_state);
 
   detail::Barriers b;
   compact.record_clear_once(cmd, b);  // the scan resets the counters after every cull
+  if (!tile_done_cleared) {           // the top-level scan zeroes them after every cull
+    b.use(tile_done_state, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);
+    b.flush(cmd);
+    vkCmdFillBuffer(cmd, tile_done_state.buffer, 0, tile_done_state.size, 0);
+    detail::count_recorded_command();
+    tile_done_cleared = true;
+  }
   uint32_t gx, gy;
   compact.grid(count, gx, gy);
-  // 1. Test: masks, counters, states.
+  // 1. Test: masks, counters, states; the last workgroup of each tile scans the tile.
   if (images) {
     b.use(*depth, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, kCompute, kSampled);
     b.use(hiz->image(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, kCompute, kSampled, std::max(1u, hiz->levels()));
@@ -356,17 +395,23 @@ void ObjectCuller::Impl::run(VkCommandBuffer cmd, HiZPyramid* hiz, Image* depth,
   b.use(in.objects, kCompute, kRead);
   b.use(in.visibility, kCompute, images ? (kRead | kWrite) : kRead);
   b.use(groups_state, kCompute, kRead | kWrite);
+  b.use(tile_done_state, kCompute, kRead | kWrite);
   b.flush(cmd);
   if (count > 0) {
     push.count = count;
     push.flags = mode | (config.reversed_z ? GLINT_OBJECT_REVERSED_Z : 0u);
     push.groups_x = gx;
+    push.tile_groups = compact.tile_groups();
     if (images) {
       push.width = static_cast<int32_t>(hiz->config().extent.width);
       push.height = static_cast<int32_t>(hiz->config().extent.height);
       push.levels = hiz->levels();
     }
-    (images ? cull : phase1).dispatch(cmd, test, push, gx * kGroup, gy);
+    const detail::ComputePipeline& test_pipeline = !images  ? (atomic ? phase1_atomic : phase1)
+                                                   : v1     ? cull_v1
+                                                   : atomic ? cull_atomic
+                                                            : cull;
+    test_pipeline.dispatch(cmd, test, push, gx * kGroup, gy);
   }
   if (profiler) profiler->mark(cmd, "object cull");
   // 2. Scan: slots, arguments, statistics; counters reset. 3. Scatter: payloads in object order.
@@ -378,7 +423,7 @@ void ObjectCuller::Impl::run(VkCommandBuffer cmd, HiZPyramid* hiz, Image* depth,
   GlintCompactPush cp;
   static_assert(sizeof(cp) == sizeof(op));
   std::memcpy(&cp, &op, sizeof(cp));
-  compact.record_scan(cmd, b, cp, {&out.indirect, &out.stats});
+  compact.record_scan(cmd, b, cp, {&out.indirect, &out.stats, &tile_done_state}, !v1);
   if (profiler) profiler->mark(cmd, "object cull scan");
   compact.record_scatter(cmd, b, cp, {&payloads}, {&out.list});
   if (profiler) profiler->mark(cmd, "object cull scatter");
@@ -423,4 +468,47 @@ void ObjectCuller::record_clear_history(VkCommandBuffer cmd, Buffer& visibility,
   detail::count_recorded_command();
 }
 
+namespace detail {
+
+struct ObjectCullerAccess {
+  static ObjectCuller::Impl& impl(ObjectCuller& c) { return *c.impl_; }
+  static const ObjectCuller::Impl& impl(const ObjectCuller& c) { return *c.impl_; }
+};
+
+void object_cull_select_kernel(ObjectCuller& culler, ObjectCullKernel kernel) {
+  ObjectCuller::Impl& m = ObjectCullerAccess::impl(culler);
+  const auto S = VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE;
+  const auto B = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+  PipelineDesc d;
+  d.push_constant_bytes = sizeof(GlintObjectCullPush);
+  d.workgroup = {kGroup, 1};
+  if (kernel == ObjectCullKernel::previous && !m.cull_v1) {
+    d.kernel_id = "object_cull_v1_main";
+    d.bindings = {S, S, B, B, B};
+    m.cull_v1 = ComputePipeline(*m.context, d);
+  }
+  if (kernel == ObjectCullKernel::shared_atomics && !m.cull_atomic) {
+    d.kernel_id = "object_cull_main";
+    d.bindings = {S, S, B, B, B, B};
+    m.cull_atomic = ComputePipeline(*m.context, d);
+    d.kernel_id = "object_cull_phase1";
+    d.bindings = {B, B, B, B};
+    m.phase1_atomic = ComputePipeline(*m.context, d);
+  }
+  m.kernel = kernel;
+}
+
+void object_cull_fill_tile_counts(ObjectCuller& culler, VkCommandBuffer cmd, uint32_t value) {
+  ObjectCuller::Impl& m = ObjectCullerAccess::impl(culler);
+  Barriers b;
+  b.use(m.tile_done_state, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);
+  b.flush(cmd);
+  vkCmdFillBuffer(cmd, m.tile_done_state.buffer, 0, m.tile_done_state.size, value);
+  count_recorded_command();
+  m.tile_done_cleared = true;
+}
+
+bool object_cull_has_subgroup_variant(const ObjectCuller& culler) { return ObjectCullerAccess::impl(culler).subgroup; }
+
+}  // namespace detail
 }  // namespace glint

@@ -1,6 +1,7 @@
 // The ordered compaction's GPU side, shared by every user (compact_params.h, docs/OCCLUSION.md
 // "The shared compaction core"). Before including, define COMPACT_GROUPS_BINDING (the group buffer's
-// binding) and, where the including kernel only reads it, COMPACT_GROUPS_READONLY. The kernel
+// binding) and, where the including kernel only reads it, COMPACT_GROUPS_READONLY; where other
+// workgroups of the same dispatch read what it writes, COMPACT_GROUPS_COHERENT. The kernel
 // declares local_size_x_id = 0 (the tile's groups, for the scans).
 //
 // The scan is the reduce-then-scan of Merrill & Garland 2016, "Single-pass Parallel Prefix Scan
@@ -15,6 +16,9 @@
 layout(std430, binding = COMPACT_GROUPS_BINDING)
 #ifdef COMPACT_GROUPS_READONLY
     readonly
+#endif
+#ifdef COMPACT_GROUPS_COHERENT
+    coherent  // read by other workgroups of the same dispatch (a test kernel that scans its tiles)
 #endif
     buffer CompactGroups {
   uint counters[GLINT_COMPACT_HEADER_WORDS];

@@ -8,8 +8,9 @@
 // destination words are then copied cooperatively, invocation t taking words t, t + 64, ...:
 // consecutive invocations write consecutive words and read each item's consecutive payload words,
 // so both sides coalesce whatever the payload size (an invocation per item would write
-// payload_words-strided words). Slots at or beyond the capacity are not written (the overflow keeps
-// the smallest indices). A slot receives the item's payload_words words (step[0] > 0) or its index.
+// payload_words-strided words); an index list (no payload) needs no copy loop: each emitted
+// invocation writes its index to its slot. Slots at or beyond the capacity are not written (the
+// overflow keeps the smallest indices). A slot receives the item's payload_words words (step[0] > 0) or its index.
 layout(local_size_x_id = 0, local_size_y_id = 1) in;  // GLINT_COMPACT_GROUP x 1
 
 #define COMPACT_GROUPS_BINDING 0
@@ -32,18 +33,20 @@ void main() {
   const uint first = groups[group / pc.tile_groups * pc.tile_groups].w + g.z;
   const uint word = t < 32u ? g.x : g.y;
   const uint bit = t & 31u;
-  if (((word >> bit) & 1u) != 0u) {
-    s_item[uint(bitCount(word & ((1u << bit) - 1u))) + (t < 32u ? 0u : uint(bitCount(g.x)))] = t;
+  const bool emitted = ((word >> bit) & 1u) != 0u;
+  const uint rank = uint(bitCount(word & ((1u << bit) - 1u))) + (t < 32u ? 0u : uint(bitCount(g.x)));
+  const uint pw = pc.step[0];
+  const uint base = group * GLINT_COMPACT_GROUP;
+  if (pw == 0u) {  // uniform: a push constant
+    // Indices: the emitted invocation writes its own slot (consecutive ranks, so consecutive
+    // words); no shared list and no barrier.
+    if (emitted && first + rank < pc.capacity) list[first + rank] = base + t;
+    return;
   }
+  if (emitted) s_item[rank] = t;
   barrier();
   const uint n = uint(bitCount(g.x) + bitCount(g.y));
   const uint kept = first >= pc.capacity ? 0u : min(n, pc.capacity - first);
-  const uint pw = pc.step[0];
-  const uint base = group * GLINT_COMPACT_GROUP;
-  if (pw == 0u) {
-    if (t < kept) list[first + t] = base + s_item[t];
-    return;
-  }
   // Fewer than 2^30 words (list and payload buffers fit maxStorageBufferRange): no wrap.
   const uint words = kept * pw, dst = first * pw;
   for (uint d = t; d < words; d += GLINT_COMPACT_GROUP) {

@@ -1,6 +1,12 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_samplerless_texture_functions : require
+#ifdef GLINT_OBJECT_SUBGROUP
+// The variants the host picks where the device's subgroups support arithmetic in compute
+// (VkPhysicalDeviceSubgroupProperties); the others count with shared atomics alone.
+#extension GL_KHR_shader_subgroup_basic : require
+#extension GL_KHR_shader_subgroup_arithmetic : require
+#endif
 // Frustum and Hi-Z occlusion test of caller objects (world-space spheres or boxes), the first of
 // the three dispatches of the object cull (include/glint/object_cull.h, docs/OCCLUSION.md "Object
 // culling"). One invocation per object, GLINT_OBJECT_GROUP per workgroup, 2D grid of workgroups.
@@ -21,8 +27,18 @@
 //    pyramid, writes its state and emits the visible ones phase 1 did not. Emission is a bit in the
 //    workgroup's mask; the ordered compaction (compact.glsl) turns the masks into
 //    slots in object order, so the list is the same bits on every run.
+// 6. The compaction's first level: the last workgroup of each tile to write its record (a per-tile
+//    count after a buffer memory barrier) scans the tile (scan_tile), so no separate dispatch does.
 // GLINT_OBJECT_PHASE1 builds the phase-1 variant, which binds no image (the depth image may be a
 // render target while phase 1 runs).
+// Cost (docs/OCCLUSION.md, "Cost"): one wave of latency-bound invocations, so the kernel keeps
+// few live values and one copy of each expensive step: the record is two 16-byte loads; spheres
+// and boxes only reduce their bound to an NDC rectangle and a nearest depth, and one Hi-Z test
+// after the branch serves both (a subgroup holding both kinds fetches once, not once per kind);
+// each slope pair takes two reciprocals instead of three divisions; the box's per-corner terms
+// that do not depend on the corner are added once after the max; the per-group counts are one
+// packed shared atomic per invocation. object_cull_v1.comp is the previous form, kept for the
+// benchmark's comparison.
 layout(local_size_x_id = 0, local_size_y_id = 1) in;
 
 #include "object_cull_params.h"
@@ -40,19 +56,30 @@ layout(binding = 1) uniform texture2D hiz_tex;    // mip m = Hi-Z level m + 1
 #include "hiz_read.glsl"
 #endif
 
-layout(std430, binding = BINDING_OBJECTS) readonly buffer Objects { GlintCullObject objects[]; };
+// GlintCullObject[] read as two vec4 per object (32 bytes: sphere_or_min, then box_max and kind):
+// two 16-byte loads instead of eight 4-byte ones.
+layout(std430, binding = BINDING_OBJECTS) readonly buffer Objects { vec4 object_words[]; };
 #ifdef GLINT_OBJECT_PHASE1
 layout(std430, binding = BINDING_VISIBILITY) readonly buffer Visibility { uint visibility[]; };
 #else
 layout(std430, binding = BINDING_VISIBILITY) buffer Visibility { uint visibility[]; };
 #endif
 #define COMPACT_GROUPS_BINDING BINDING_GROUPS  // the compaction's group buffer: this writes the masks (x, y)
+// and, in the last workgroup of each tile, scans the tile (so the separate tile-scan dispatch is
+// not needed). Coherent: the last workgroup reads records other workgroups wrote in this dispatch.
+#define COMPACT_GROUPS_COHERENT
 #define COMPACT_NO_SCAN
 #include "compact.glsl"
+// Per tile of the scan: the workgroups of the tile that have written their record. Zero between
+// culls (zero-filled once; object_cull_scan.comp zeroes it after every cull).
+layout(std430, binding = BINDING_GROUPS + 1) coherent buffer TileDone { uint tile_done[]; };
 layout(push_constant) uniform Push { GlintObjectCullPush pc; };
 
 shared uint s_mask[2];
-shared uint s_frustum, s_occluded, s_visible, s_invalid;
+shared uint s_counts;  // the group's counts, packed as compact_pack_counts packs them
+shared bool s_last;    // this workgroup is the last of its tile to write its record
+shared uint s_scan[2][GLINT_OBJECT_GROUP];
+shared uint s_tile_counts[4];
 
 const float kEps = float(GLINT_OBJECT_EPS);
 
@@ -92,11 +119,14 @@ vec2 plane_margin(float c, float w, float r, float s, float o, vec2 len) {
 // the form of zeux/niagara that divides without cancellation in the numerator's sign).
 vec2 sphere_slopes(float c, float w, float r) {
   const float t = sqrt(max(c * c + (w - r) * (w + r), 0.0));  // length of the tangent
-  const float lo = (t * c - r * w) / (t * w + r * c);
-  const float hi = (t * c + r * w) / (t * w - r * c);
-  const float den = t * w - r * abs(c);                        // the smaller denominator, > 0
-  const float err = kEps * (t * abs(c) + r * w) * (t * w + r * abs(c)) / (den * den);
-  return vec2(lo - err, hi + err);
+  // Two reciprocals instead of three divisions: the smaller denominator t w - r |c| (> 0) is the
+  // one whose reciprocal is larger. Each reciprocal and product adds a few units in the last place,
+  // within the kEps margin the bound is widened by.
+  const float tc = t * c, rw = r * w, tw = t * w, rc = r * c;
+  const float i_lo = 1.0 / (tw + rc), i_hi = 1.0 / (tw - rc);
+  const float i_den = max(i_lo, i_hi);
+  const float err = kEps * (t * abs(c) + rw) * (tw + r * abs(c)) * (i_den * i_den);
+  return vec2((tc - rw) * i_lo - err, (tc + rw) * i_hi + err);
 }
 
 // The NDC interval of slopes [m.x, m.y] on one axis (ndc = s * m + o), widened by the rounding of
@@ -163,16 +193,23 @@ uint hiz_test(vec2 x, vec2 y, float z, bool reversed) {
 }
 #endif
 
-// The state of one object; `invalid` is set for malformed bounds (counted visible).
-uint test_object(GlintCullObject o, bool frustum_only, out bool invalid) {
+// The state of one object; `invalid` is set for malformed bounds (counted visible). NONE means
+// "in the frustum, in front of the near plane": the caller runs hiz_test on the NDC rectangle
+// `rect` (x0, x1, y0, y1) with nearest depth `z`, so the test is one copy of code for both kinds.
+uint test_object(vec4 w0, vec4 w1, bool frustum_only, out bool invalid, out vec4 rect, out float z) {
   invalid = false;
+  rect = vec4(0.0);
+  z = 0.0;
   const bool reversed = (pc.flags & GLINT_OBJECT_REVERSED_Z) != 0u;
-  const vec3 a = vec3(o.sphere_or_min[0], o.sphere_or_min[1], o.sphere_or_min[2]);
+  const uint kind = floatBitsToUint(w1.w);
+  const vec3 a = w0.xyz;
   // Planes' near and far tests widened by the rounding of near_w, far_w.
   const float near_lo = pc.near_w * (1.0 - kEps), near_hi = pc.near_w * (1.0 + kEps);
   const float far_hi = pc.far_w * (1.0 + kEps);  // +Inf for an infinite far plane (FLT_MAX)
-  if (o.kind == GLINT_OBJECT_SPHERE) {
-    const float radius = o.sphere_or_min[3];
+  const vec2 len_x = vec2(pc.plane_len[0], pc.plane_len[1]), len_y = vec2(pc.plane_len[2], pc.plane_len[3]);
+  float w_near;  // smallest w of the bound, less its error (> near_hi when the Hi-Z test runs)
+  if (kind == GLINT_OBJECT_SPHERE) {
+    const float radius = w0.w;
     if (!finite3(a) || !finite_f(radius) || !(radius >= 0.0)) {
       invalid = true;
       return GLINT_OBJECT_STATE_VISIBLE;
@@ -182,17 +219,17 @@ uint test_object(GlintCullObject o, bool frustum_only, out bool invalid) {
     const float r = radius * pc.radius_scale * (1.0 + kEps) + err;
     if (!finite3(c) || !finite_f(r)) return GLINT_OBJECT_STATE_VISIBLE;  // overflow: conservative
     if (c.z - r > far_hi || c.z + r < near_lo) return GLINT_OBJECT_STATE_FRUSTUM;
-    const vec2 mx = plane_margin(c.x, c.z, r, pc.proj_x, pc.proj_ox, vec2(pc.plane_len[0], pc.plane_len[1]));
-    const vec2 my = plane_margin(c.y, c.z, r, pc.proj_y, pc.proj_oy, vec2(pc.plane_len[2], pc.plane_len[3]));
+    const vec2 mx = plane_margin(c.x, c.z, r, pc.proj_x, pc.proj_ox, len_x);
+    const vec2 my = plane_margin(c.y, c.z, r, pc.proj_y, pc.proj_oy, len_y);
     if (min(min(mx.x, mx.y), min(my.x, my.y)) < 0.0) return GLINT_OBJECT_STATE_FRUSTUM;
     if (frustum_only || c.z - r < near_hi) return GLINT_OBJECT_STATE_VISIBLE;  // in, or crossing near
 #ifndef GLINT_OBJECT_PHASE1
-    const vec2 x = slopes_to_ndc(sphere_slopes(c.x, c.z, r), pc.proj_x, pc.proj_ox);
-    const vec2 y = slopes_to_ndc(sphere_slopes(c.y, c.z, r), pc.proj_y, pc.proj_oy);
-    return hiz_test(x, y, nearest_depth(c.z - r, reversed), reversed);
+    rect.xy = slopes_to_ndc(sphere_slopes(c.x, c.z, r), pc.proj_x, pc.proj_ox);
+    rect.zw = slopes_to_ndc(sphere_slopes(c.y, c.z, r), pc.proj_y, pc.proj_oy);
 #endif
-  } else if (o.kind == GLINT_OBJECT_BOX) {
-    const vec3 b = vec3(o.box_max[0], o.box_max[1], o.box_max[2]);
+    w_near = c.z - r;
+  } else if (kind == GLINT_OBJECT_BOX) {
+    const vec3 b = w1.xyz;
     if (!finite3(a) || !finite3(b) || !all(lessThanEqual(a, b))) {
       invalid = true;
       return GLINT_OBJECT_STATE_VISIBLE;
@@ -201,8 +238,11 @@ uint test_object(GlintCullObject o, bool frustum_only, out bool invalid) {
     float r;
     to_view(max(abs(a), abs(b)), r);
     float w_min = 3.4028235e38, w_max = -3.4028235e38;
-    vec4 side = vec4(-3.4028235e38);  // max over corners of the four side-plane margins
-    const vec2 len_x = vec2(pc.plane_len[0], pc.plane_len[1]), len_y = vec2(pc.plane_len[2], pc.plane_len[3]);
+    // Max over corners of the four side-plane margins less their corner-independent term
+    // len * r * (1 + kEps) (plane_margin), which is added once after the loop: max(d_j + C) =
+    // max(d_j) + C.
+    vec4 side = vec4(-3.4028235e38);
+    bool finite = true;
     // The corners' slope intervals, in the same pass (no array of corners is kept; used only
     // when the box is in front of the near plane, where w - r > 0). Each slope is widened by its
     // point error r (|d(c / w)| <= r (1 + |c / w|) / (w - r)) and the rounding of the reciprocal
@@ -211,11 +251,11 @@ uint test_object(GlintCullObject o, bool frustum_only, out bool invalid) {
     for (int j = 0; j < 8; ++j) {
       float unused;
       const vec3 v = to_view(vec3((j & 1) != 0 ? b.x : a.x, (j & 2) != 0 ? b.y : a.y, (j & 4) != 0 ? b.z : a.z), unused);
-      if (!finite3(v)) return GLINT_OBJECT_STATE_VISIBLE;
+      finite = finite && finite3(v);  // checked after the loop (no exit from inside it)
       w_min = min(w_min, v.z);
       w_max = max(w_max, v.z);
-      side = max(side, vec4(plane_margin(v.x, v.z, r, pc.proj_x, pc.proj_ox, len_x),
-                            plane_margin(v.y, v.z, r, pc.proj_y, pc.proj_oy, len_y)));
+      side = max(side, vec4(plane_margin(v.x, v.z, 0.0, pc.proj_x, pc.proj_ox, len_x),
+                            plane_margin(v.y, v.z, 0.0, pc.proj_y, pc.proj_oy, len_y)));
 #ifndef GLINT_OBJECT_PHASE1
       const vec2 m = v.xy * (1.0 / v.z);
       const vec2 e = (r * (1.0 / (v.z - r))) * (1.0 + abs(m)) + kEps * abs(m);
@@ -223,19 +263,63 @@ uint test_object(GlintCullObject o, bool frustum_only, out bool invalid) {
       sy = vec2(min(sy.x, m.y - e.y), max(sy.y, m.y + e.y));
 #endif
     }
-    if (!finite_f(r)) return GLINT_OBJECT_STATE_VISIBLE;
+    if (!finite || !finite_f(r)) return GLINT_OBJECT_STATE_VISIBLE;
+    side += vec4(len_x, len_y) * (r * (1.0 + kEps));
     if (w_min - r > far_hi || w_max + r < near_lo) return GLINT_OBJECT_STATE_FRUSTUM;
     if (min(min(side.x, side.y), min(side.z, side.w)) < 0.0) return GLINT_OBJECT_STATE_FRUSTUM;
     if (frustum_only || w_min - r < near_hi) return GLINT_OBJECT_STATE_VISIBLE;
 #ifndef GLINT_OBJECT_PHASE1
-    const vec2 x = slopes_to_ndc(sx, pc.proj_x, pc.proj_ox);
-    const vec2 y = slopes_to_ndc(sy, pc.proj_y, pc.proj_oy);
-    return hiz_test(x, y, nearest_depth(w_min - r, reversed), reversed);
+    rect.xy = slopes_to_ndc(sx, pc.proj_x, pc.proj_ox);
+    rect.zw = slopes_to_ndc(sy, pc.proj_y, pc.proj_oy);
 #endif
+    w_near = w_min - r;
   } else {
     invalid = true;
+    return GLINT_OBJECT_STATE_VISIBLE;
   }
-  return GLINT_OBJECT_STATE_VISIBLE;
+  z = nearest_depth(w_near, reversed);
+  return GLINT_OBJECT_STATE_NONE;
+}
+
+// The first level of the ordered compaction's scan (compact.glsl, compact_tile_scan), run by the
+// last workgroup of a tile to write its record: for each of the tile's `n` groups from `first`,
+// the emitted objects of the tile before it (z, replacing the packed counts); the tile's total in
+// its first group's w; the packed counts added to the header, one atomic per tile and counter.
+// Invocation t takes a run of consecutive groups (ceil(n / 64) of them, at most 16 for tiles of
+// 1024 groups); the runs' totals are scanned in shared memory (Hillis & Steele 1986).
+void scan_tile(uint first, uint n) {
+  const uint lid = gl_LocalInvocationIndex;
+  const uint per = (n + GLINT_OBJECT_GROUP - 1u) / GLINT_OBJECT_GROUP;
+  const uint g0 = first + min(lid * per, n), g1 = first + min(lid * per + per, n);
+  uint run = 0u;
+  uvec4 c = uvec4(0u);
+  for (uint g = g0; g < g1; ++g) {
+    const uvec4 v = groups[g];
+    run += uint(bitCount(v.x) + bitCount(v.y));
+    c += (uvec4(v.z) >> uvec4(0u, 8u, 16u, 24u)) & 0xffu;
+  }
+  s_scan[0][lid] = run;
+  barrier();
+  uint src = 0u;
+  for (uint d = 1u; d < GLINT_OBJECT_GROUP; d <<= 1u) {
+    uint v = s_scan[src][lid];
+    if (lid >= d) v += s_scan[src][lid - d];
+    s_scan[src ^ 1u][lid] = v;
+    barrier();
+    src ^= 1u;
+  }
+  uint before = s_scan[src][lid] - run;  // exclusive
+  for (uint g = g0; g < g1; ++g) {
+    const uvec4 v = groups[g];
+    groups[g].z = before;
+    before += uint(bitCount(v.x) + bitCount(v.y));
+  }
+  if (lid == 0u) groups[first].w = s_scan[src][GLINT_OBJECT_GROUP - 1u];
+  for (uint f = 0u; f < 4u; ++f) {
+    if (c[f] != 0u) atomicAdd(s_tile_counts[f], c[f]);
+  }
+  barrier();
+  if (lid < 4u && s_tile_counts[lid] != 0u) atomicAdd(counters[1u + lid], s_tile_counts[lid]);
 }
 
 void main() {
@@ -243,11 +327,10 @@ void main() {
   if (lid == 0u) {
     s_mask[0] = 0u;
     s_mask[1] = 0u;
-    s_frustum = 0u;
-    s_occluded = 0u;
-    s_visible = 0u;
-    s_invalid = 0u;
+    s_counts = 0u;
+    s_last = false;
   }
+  if (lid < 4u) s_tile_counts[lid] = 0u;
   barrier();
   const uint group = gl_WorkGroupID.y * pc.groups_x + gl_WorkGroupID.x;
   const uint group_count = (pc.count + GLINT_OBJECT_GROUP - 1u) / GLINT_OBJECT_GROUP;
@@ -258,21 +341,56 @@ void main() {
   if (group < group_count && i < pc.count) {
     const uint history = mode == GLINT_OBJECT_MODE_SINGLE ? GLINT_OBJECT_STATE_NONE : visibility[i];
     if (mode != GLINT_OBJECT_MODE_PHASE1 || history == GLINT_OBJECT_STATE_VISIBLE) {
-      state = test_object(objects[i], mode == GLINT_OBJECT_MODE_PHASE1, invalid);
-      emit = state == GLINT_OBJECT_STATE_VISIBLE &&
-             (mode != GLINT_OBJECT_MODE_PHASE2 || history != GLINT_OBJECT_STATE_VISIBLE);
+      vec4 rect;
+      float z;
+      state = test_object(object_words[2u * i], object_words[2u * i + 1u], mode == GLINT_OBJECT_MODE_PHASE1, invalid,
+                          rect, z);
 #ifndef GLINT_OBJECT_PHASE1
+      // One Hi-Z test for both kinds of bound.
+      if (state == GLINT_OBJECT_STATE_NONE)
+        state = hiz_test(rect.xy, rect.zw, z, (pc.flags & GLINT_OBJECT_REVERSED_Z) != 0u);
       visibility[i] = state;
 #endif
+      emit = state == GLINT_OBJECT_STATE_VISIBLE &&
+             (mode != GLINT_OBJECT_MODE_PHASE2 || history != GLINT_OBJECT_STATE_VISIBLE);
     }
   }
-  if (emit) atomicOr(s_mask[lid >> 5u], 1u << (lid & 31u));
-  if (state == GLINT_OBJECT_STATE_FRUSTUM) atomicAdd(s_frustum, 1u);
-  if (state == GLINT_OBJECT_STATE_OCCLUDED) atomicAdd(s_occluded, 1u);
-  if (state == GLINT_OBJECT_STATE_VISIBLE) atomicAdd(s_visible, 1u);
-  if (invalid) atomicAdd(s_invalid, 1u);
-  barrier();
-  if (lid == 0u && group < group_count) {  // the counts go to the header through the tile scan
-    groups[group] = uvec4(s_mask[0], s_mask[1], compact_pack_counts(uvec4(s_frustum, s_occluded, s_visible, s_invalid)), 0u);
+  // Counter 1 + f of the header is byte f of the packed word (compact_pack_counts): frustum,
+  // occluded, visible, invalid; each at most 64 per workgroup, so no byte carries into the next.
+  uint packed = invalid ? (1u << 24u) : 0u;
+  if (state != GLINT_OBJECT_STATE_NONE) {
+    packed += 1u << (8u * (state == GLINT_OBJECT_STATE_FRUSTUM ? 0u : state == GLINT_OBJECT_STATE_OCCLUDED ? 1u : 2u));
   }
+#ifdef GLINT_OBJECT_SUBGROUP
+  // Reduced over the subgroup first (uniform control flow: every invocation gets here), then one
+  // invocation per subgroup adds the subgroup's part: a few shared atomics per workgroup instead of
+  // two per invocation on the same words, which serialise. Integer OR and sums: the same bits
+  // whatever the subgroup size or the mapping of invocations to subgroups.
+  const uint bit = emit ? 1u << (lid & 31u) : 0u;
+  const uint lo = subgroupOr(lid < 32u ? bit : 0u);
+  const uint hi = subgroupOr(lid < 32u ? 0u : bit);
+  const uint sum = subgroupAdd(packed);
+  if (subgroupElect()) {
+    if (lo != 0u) atomicOr(s_mask[0], lo);
+    if (hi != 0u) atomicOr(s_mask[1], hi);
+    if (sum != 0u) atomicAdd(s_counts, sum);
+  }
+#else
+  if (emit) atomicOr(s_mask[lid >> 5u], 1u << (lid & 31u));
+  if (packed != 0u) atomicAdd(s_counts, packed);
+#endif
+  barrier();
+  const uint tile = group / pc.tile_groups, first = tile * pc.tile_groups;
+  const uint tile_size = group < group_count ? min(pc.tile_groups, group_count - first) : 0u;
+  if (lid == 0u && group < group_count) {  // the counts go to the header through the tile scan
+    groups[group] = uvec4(s_mask[0], s_mask[1], s_counts, 0u);
+    // The record, then the count that announces it (the "last block" pattern: the workgroup that
+    // brings the count to the tile's size sees every record of the tile).
+    memoryBarrierBuffer();
+    s_last = atomicAdd(tile_done[tile], 1u) == tile_size - 1u;
+  }
+  barrier();
+  if (!s_last) return;  // uniform in the workgroup
+  memoryBarrierBuffer();
+  scan_tile(first, tile_size);
 }

@@ -1,7 +1,8 @@
 // Internal layouts of the object occlusion cull (not installed): the push constants of its
-// dispatches (object_cull.comp: frustum + Hi-Z test; then the ordered compaction of
-// compact_params.h: compact_scan_tiles.comp, object_cull_scan.comp (tile totals, indirect
-// arguments and statistics) and compact_scatter.comp (payloads into their slots in object order)).
+// dispatches (object_cull.comp: frustum + Hi-Z test, whose last workgroup per tile runs the first
+// level of the scan; then the ordered compaction of compact_params.h: object_cull_scan.comp (tile
+// totals, indirect arguments and statistics) and compact_scatter.comp (payloads into their slots
+// in object order); compact_scan_tiles.comp runs the first level after object_cull_v1.comp).
 // Declared once for GLSL and C++; src/visibility/object_cull.cpp static_asserts the layouts.
 #ifndef GLINT_OBJECT_CULL_PARAMS_H
 #define GLINT_OBJECT_CULL_PARAMS_H
@@ -59,7 +60,7 @@ struct GlintObjectCullPush {
   GLINT_UINT levels;    // Hi-Z levels built above level 0
   GLINT_UINT flags;     // GLINT_OBJECT_MODE_* | GLINT_OBJECT_REVERSED_Z
   GLINT_UINT groups_x;  // workgroups per row of the 2D dispatch (group = y * groups_x + x)
-  GLINT_UINT reserved;
+  GLINT_UINT tile_groups;  // groups per tile of the compaction's scan (object_cull.comp scans its tiles)
   // Lengths of the side planes' normals (proj_x, 1 + proj_ox), (-proj_x, 1 - proj_ox), then the
   // same of y, computed in double and rounded up (a per-frame constant the test would otherwise
   // take 2 square roots per plane evaluation for).

@@ -1,0 +1,32 @@
+// Internal switches of the object cull for benchmarks and tests (not installed).
+#pragma once
+
+#include <glint/object_cull.h>
+
+#include <cstdint>
+
+namespace glint::detail {
+
+/// The test kernels an ObjectCuller can run (object_cull_select_kernel()).
+enum class ObjectCullKernel : uint32_t {
+  /// object_cull.comp; its subgroup variants (per-group counts reduced over each subgroup) where
+  /// the device's subgroups support arithmetic in compute, else the shared-atomic ones. The default.
+  current,
+  /// object_cull.comp counting with shared atomics alone (what devices without subgroup arithmetic
+  /// run), in every mode: the tests reach it on any device.
+  shared_atomics,
+  /// object_cull_v1.comp (the same test before the cost work of docs/OCCLUSION.md "Cost") for the
+  /// single-phase record(); phase 1 and 2 run `current`. glint_bench times it against `current`.
+  previous,
+};
+
+/// Selects the kernel `culler` records from now on.
+void object_cull_select_kernel(ObjectCuller& culler, ObjectCullKernel kernel);
+/// Test hook: records a fill of `culler`'s per-tile counts of written records with `value` (0
+/// between culls), as a broken counter would leave them; the next cull's top-level scan zeroes
+/// the tiles it uses.
+void object_cull_fill_tile_counts(ObjectCuller& culler, VkCommandBuffer cmd, uint32_t value);
+/// Whether `culler` runs the subgroup variants in ObjectCullKernel::current (the device supports them).
+bool object_cull_has_subgroup_variant(const ObjectCuller& culler);
+
+}  // namespace glint::detail
