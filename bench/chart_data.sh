@@ -11,8 +11,8 @@
 # GPU filters (about 5 minutes on an H100 in all): bloom at 1920x1080, every filter, guard and
 # fp32 variant; the Gaussian blur methods at 3840x2160, sigma 1.2 to 64; the light cull at 1,000,000
 # lights for N = 1, 4, 8, 16 (default multi-jittered pattern) and N = 4 regular; the object cull.
-# --cpu scales them down for CPU devices (lavapipe): the blur at 960x540 and sigma 1.2 to 16, the
-# light cull at 1000 lights.
+# --cpu takes the blur at 960x540 instead, for CPU devices (lavapipe: about 12 minutes on 2 cores
+# for bloom, blur and occlusion).
 set -euo pipefail
 
 cpu=0
@@ -37,9 +37,8 @@ filter_for() {
   case "$1:$cpu" in
     bloom:*) echo 'BM_Bloom/w:1920/h:1080/' ;;
     blur:0) echo 'BM_Blur(Separable|SeparableLinear|Pyramid|Dual|Auto)/sigma10:[0-9]+/w:3840/h:2160/' ;;
-    blur:1) echo 'BM_Blur(Separable|SeparableLinear|Pyramid|Dual|Auto)/sigma10:(12|20|40|80|160)/w:960/h:540/' ;;
-    occlusion:0) echo 'BM_LightCull/n:1000000/grid:[0-9]+/results:0/hiz:0/pattern:[01]/' ;;
-    occlusion:1) echo 'BM_LightCull/n:1000/grid:[0-9]+/results:0/hiz:0/pattern:[01]/' ;;
+    blur:1) echo 'BM_Blur(Separable|SeparableLinear|Pyramid|Dual|Auto)/sigma10:[0-9]+/w:960/h:540/' ;;
+    occlusion:*) echo 'BM_LightCull/n:1000000/grid:[0-9]+/results:0/hiz:0/pattern:[01]/' ;;
     object_cull:*) echo 'BM_ObjectCull' ;;
     *)
       echo "unknown chart '$1' (bloom, blur, occlusion, object_cull)" >&2
