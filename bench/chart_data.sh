@@ -11,8 +11,8 @@
 # GPU filters (about 5 minutes on an H100 in all): bloom at 1920x1080, every filter, guard and
 # fp32 variant; the Gaussian blur methods at 3840x2160, sigma 1.2 to 64; the light cull at 1,000,000
 # lights for N = 1, 4, 8, 16 (default multi-jittered pattern) and N = 4 regular; the object cull.
-# --cpu takes the blur at 960x540 instead, for CPU devices (lavapipe: about 12 minutes on 2 cores
-# for bloom, blur and occlusion).
+# --cpu takes the blur at 960x540 instead, for CPU devices (lavapipe: about 15 minutes on 2 loaded
+# cores for bloom, blur and occlusion).
 set -euo pipefail
 
 cpu=0
@@ -21,7 +21,7 @@ if [[ "${1:-}" == "--cpu" ]]; then
   shift
 fi
 if [[ $# -lt 2 ]]; then
-  sed -n '2,16p' "$0" | sed 's/^# \{0,1\}//'
+  sed -n '2,15p' "$0" | sed 's/^# \{0,1\}//'
   exit 2
 fi
 bench=$1
@@ -46,6 +46,8 @@ filter_for() {
       ;;
   esac
 }
+
+for chart in "${charts[@]}"; do filter_for "$chart" >/dev/null; done # refuse a bad name before running
 
 for chart in "${charts[@]}"; do
   filter=$(filter_for "$chart")
