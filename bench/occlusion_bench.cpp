@@ -76,13 +76,14 @@ BENCHMARK(BM_HiZBuild)
     ->UseManualTime()
     ->Unit(benchmark::kMicrosecond);
 
-// Args: lights, grid N, per-light results (0/1), and whether the Hi-Z build is timed with the
-// cull (0/1).
+// Args: lights, grid N, per-light results (0/1), whether the Hi-Z build is timed with the cull
+// (0/1), and the sampling pattern (OcclusionPattern: 0 multi-jittered, the default; 1 regular).
 void BM_LightCull(benchmark::State& state) {
   const auto n = static_cast<uint32_t>(state.range(0));
   const auto grid = static_cast<uint32_t>(state.range(1));
   const bool with_results = state.range(2) != 0;
   const bool with_hiz = state.range(3) != 0;
+  const auto pattern = static_cast<OcclusionPattern>(state.range(4));
   const Context& ctx = context();
   const uint32_t w = 1920, h = 1080;
   // Flares of 8 to 128 pixels (the default flare size is 100).
@@ -94,6 +95,7 @@ void BM_LightCull(benchmark::State& state) {
   LightCullConfig cc;
   cc.capacity = std::max(n, 1u);
   cc.grid = grid;
+  cc.pattern = pattern;
   cc.max_lights = std::max(n, 1u);
   LightCuller culler(ctx, cc);
   const VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT;
@@ -154,6 +156,7 @@ void BM_LightCull(benchmark::State& state) {
   std::copy(scene.view_proj, scene.view_proj + 16, s.view_proj);
   s.grid = grid;
   s.levels = hiz.levels();
+  s.regular_grid = pattern == OcclusionPattern::regular;
   const auto pyramid = reference::hiz_pyramid(scene.depth, false, hiz.levels());
   double error_sum = 0.0;
   uint32_t tested = 0, broken = 0;
@@ -181,22 +184,27 @@ void BM_LightCull(benchmark::State& state) {
   state.counters["frustum_culled"] = st.frustum_culled;
   state.counters["mean_abs_error_vs_brute_force"] = tested ? error_sum / tested : 0.0;
   state.counters["bound_or_exactness_violations"] = broken;
-  state.SetLabel(std::string("ordered compaction") + (with_hiz ? " + Hi-Z" : "") + " on " + ctx.info().name);
+  state.SetLabel(std::string("ordered compaction") + (with_hiz ? " + Hi-Z" : "") +
+                 (pattern == OcclusionPattern::regular ? ", regular grid" : ", multi-jittered") + " on " +
+                 ctx.info().name);
 }
 
 BENCHMARK(BM_LightCull)
-    ->Args({10, 4, 0, 0})
-    ->Args({1000, 4, 0, 0})
-    ->Args({1000000, 4, 0, 0})
-    ->Args({1000000, 4, 1, 0})
-    ->Args({1000000, 1, 0, 0})
-    ->Args({1000000, 8, 0, 0})
-    ->Args({1000000, 16, 0, 0})
-    ->Args({10, 4, 0, 1})
-    ->Args({1000, 1, 0, 0})
-    ->Args({1000, 8, 0, 0})
-    ->Args({1000, 16, 0, 0})
-    ->ArgNames({"n", "grid", "results", "hiz"})
+    ->Args({10, 4, 0, 0, 0})
+    ->Args({1000, 4, 0, 0, 0})
+    ->Args({1000000, 4, 0, 0, 0})
+    ->Args({1000000, 4, 1, 0, 0})
+    ->Args({1000000, 1, 0, 0, 0})
+    ->Args({1000000, 8, 0, 0, 0})
+    ->Args({1000000, 16, 0, 0, 0})
+    ->Args({10, 4, 0, 1, 0})
+    ->Args({1000, 1, 0, 0, 0})
+    ->Args({1000, 8, 0, 0, 0})
+    ->Args({1000, 16, 0, 0, 0})
+    // The regular grid for comparison (docs/OCCLUSION.md).
+    ->Args({1000000, 4, 0, 0, 1})
+    ->Args({1000, 4, 0, 0, 1})
+    ->ArgNames({"n", "grid", "results", "hiz", "pattern"})
     ->UseManualTime()
     ->Unit(benchmark::kMicrosecond);
 

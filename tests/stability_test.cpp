@@ -2,7 +2,7 @@
 // the scale of the bloom against the resolution, NaN/Inf/huge inputs, degenerate and maximal
 // sizes, and run-to-run determinism. Image effects come from support/effects.h, so a new effect
 // joins the range, size and determinism tables there; docs/STABILITY.md has the measurements and
-// bench/stability/stability_report.cpp draws its pictures with the same analysis code.
+// bench/stability/stability_report.cpp measures its pictures with the same analysis code.
 #include <glint/bloom.h>
 #include <glint/blur.h>
 #include <glint/lod.h>

@@ -1,7 +1,12 @@
-// Draws docs/STABILITY.md's pictures and prints its tables: the flicker of a moving sub-pixel
+// Measures docs/STABILITY.md's data and prints its tables: the flicker of a moving sub-pixel
 // firefly per filter with and without the Karis guard, and the size of a point's bloom as a
 // fraction of the image width at 720p, 1080p and 2160p. The tests (tests/stability_test.cpp)
 // check the same numbers with the same code (tools/analysis/light_stats.h).
+//
+// Writes, into DIR, firefly_energy.json (the device and the bloom energy of every frame of every
+// firefly configuration) and firefly_frames_raw.png (frames 0 to 2 of the 1e4 firefly, one row
+// per guard, tiles described in the JSON); bench/plot.py --chart firefly draws the charts from
+// them (docs/PERF.md).
 //
 //   build/bench/glint_stability_report [--out DIR]     (DIR default docs/stability)
 #include <glint/bloom.h>
@@ -60,53 +65,27 @@ FireflySeries firefly(const Context& ctx, const BloomConfig& config, float value
   return s;
 }
 
-// Energy of each frame relative to the series' mean, one line per setting, on a 0.4..1.6 scale
-// (grey lines at 1.0 +- 2%). Colours in docs/STABILITY.md. Drawn with values of 100 so that the
-// tonemapped PNG shows saturated colours.
-void draw_chart(const std::vector<std::pair<std::string, std::vector<double>>>& series, const std::string& path) {
-  const uint32_t w = 640, h = 320;
-  CpuImage img(w, h, 0.0f);
-  auto put = [&](int x, int y, const float* c) {
-    if (x < 0 || y < 0 || x >= int(w) || y >= int(h)) return;
-    for (int k = 0; k < 3; ++k) img.at(x, y)[k] = c[k];
-  };
-  const float grey[3] = {0.3f, 0.3f, 0.3f};
-  auto y_of = [&](double v) { return int(std::lround((1.6 - v) / 1.2 * (h - 1))); };
-  for (double v : {0.98, 1.0, 1.02})
-    for (uint32_t x = 0; x < w; ++x) put(int(x), y_of(v), grey);
-  const float colours[][3] = {{100, 0, 0},  {100, 100, 0}, {0, 100, 0},  {0, 100, 100},   {0, 0, 100},  {100, 0, 100},
-                              {100, 40, 0}, {40, 100, 0},  {0, 40, 100}, {100, 100, 100}, {60, 0, 100}, {100, 0, 40}};
-  for (size_t s = 0; s < series.size(); ++s) {
-    const auto& v = series[s].second;
-    const float* c = colours[s % 12];
-    for (size_t i = 0; i + 1 < v.size(); ++i) {
-      const int x0 = int(i * (w - 1) / (v.size() - 1)), x1 = int((i + 1) * (w - 1) / (v.size() - 1));
-      const int y0 = y_of(v[i]), y1 = y_of(v[i + 1]);
-      const int steps = std::max(std::abs(x1 - x0), std::abs(y1 - y0)) + 1;
-      for (int t = 0; t <= steps; ++t) {
-        const int x = x0 + (x1 - x0) * t / steps, y = y0 + (y1 - y0) * t / steps;
-        put(x, y, c);
-        put(x, y + 1, c);
-      }
-    }
-    std::printf("chart colour %zu (%g,%g,%g): %s\n", s, c[0], c[1], c[2], series[s].first.c_str());
-  }
-  io::write_png_tonemapped(path, img, 1.0f);
-}
+// Frames 0, 1, 2 (x = 100, 100.25, 100.5 px) of the 1e4 firefly for the default settings (top row)
+// and with the per-box Karis guard (bottom row), each crop 96x48 around the point, intensity 1,
+// tonemapped with exposure 0.5. The tiles' geometry is kFilmstrip, written to the JSON.
+struct FilmstripLayout {
+  uint32_t tile_w = 96, tile_h = 48, frames = 3;
+  const char* rows[2] = {"karis_smooth", "karis"};
+  double exposure = 0.5, intensity = 1.0, value = 1e4;
+};
+constexpr FilmstripLayout kFilmstrip;
 
-// Frames 0, 1, 2 (x = 0, 0.25, 0.5 px) of the 1e4 firefly for the default settings (top row) and
-// with the per-box Karis guard (bottom row), each crop 96x48 around the point.
 void filmstrip(const Context& ctx, const std::string& path) {
-  const uint32_t w = 256, h = 128, cw = 96, ch = 48;
+  const uint32_t w = 256, h = 128, cw = kFilmstrip.tile_w, ch = kFilmstrip.tile_h;
   CpuImage strip(3 * cw, 2 * ch, 0.0f);
   for (int row = 0; row < 2; ++row) {
     BloomConfig c;
     c.firefly_guard = row == 0 ? FireflyGuard::karis_smooth : FireflyGuard::karis;
-    c.intensity = 1.0f;
+    c.intensity = float(kFilmstrip.intensity);
     Frame frame(ctx, {w, h});
     Bloom bloom(ctx, c);
-    for (int f = 0; f < 3; ++f) {
-      const CpuImage in = analysis::subpixel_point(w, h, 100.0 + 0.25 * f, h / 2.0, 1e4f);
+    for (int f = 0; f < int(kFilmstrip.frames); ++f) {
+      const CpuImage in = analysis::subpixel_point(w, h, 100.0 + 0.25 * f, h / 2.0, float(kFilmstrip.value));
       const CpuImage out = frame.run(ctx, bloom, in);
       for (uint32_t y = 0; y < ch; ++y)
         for (uint32_t x = 0; x < cw; ++x) {
@@ -116,7 +95,49 @@ void filmstrip(const Context& ctx, const std::string& path) {
         }
     }
   }
-  io::write_png_tonemapped(path, strip, 0.5f);
+  io::write_png_tonemapped(path, strip, float(kFilmstrip.exposure));
+}
+
+// One firefly configuration and its per-frame bloom energy (absolute: the light the bloom adds,
+// summed over R, G, B and all pixels).
+struct EnergyRecord {
+  std::string filter, guard;
+  double max_brightness, value;
+  std::vector<double> energy;
+};
+
+std::string json_string(const std::string& s) {
+  std::string out = "\"";
+  for (char c : s) {
+    if (c == '"' || c == '\\') out += '\\';
+    if (static_cast<unsigned char>(c) >= 0x20) out += c;
+  }
+  return out + "\"";
+}
+
+// firefly_energy.json: what bench/plot.py --chart firefly draws. Frame f has the point at
+// x = 100 + 0.25 f px on a 256x128 image.
+void write_energy_json(const std::string& path, const std::string& device, const std::vector<EnergyRecord>& rows) {
+  FILE* f = std::fopen(path.c_str(), "w");
+  if (!f) throw Error(ErrorCode::io_failure, "cannot write " + path);
+  std::fprintf(f, "{\n  \"device\": %s,\n  \"image\": [256, 128],\n  \"x0_px\": 100.0,\n  \"step_px\": 0.25,\n",
+               json_string(device).c_str());
+  std::fprintf(f,
+               "  \"filmstrip\": {\"file\": \"firefly_frames_raw.png\", \"tile\": [%u, %u], \"frames\": %u, "
+               "\"rows\": [\"%s\", \"%s\"], \"value\": %g, \"intensity\": %g, \"exposure\": %g},\n",
+               kFilmstrip.tile_w, kFilmstrip.tile_h, kFilmstrip.frames, kFilmstrip.rows[0], kFilmstrip.rows[1],
+               kFilmstrip.value, kFilmstrip.intensity, kFilmstrip.exposure);
+  std::fprintf(f, "  \"series\": [\n");
+  for (size_t i = 0; i < rows.size(); ++i) {
+    const auto& r = rows[i];
+    std::fprintf(
+        f, "    {\"filter\": \"%s\", \"firefly_guard\": \"%s\", \"max_brightness\": %g, \"value\": %g, \"energy\": [",
+        r.filter.c_str(), r.guard.c_str(), r.max_brightness, r.value);
+    for (size_t k = 0; k < r.energy.size(); ++k) std::fprintf(f, "%s%.9g", k ? ", " : "", r.energy[k]);
+    std::fprintf(f, "]}%s\n", i + 1 < rows.size() ? "," : "");
+  }
+  std::fprintf(f, "  ]\n}\n");
+  if (std::fclose(f) != 0) throw Error(ErrorCode::io_failure, "cannot write " + path);
 }
 
 int main_impl(int argc, char** argv) {
@@ -129,7 +150,7 @@ int main_impl(int argc, char** argv) {
   std::printf(
       "| filter | firefly_guard | max_brightness | value | energy spread | max step | centroid jitter px | mean energy "
       "|\n|---|---|---|---|---|---|---|---|\n");
-  std::vector<std::pair<std::string, std::vector<double>>> chart;
+  std::vector<EnergyRecord> records;
   for (float maxb : {1000.0f, 8000.0f}) {
     for (float value : {1e4f, 1e3f}) {
       for (BloomFilter f : {BloomFilter::cod13, BloomFilter::dual, BloomFilter::gauss9}) {
@@ -142,15 +163,7 @@ int main_impl(int argc, char** argv) {
           const auto ev = analysis::relative_variation(s.energy);
           double lo = 1e9, hi = -1e9;
           for (double e : s.centroid_error) lo = std::min(lo, e), hi = std::max(hi, e);
-          if (maxb == 1000.0f && value > 5000) {
-            std::vector<double> rel;
-            double m = 0;
-            for (double e : s.energy) m += e / s.energy.size();
-            for (double e : s.energy) rel.push_back(e / m);
-            chart.emplace_back(
-                std::string(bloom_filter_name(f)) + " " + firefly_guard_name(guard) + (value > 5000 ? " 1e4" : " 1e3"),
-                rel);
-          }
+          records.push_back({bloom_filter_name(f), firefly_guard_name(guard), maxb, value, s.energy});
           double mean = 0;
           for (double e : s.energy) mean += e / s.energy.size();
           std::printf("| %s | %s | %g | %g | %.4f | %.4f | %.3f | %.4g |\n", bloom_filter_name(f),
@@ -166,8 +179,8 @@ int main_impl(int argc, char** argv) {
     const auto ev = analysis::relative_variation(firefly(ctx, c, 1e4f, 256, 128, true).energy);
     std::printf("| %s | %.4f | %.4f |\n", bloom_filter_name(f), ev.spread, ev.max_step);
   }
-  draw_chart(chart, out_dir + "/firefly_energy.png");
-  filmstrip(ctx, out_dir + "/firefly_frames.png");
+  write_energy_json(out_dir + "/firefly_energy.json", ctx.info().name, records);
+  filmstrip(ctx, out_dir + "/firefly_frames_raw.png");
   std::printf(
       "\n| filter | iterations | level0_height | size | r50 / width | r90 / width | sigma / width "
       "|\n|---|---|---|---|---|---|---|\n");
