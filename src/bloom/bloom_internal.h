@@ -1,5 +1,6 @@
 // Bloom's dispatch structure, switchable for benchmarks and tests (not installed, not public API):
-// docs/BLOOM.md "Dispatches" says what each switch fuses. The default is every fusion on.
+// docs/BLOOM.md "Dispatches" says what each switch fuses. The default is every fusion on, except
+// fuse_last_up on CPU devices (Bloom's constructor).
 #pragma once
 
 #include <glint/bloom.h>
@@ -11,7 +12,7 @@ struct BloomPath {
   /// their downsamples, blurs and upsamples back to the level above them.
   bool fuse_small_levels = true;
   /// The composite evaluates A(0) = level 0 + Up(A(1)) itself (bloom_composite_up.comp) instead of
-  /// an upsample dispatch writing A(0) over level 0.
+  /// an upsample dispatch writing A(0) over level 0. Default: on GPUs.
   bool fuse_last_up = true;
 };
 

@@ -12,8 +12,16 @@ const uint WIN_W = gl_WorkGroupSize.x + 10u;
 const uint WIN_H = gl_WorkGroupSize.y + 10u;
 const uint UP_GROUP_SIZE = gl_WorkGroupSize.x * gl_WorkGroupSize.y;
 
-shared vec4 s_src[WIN_W * WIN_H];
-shared vec4 s_rows[gl_WorkGroupSize.x * WIN_H];
+// A kernel that also uses the two arrays for other things before the upsample
+// (bloom_composite_up.comp) defines larger sizes first.
+#ifndef UP_SRC_SIZE
+#define UP_SRC_SIZE (WIN_W * WIN_H)
+#endif
+#ifndef UP_ROWS_SIZE
+#define UP_ROWS_SIZE (gl_WorkGroupSize.x * WIN_H)
+#endif
+shared vec4 s_src[UP_SRC_SIZE];
+shared vec4 s_rows[UP_ROWS_SIZE];
 
 vec3 bilinear_window(vec2 q, ivec2 lo) {
   vec2 f = floor(q);
