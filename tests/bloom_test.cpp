@@ -304,9 +304,10 @@ TEST_F(BloomTest, ReferenceComparisonDetectsAWrongParameter) {
 TEST_F(BloomTest, FusedDispatchesMatchOneDispatchPerLevel) {
   struct Case {
     uint32_t w, h, iterations, level0_height;
+    float radius;  // up to 1 and above: the small-levels kernel has a cod13 path for radius <= 1
   };
-  const Case cases[] = {{97, 61, 4, 0},    {300, 200, 5, 0}, {640, 480, 5, 0}, {961, 541, 5, 0},
-                        {200, 150, 4, 40}, {2, 2, 5, 0},     {7, 3, 5, 0}};
+  const Case cases[] = {{97, 61, 4, 0, 1.3f},    {300, 200, 5, 0, 1.0f}, {640, 480, 5, 0, 0.6f}, {961, 541, 5, 0, 1.3f},
+                        {200, 150, 4, 40, 1.0f}, {2, 2, 5, 0, 1.0f},     {7, 3, 5, 0, 1.3f}};
   const uint32_t capacity_texels = std::min(context().info().max_shared_memory_bytes, 65536u) / 12;
   const detail::BloomPath paths[] = {{true, true}, {true, false}, {false, true}};
   bool top_zero = false, top_later = false, top_none = false;
@@ -315,13 +316,13 @@ TEST_F(BloomTest, FusedDispatchesMatchOneDispatchPerLevel) {
       BloomConfig config;
       config.filter = filter;
       config.precision = precision;
-      config.radius = 1.3f;
       config.intensity = 1.0f;
       Bloom fused(context(), config), per_level(context(), config);
       detail::BloomAccess::set_path(per_level, {false, false});
       for (const Case& c : cases) {
         config.iterations = c.iterations;
         config.level0_height = c.level0_height;
+        config.radius = c.radius;
         fused.set_config(config);
         per_level.set_config(config);
         const CpuImage input = random_hdr(c.w, c.h, c.w + 3 * c.h);
@@ -361,8 +362,8 @@ TEST_F(BloomTest, FusedDispatchesMatchOneDispatchPerLevel) {
           ASSERT_GT(norm, 0.0);
           EXPECT_LT(std::sqrt(diff / norm), tol)
               << bloom_filter_name(filter) << (precision == Precision::fp16 ? " fp16" : " fp32") << " " << c.w << "x"
-              << c.h << " level0_height " << c.level0_height << " small levels " << path.fuse_small_levels
-              << " last up " << path.fuse_last_up << " top " << top;
+              << c.h << " radius " << c.radius << " level0_height " << c.level0_height << " small levels "
+              << path.fuse_small_levels << " last up " << path.fuse_last_up << " top " << top;
         }
       }
     }
