@@ -441,27 +441,32 @@ TEST_F(BloomTest, NonFiniteAndHugeScenePixelsGiveAFiniteOutput) {
     for (int c = 0; c < 4; ++c) input.at(8 + 10 * i, 20)[c] = bad[i][c];
   BloomConfig config;
   config.intensity = 1.0f;
-  for (VkFormat out_format : {kF16, kF32}) {
-    const CpuImage gpu = run_bloom(config, input, kF32, out_format);
-    const float limit = out_format == kF16 ? 65504.0f : std::numeric_limits<float>::max();
-    for (float v : gpu.rgba) ASSERT_TRUE(std::isfinite(v)) << (out_format == kF16 ? "rgba16f" : "rgba32f");
-    // NaN -> 0 before the add: the NaN channels of pixel 0 equal the bloom alone, which the
-    // neighbouring finite pixel shows to be positive; +Inf -> the limit; 65400 + bloom clamps to
-    // 65504 in RGBA16F (it would round to Inf) and stays above 65400 in RGBA32F.
-    const float* p0 = gpu.at(8, 20);
-    EXPECT_GT(p0[0], 0.0f);
-    EXPECT_LT(p0[0], 100.0f);
-    EXPECT_EQ(p0[3], 0.0f);
-    EXPECT_EQ(gpu.at(18, 20)[0], limit);
-    EXPECT_EQ(gpu.at(18, 20)[1], -limit);
-    EXPECT_EQ(gpu.at(28, 20)[0], out_format == kF16 ? 65504.0f : gpu.at(28, 20)[0]);
-    EXPECT_GT(gpu.at(28, 20)[0], 65400.0f);
-    EXPECT_EQ(gpu.at(38, 20)[0], -limit);
-    EXPECT_EQ(gpu.at(38, 20)[2], limit);
-    // The reference (fp16 levels, the RGBA32F limit) agrees at the NaN pixel: 0 plus its bloom.
-    if (out_format == kF32) {
-      const auto ref = reference::bloom(input, config, /*round_intermediates_to_half=*/true);
-      EXPECT_NEAR(p0[0], ref.at(8, 20)[0], 5e-3 * std::abs(ref.at(8, 20)[0]));
+  // Both composites: the one that evaluates A(0) itself (the GPU default) and the original.
+  for (const bool fuse : {true, false}) {
+    Bloom bloom(context(), config);
+    detail::BloomAccess::set_path(bloom, {fuse, fuse});
+    for (VkFormat out_format : {kF16, kF32}) {
+      const CpuImage gpu = run_bloom(bloom, input, kF32, out_format);
+      const float limit = out_format == kF16 ? 65504.0f : std::numeric_limits<float>::max();
+      for (float v : gpu.rgba) ASSERT_TRUE(std::isfinite(v)) << (out_format == kF16 ? "rgba16f" : "rgba32f");
+      // NaN -> 0 before the add: the NaN channels of pixel 0 equal the bloom alone, which the
+      // neighbouring finite pixel shows to be positive; +Inf -> the limit; 65400 + bloom clamps to
+      // 65504 in RGBA16F (it would round to Inf) and stays above 65400 in RGBA32F.
+      const float* p0 = gpu.at(8, 20);
+      EXPECT_GT(p0[0], 0.0f);
+      EXPECT_LT(p0[0], 100.0f);
+      EXPECT_EQ(p0[3], 0.0f);
+      EXPECT_EQ(gpu.at(18, 20)[0], limit);
+      EXPECT_EQ(gpu.at(18, 20)[1], -limit);
+      EXPECT_EQ(gpu.at(28, 20)[0], out_format == kF16 ? 65504.0f : gpu.at(28, 20)[0]);
+      EXPECT_GT(gpu.at(28, 20)[0], 65400.0f);
+      EXPECT_EQ(gpu.at(38, 20)[0], -limit);
+      EXPECT_EQ(gpu.at(38, 20)[2], limit);
+      // The reference (fp16 levels, the RGBA32F limit) agrees at the NaN pixel: 0 plus its bloom.
+      if (out_format == kF32) {
+        const auto ref = reference::bloom(input, config, /*round_intermediates_to_half=*/true);
+        EXPECT_NEAR(p0[0], ref.at(8, 20)[0], 5e-3 * std::abs(ref.at(8, 20)[0]));
+      }
     }
   }
 }
@@ -564,12 +569,15 @@ TEST_F(BloomTest, UniformImageStaysUniformAtOddSizes) {
 TEST_F(BloomTest, InPlaceEqualsOutOfPlace) {
   const CpuImage input = random_hdr(80, 50, 21);
   BloomConfig config;
-  const CpuImage separate = run_bloom(config, input, kF16, kF16);
-  auto img = make_image(input, kF16);
-  Bloom bloom(context(), config);
-  context().run_once([&](VkCommandBuffer cmd) { bloom.record(cmd, img.state, img.state); });
-  const CpuImage in_place = detail::download(context(), img.state);
-  EXPECT_EQ(0, std::memcmp(in_place.rgba.data(), separate.rgba.data(), separate.rgba.size() * 4));
+  for (const bool fuse : {true, false}) {  // both composites (docs/BLOOM.md "Dispatches")
+    Bloom bloom(context(), config);
+    detail::BloomAccess::set_path(bloom, {fuse, fuse});
+    const CpuImage separate = run_bloom(bloom, input, kF16, kF16);
+    auto img = make_image(input, kF16);
+    context().run_once([&](VkCommandBuffer cmd) { bloom.record(cmd, img.state, img.state); });
+    const CpuImage in_place = detail::download(context(), img.state);
+    EXPECT_EQ(0, std::memcmp(in_place.rgba.data(), separate.rgba.data(), separate.rgba.size() * 4)) << fuse;
+  }
 }
 
 TEST_F(BloomTest, RecordingAgainCreatesNoVulkanObject) {
