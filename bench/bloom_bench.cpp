@@ -13,6 +13,7 @@
 #include <random>
 
 #include "bench_support.h"
+#include "bloom/bloom_internal.h"
 #include "core/half.h"
 #include "reference/bloom_reference.h"
 #include "support/transfer.h"
@@ -29,6 +30,9 @@ void BM_Bloom(benchmark::State& state) {
   const auto precision = static_cast<Precision>(state.range(3));
   const auto guard = static_cast<FireflyGuard>(state.range(4));
   const auto level0_height = static_cast<uint32_t>(state.range(5));
+  // fused: bit 0 the small levels in one dispatch, bit 1 the last upsample in the composite
+  // (src/bloom/bloom_internal.h, docs/BLOOM.md "Dispatches"); 3 is the default, 0 one dispatch per level.
+  const auto fused = static_cast<uint32_t>(state.range(6));
   const Context& ctx = context();
   const VkFormat format = VK_FORMAT_R16G16B16A16_SFLOAT;
 
@@ -42,6 +46,7 @@ void BM_Bloom(benchmark::State& state) {
   config.firefly_guard = guard;
   config.level0_height = level0_height;
   Bloom bloom(ctx, config);
+  detail::BloomAccess::set_path(bloom, {(fused & 1u) != 0, (fused & 2u) != 0});
   bloom.prepare({width, height});
   Profiler profiler(ctx, kFramesPerIteration + 1);
 
@@ -68,14 +73,19 @@ void BM_Bloom(benchmark::State& state) {
     stages.mark(cmd, "start");
     bloom.record(cmd, in.state, out.state, &stages);
   });
+  // Every stage's key is reported (0 when the path has no such stage), so rows of different paths compare.
+  for (const char* key : {"us_prefilter_down0", "us_down", "us_small_levels", "us_up", "us_composite"})
+    state.counters[key] = 0.0;
   for (const auto& s : stages.results()) {
     const std::string& l = s.label;
-    const char* key = l.find("bright") != std::string::npos       ? "us_prefilter_down0"
-                      : l.find("downsample") != std::string::npos ? "us_down"
-                      : l.find("upsample") != std::string::npos   ? "us_up"
-                                                                  : "us_composite";
+    const char* key = l.find("bright") != std::string::npos         ? "us_prefilter_down0"
+                      : l.find("downsample") != std::string::npos   ? "us_down"
+                      : l.find("small levels") != std::string::npos ? "us_small_levels"
+                      : l.find("upsample") != std::string::npos     ? "us_up"
+                                                                    : "us_composite";
     state.counters[key] = s.ms * 1e3;
   }
+  state.counters["small_levels_top"] = detail::BloomAccess::small_levels_top(bloom);
   const double bytes = static_cast<double>(bloom.min_bytes_moved(format, format));
   state.counters["floor_bytes"] = bytes;
   state.counters["bytes_per_second"] = benchmark::Counter(bytes, benchmark::Counter::kIsIterationInvariantRate);
@@ -83,21 +93,26 @@ void BM_Bloom(benchmark::State& state) {
   state.counters["rel_l2_vs_f64"] = error;
   state.counters["levels"] = bloom.levels();
   state.SetLabel(std::string(bloom_filter_name(filter)) + (precision == Precision::fp16 ? "/fp16/" : "/fp32/") +
-                 firefly_guard_name(guard) + (level0_height ? "/l0h" + std::to_string(level0_height) : "") + " on " +
-                 ctx.info().name);
+                 firefly_guard_name(guard) + (level0_height ? "/l0h" + std::to_string(level0_height) : "") + "/fused" +
+                 std::to_string(fused) + " on " + ctx.info().name);
 }
 
 void bloom_args(benchmark::internal::Benchmark* b) {
   // Defaults (karis_smooth, level0_height 0) per filter and cod13 with fp32 levels; then cod13 with
-  // the per-box guard and none (what the smooth guard costs), and with level0_height 540.
+  // the per-box guard and none (what the smooth guard costs), and with level0_height 540. Each with
+  // the fused dispatches (fused:3, the default) and one dispatch per level (fused:0); the default
+  // configuration also with each fusion alone (fused:1 small levels, fused:2 the last upsample).
   for (auto size : {std::pair{640, 480}, std::pair{1920, 1080}, std::pair{3840, 2160}}) {
-    for (int filter = 0; filter < 3; ++filter) b->Args({size.first, size.second, filter, 0, 2, 0});
-    b->Args({size.first, size.second, 0, 1, 2, 0});
-    b->Args({size.first, size.second, 0, 0, 1, 0});
-    b->Args({size.first, size.second, 0, 0, 0, 0});
-    if (size.second >= 1080) b->Args({size.first, size.second, 0, 0, 2, 540});
+    for (int fused : {3, 0, 1, 2}) b->Args({size.first, size.second, 0, 0, 2, 0, fused});
+    for (int fused : {3, 0}) {
+      for (int filter = 1; filter < 3; ++filter) b->Args({size.first, size.second, filter, 0, 2, 0, fused});
+      b->Args({size.first, size.second, 0, 1, 2, 0, fused});
+      b->Args({size.first, size.second, 0, 0, 1, 0, fused});
+      b->Args({size.first, size.second, 0, 0, 0, 0, fused});
+      if (size.second >= 1080) b->Args({size.first, size.second, 0, 0, 2, 540, fused});
+    }
   }
-  b->ArgNames({"w", "h", "filter", "fp32", "guard", "l0h"});
+  b->ArgNames({"w", "h", "filter", "fp32", "guard", "l0h", "fused"});
   b->UseManualTime();
   b->Unit(benchmark::kMicrosecond);
 }

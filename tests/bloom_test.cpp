@@ -8,6 +8,7 @@
 #include <cstring>
 #include <limits>
 
+#include "bloom/bloom_internal.h"
 #include "core/half.h"
 #include "core/pipeline.h"
 #include "reference/bloom_reference.h"
@@ -286,6 +287,90 @@ TEST_F(BloomTest, ReferenceComparisonDetectsAWrongParameter) {
   EXPECT_LT(reference::relative_l2(gpu, reference::bloom(input, config)), 1e-3);
 }
 
+// The fused dispatches (docs/BLOOM.md "Dispatches": the small levels in one workgroup, the last
+// upsample inside the composite) against one dispatch per level, every filter, both level
+// precisions, on random input at sizes where the small-levels dispatch starts at level 0, at a
+// later level, not at all (one level), and with level0_height's pre-levels.
+// Tolerance: the two paths run the same filters, weights, maps and clamps; the fused path skips
+// the stores of the levels it keeps in shared memory (fp32) and of A(0). With fp32 levels the
+// paths differ by fp32 rounding only (the same sums in another order: each of the at most 2 x 8
+// filter stages adds a relative error of a few 2^-24), far below 1e-5. With fp16 levels each
+// skipped store is a rounding of relative size at most 2^-10 (2^-11 when rounding to nearest;
+// some devices truncate), and since every stage is a positive-weight mean or a sum of positive
+// terms a relative error is carried, never amplified: the added light differs by at most
+// r 2^-10 relative, r the skipped stores on the longest path (2 per level of the small-levels
+// dispatch, 4 with gauss9's two blur passes, plus A(0)). A missing or misplaced level changes
+// the bloom by a fraction of the order of 1 / levels, far above both.
+TEST_F(BloomTest, FusedDispatchesMatchOneDispatchPerLevel) {
+  struct Case {
+    uint32_t w, h, iterations, level0_height;
+    float radius;  // up to 1 and above: the small-levels kernel has a cod13 path for radius <= 1
+  };
+  const Case cases[] = {{97, 61, 4, 0, 1.3f},    {300, 200, 5, 0, 1.0f}, {640, 480, 5, 0, 0.6f}, {961, 541, 5, 0, 1.3f},
+                        {200, 150, 4, 40, 1.0f}, {2, 2, 5, 0, 1.0f},     {7, 3, 5, 0, 1.3f}};
+  const uint32_t capacity_texels = std::min(context().info().max_shared_memory_bytes, 65536u) / 12;
+  const detail::BloomPath paths[] = {{true, true}, {true, false}, {false, true}};
+  bool top_zero = false, top_later = false, top_none = false;
+  for (BloomFilter filter : kFilters) {
+    for (Precision precision : {Precision::fp32, Precision::fp16}) {
+      BloomConfig config;
+      config.filter = filter;
+      config.precision = precision;
+      config.intensity = 1.0f;
+      Bloom fused(context(), config), per_level(context(), config);
+      detail::BloomAccess::set_path(per_level, {false, false});
+      for (const Case& c : cases) {
+        config.iterations = c.iterations;
+        config.level0_height = c.level0_height;
+        config.radius = c.radius;
+        fused.set_config(config);
+        per_level.set_config(config);
+        const CpuImage input = random_hdr(c.w, c.h, c.w + 3 * c.h);
+        const CpuImage want = run_bloom(per_level, input, kF32, kF32);
+        const std::vector<LevelSize> chain = per_level.level_sizes();
+        const size_t n = chain.size();
+        // The small-levels dispatch starts at the first level whose levels below fit its shared memory.
+        int expected_top = -1;
+        for (size_t t = 0; t + 1 < n && expected_top < 0; ++t) {
+          uint64_t texels = 0;
+          for (size_t k = t + 1; k < n; ++k) texels += uint64_t(chain[k].width) * chain[k].height;
+          if (filter == BloomFilter::gauss9) texels += uint64_t(chain[t + 1].width) * chain[t + 1].height;
+          if (texels <= capacity_texels) expected_top = static_cast<int>(t);
+        }
+        for (const detail::BloomPath& path : paths) {
+          detail::BloomAccess::set_path(fused, path);
+          const CpuImage got = run_bloom(fused, input, kF32, kF32);
+          const int top = detail::BloomAccess::small_levels_top(fused);
+          EXPECT_EQ(top, path.fuse_small_levels ? expected_top : -1) << c.w << "x" << c.h;
+          top_zero |= top == 0;
+          top_later |= top > 0;
+          top_none |= path.fuse_small_levels && top < 0;
+          ASSERT_TRUE(all_finite(got)) << "unwritten (poisoned) texels remain";
+          double skipped = path.fuse_last_up ? 1.0 : 0.0;
+          if (top >= 0) skipped += double(n - 1 - size_t(top)) * (filter == BloomFilter::gauss9 ? 4.0 : 2.0);
+          const double tol = precision == Precision::fp32 ? 1e-5 : std::max(skipped, 1.0) * std::ldexp(1.0, -10);
+          double diff = 0.0, norm = 0.0;
+          for (size_t i = 0; i < got.rgba.size(); ++i) {
+            if (i % 4 == 3) {
+              ASSERT_EQ(got.rgba[i], input.rgba[i]);
+              continue;
+            }
+            const double a = double(want.rgba[i]) - input.rgba[i], b = double(got.rgba[i]) - input.rgba[i];
+            diff += (b - a) * (b - a);
+            norm += a * a;
+          }
+          ASSERT_GT(norm, 0.0);
+          EXPECT_LT(std::sqrt(diff / norm), tol)
+              << bloom_filter_name(filter) << (precision == Precision::fp16 ? " fp16" : " fp32") << " " << c.w << "x"
+              << c.h << " radius " << c.radius << " level0_height " << c.level0_height << " small levels "
+              << path.fuse_small_levels << " last up " << path.fuse_last_up << " top " << top;
+        }
+      }
+    }
+  }
+  EXPECT_TRUE(top_zero && top_later && top_none) << "the cases must start the small levels at 0, later, and not at all";
+}
+
 TEST_F(BloomTest, AllSizesWorkAndMatchTheReference) {
   const VkExtent2D sizes[] = {{320, 240}, {640, 480}, {1280, 720}, {1920, 1080}, {64, 64},
                               {3, 5},     {1, 1},     {1, 9},      {9, 1}};
@@ -356,27 +441,32 @@ TEST_F(BloomTest, NonFiniteAndHugeScenePixelsGiveAFiniteOutput) {
     for (int c = 0; c < 4; ++c) input.at(8 + 10 * i, 20)[c] = bad[i][c];
   BloomConfig config;
   config.intensity = 1.0f;
-  for (VkFormat out_format : {kF16, kF32}) {
-    const CpuImage gpu = run_bloom(config, input, kF32, out_format);
-    const float limit = out_format == kF16 ? 65504.0f : std::numeric_limits<float>::max();
-    for (float v : gpu.rgba) ASSERT_TRUE(std::isfinite(v)) << (out_format == kF16 ? "rgba16f" : "rgba32f");
-    // NaN -> 0 before the add: the NaN channels of pixel 0 equal the bloom alone, which the
-    // neighbouring finite pixel shows to be positive; +Inf -> the limit; 65400 + bloom clamps to
-    // 65504 in RGBA16F (it would round to Inf) and stays above 65400 in RGBA32F.
-    const float* p0 = gpu.at(8, 20);
-    EXPECT_GT(p0[0], 0.0f);
-    EXPECT_LT(p0[0], 100.0f);
-    EXPECT_EQ(p0[3], 0.0f);
-    EXPECT_EQ(gpu.at(18, 20)[0], limit);
-    EXPECT_EQ(gpu.at(18, 20)[1], -limit);
-    EXPECT_EQ(gpu.at(28, 20)[0], out_format == kF16 ? 65504.0f : gpu.at(28, 20)[0]);
-    EXPECT_GT(gpu.at(28, 20)[0], 65400.0f);
-    EXPECT_EQ(gpu.at(38, 20)[0], -limit);
-    EXPECT_EQ(gpu.at(38, 20)[2], limit);
-    // The reference (fp16 levels, the RGBA32F limit) agrees at the NaN pixel: 0 plus its bloom.
-    if (out_format == kF32) {
-      const auto ref = reference::bloom(input, config, /*round_intermediates_to_half=*/true);
-      EXPECT_NEAR(p0[0], ref.at(8, 20)[0], 5e-3 * std::abs(ref.at(8, 20)[0]));
+  // Both composites: the one that evaluates A(0) itself (the GPU default) and the original.
+  for (const bool fuse : {true, false}) {
+    Bloom bloom(context(), config);
+    detail::BloomAccess::set_path(bloom, {fuse, fuse});
+    for (VkFormat out_format : {kF16, kF32}) {
+      const CpuImage gpu = run_bloom(bloom, input, kF32, out_format);
+      const float limit = out_format == kF16 ? 65504.0f : std::numeric_limits<float>::max();
+      for (float v : gpu.rgba) ASSERT_TRUE(std::isfinite(v)) << (out_format == kF16 ? "rgba16f" : "rgba32f");
+      // NaN -> 0 before the add: the NaN channels of pixel 0 equal the bloom alone, which the
+      // neighbouring finite pixel shows to be positive; +Inf -> the limit; 65400 + bloom clamps to
+      // 65504 in RGBA16F (it would round to Inf) and stays above 65400 in RGBA32F.
+      const float* p0 = gpu.at(8, 20);
+      EXPECT_GT(p0[0], 0.0f);
+      EXPECT_LT(p0[0], 100.0f);
+      EXPECT_EQ(p0[3], 0.0f);
+      EXPECT_EQ(gpu.at(18, 20)[0], limit);
+      EXPECT_EQ(gpu.at(18, 20)[1], -limit);
+      EXPECT_EQ(gpu.at(28, 20)[0], out_format == kF16 ? 65504.0f : gpu.at(28, 20)[0]);
+      EXPECT_GT(gpu.at(28, 20)[0], 65400.0f);
+      EXPECT_EQ(gpu.at(38, 20)[0], -limit);
+      EXPECT_EQ(gpu.at(38, 20)[2], limit);
+      // The reference (fp16 levels, the RGBA32F limit) agrees at the NaN pixel: 0 plus its bloom.
+      if (out_format == kF32) {
+        const auto ref = reference::bloom(input, config, /*round_intermediates_to_half=*/true);
+        EXPECT_NEAR(p0[0], ref.at(8, 20)[0], 5e-3 * std::abs(ref.at(8, 20)[0]));
+      }
     }
   }
 }
@@ -479,12 +569,15 @@ TEST_F(BloomTest, UniformImageStaysUniformAtOddSizes) {
 TEST_F(BloomTest, InPlaceEqualsOutOfPlace) {
   const CpuImage input = random_hdr(80, 50, 21);
   BloomConfig config;
-  const CpuImage separate = run_bloom(config, input, kF16, kF16);
-  auto img = make_image(input, kF16);
-  Bloom bloom(context(), config);
-  context().run_once([&](VkCommandBuffer cmd) { bloom.record(cmd, img.state, img.state); });
-  const CpuImage in_place = detail::download(context(), img.state);
-  EXPECT_EQ(0, std::memcmp(in_place.rgba.data(), separate.rgba.data(), separate.rgba.size() * 4));
+  for (const bool fuse : {true, false}) {  // both composites (docs/BLOOM.md "Dispatches")
+    Bloom bloom(context(), config);
+    detail::BloomAccess::set_path(bloom, {fuse, fuse});
+    const CpuImage separate = run_bloom(bloom, input, kF16, kF16);
+    auto img = make_image(input, kF16);
+    context().run_once([&](VkCommandBuffer cmd) { bloom.record(cmd, img.state, img.state); });
+    const CpuImage in_place = detail::download(context(), img.state);
+    EXPECT_EQ(0, std::memcmp(in_place.rgba.data(), separate.rgba.data(), separate.rgba.size() * 4)) << fuse;
+  }
 }
 
 TEST_F(BloomTest, RecordingAgainCreatesNoVulkanObject) {
@@ -526,16 +619,30 @@ TEST_F(BloomTest, ResizeAndShapeChangesRebuildAndStayCorrect) {
   EXPECT_LT(reference::relative_l2(run_bloom(bloom, input, kF32, kF32), reference::bloom(input, c)), 1e-3);
 }
 
+// The stages of each dispatch structure (docs/BLOOM.md "Dispatches"). At 640x480 (levels 320x240
+// to 20x15) the small levels run from level 2 on wherever levels 3 and 4 (1500 texels, 18000
+// bytes) fit the shared memory the dispatch uses (every device with 32 KiB, lavapipe and GPUs);
+// levels 2 to 4 need more than its 64 KiB at most.
 TEST_F(BloomTest, ProfilerReportsEveryStage) {
-  Profiler profiler(context());
-  Bloom bloom(context());
-  run_bloom(bloom, random_hdr(128, 96, 4), kF16, kF16, &profiler);
-  const auto stages = profiler.results();
-  ASSERT_EQ(stages.size(), 4u);
-  EXPECT_EQ(stages[0].label, "bloom bright-pass + down 0");
-  EXPECT_EQ(stages[3].label, "bloom composite");
-  for (const auto& s : stages) EXPECT_GE(s.ms, 0.0);
-  EXPECT_GT(profiler.total_ms(), 0.0);
+  const std::vector<std::string> fused = {"bloom bright-pass + down 0", "bloom downsample", "bloom small levels",
+                                          "bloom upsample", "bloom composite"};
+  const std::vector<std::string> per_level = {"bloom bright-pass + down 0", "bloom downsample", "bloom upsample",
+                                              "bloom composite"};
+  for (const bool fuse : {true, false}) {
+    Profiler profiler(context());
+    Bloom bloom(context());
+    if (!fuse) detail::BloomAccess::set_path(bloom, {false, false});
+    run_bloom(bloom, random_hdr(640, 480, 4), kF16, kF16, &profiler);
+    const bool fits = context().info().max_shared_memory_bytes >= 18000;
+    EXPECT_EQ(detail::BloomAccess::small_levels_top(bloom), fuse && fits ? 2 : -1);
+    std::vector<std::string> labels;
+    for (const auto& s : profiler.results()) {
+      labels.push_back(s.label);
+      EXPECT_GE(s.ms, 0.0);
+    }
+    EXPECT_EQ(labels, fuse && fits ? fused : per_level);
+    EXPECT_GT(profiler.total_ms(), 0.0);
+  }
 }
 
 // ---- bad input: a clear error naming the value and range, and nothing recorded ----------------

@@ -10,6 +10,10 @@
 
 namespace glint {
 
+namespace detail {
+struct BloomAccess;  // benchmarks' and tests' switch of the dispatch structure (not installed)
+}
+
 /// The filter used between pyramid levels.
 enum class BloomFilter : uint32_t {
   cod13 = 0,   //!< 13-tap downsample, 3x3 tent upsample (Jimenez 2014). Default.
@@ -137,6 +141,7 @@ class Bloom {
   struct Impl;
 
  private:
+  friend struct detail::BloomAccess;
   std::unique_ptr<Impl> impl_;
 };
 

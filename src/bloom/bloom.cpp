@@ -7,6 +7,7 @@
 #include <map>
 #include <utility>
 
+#include "bloom/bloom_internal.h"
 #include "bloom/shaders/bloom_params.h"
 #include "core/barriers.h"
 #include "core/check.h"
@@ -26,6 +27,9 @@ static_assert(sizeof(BloomPush) == 48, "BloomPush layout changed: update src/blo
 static_assert(offsetof(BloomPush, threshold) == 16);
 static_assert(offsetof(BloomPush, composite_scale) == 32);
 static_assert(offsetof(BloomPush, flags) == 36);
+static_assert(offsetof(BloomPush, next_width) == 40);
+static_assert(sizeof(BloomTailPush) == 16 + 8 * GLINT_BLOOM_MAX_LEVELS);
+static_assert(offsetof(BloomTailPush, sizes) == 16);
 static_assert(static_cast<uint32_t>(BloomFilter::cod13) == GLINT_BLOOM_COD13);
 static_assert(static_cast<uint32_t>(BloomFilter::dual) == GLINT_BLOOM_DUAL);
 static_assert(static_cast<uint32_t>(BloomFilter::gauss9) == GLINT_BLOOM_GAUSS9);
@@ -136,15 +140,17 @@ constexpr VkAccessFlags2 kStorageWrite = VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT;
 constexpr VkAccessFlags2 kStorageRead = VK_ACCESS_2_SHADER_STORAGE_READ_BIT;
 
 // Shared memory the tiled kernels declare for a workgroup (src/bloom/shaders/bloom_down_tiled.glsl,
-// bloom_up_tiled.glsl and src/bloom/shaders/bloom_prefilter_smooth.comp: vec4 windows of the source;
-// src/bloom/shaders/bloom_prefilter_boxes.comp: three floats per texel of a window for a 2 g.y row tile).
+// bloom_up_tiled.glsl, bloom_composite_up.comp and src/bloom/shaders/bloom_prefilter_smooth.comp: vec4 windows of the
+// source; src/bloom/shaders/bloom_prefilter_boxes.comp: three floats per texel of a window for a 2 g.y row tile).
 uint32_t bloom_shared_bytes(detail::Workgroup2D g) {
   const uint32_t down = ((2 * g.x + 4) * (2 * g.y + 4) + (2 * g.x + 3) * (2 * g.y + 3)) * 16;
   const uint32_t up = ((g.x + 10) * (g.y + 10) + g.x * (g.y + 10)) * 16;
+  // bloom_composite_up.comp: the up tiles plus the window of level 1.
+  const uint32_t composite_up = up + ((g.x + 9) / 2 + 12) * ((g.y + 9) / 2 + 12) * 16;
   const uint32_t apron = 2 * GLINT_BLOOM_SMOOTH_RADIUS;
   const uint32_t smooth = ((2 * g.x + 6 + apron) * (2 * g.y + 6 + apron) + (2 * g.y + 6 + apron) * (2 * g.x + 6)) * 16;
   const uint32_t boxes = (2 * g.x + 4 + apron) * (4 * g.y + 4 + apron) * 12;
-  return std::max({down, up, smooth, boxes});
+  return std::max({down, composite_up, smooth, boxes});
 }
 
 // Whether src/bloom/shaders/bloom_prefilter_boxes.comp can serve this configuration: the
@@ -179,19 +185,45 @@ detail::Workgroup2D bloom_workgroup(const Context& context) {
   return g;
 }
 
+// The small-levels dispatch (src/bloom/shaders/bloom_tail.comp) runs one workgroup: on a GPU as
+// many invocations as the device allows up to 1024 (every one of them works on each level; a
+// 32-wide x keeps within maxComputeWorkGroupSize, at least 128 x 128 x 64), on a CPU device 8x8
+// (lavapipe runs a workgroup on one thread, SIMD 8 wide: more invocations add no parallelism).
+detail::Workgroup2D tail_workgroup(const Context& context) {
+  const DeviceInfo& info = context.info();
+  if (info.type == VK_PHYSICAL_DEVICE_TYPE_CPU) return {8, 8};
+  const uint32_t n = std::min(1024u, std::max(128u, info.max_workgroup_invocations));
+  return {32, n / 32};
+}
+
+// Floats of shared memory the small-levels dispatch declares (3 per texel): the device's
+// maxComputeSharedMemorySize (at least 16 KiB), at most 64 KiB so that one workgroup's work stays
+// small: with 48 KiB (NVIDIA) the levels below T hold at most 4096 texels, so level T, which
+// the workgroup accumulates into, has at most about 4 x 4096 / (4/3) = 12288 texels.
+uint32_t tail_floats(const Context& context) {
+  const uint32_t bytes = std::min(context.info().max_shared_memory_bytes, 65536u);
+  return bytes / 12 * 3;
+}
+
 }  // namespace
 
 struct Bloom::Impl {
   const Context* context;
   BloomConfig config;
   detail::Workgroup2D workgroup;
+  detail::BloomPath path;  // which dispatches are fused (bloom_internal.h)
+  detail::Workgroup2D tail_group;
+  uint32_t tail_capacity = 0;  // floats of shared memory of the small-levels dispatch
 
   // Pipelines for the current shape (filter, precision); composite and copy per output format.
   detail::ComputePipeline prefilter_down, down, blur, up;
   // karis_smooth at an exact 2:1 first step with cod13 or dual (smooth_boxes_apply()); else empty.
   detail::ComputePipeline prefilter_boxes;
+  // The small levels in one dispatch (path.fuse_small_levels); else empty.
+  detail::ComputePipeline tail;
   // Composite and copy per output variant (core/formats.h, check_color_write()): rgba16f and
-  // rgba32f are made with the others, r11f_g11f_b10f and noformat on first use.
+  // rgba32f are made with the others, r11f_g11f_b10f and noformat on first use. The composite is
+  // bloom_composite_up (path.fuse_last_up) or bloom_composite.
   std::map<std::string, detail::ComputePipeline> composite, copy;
 
   // The pyramid of one input extent (and config generation). Kept per size in `cache` until no
@@ -240,6 +272,15 @@ struct Bloom::Impl {
     blur = config.filter == BloomFilter::gauss9 ? detail::ComputePipeline(*context, desc("bloom_blur_" + lv, {S, W}))
                                                 : detail::ComputePipeline();
     up = detail::ComputePipeline(*context, desc("bloom_up_" + lv, {S, W}));
+    if (path.fuse_small_levels) {
+      detail::PipelineDesc d = desc("bloom_tail_" + lv, {S, W});
+      d.push_constant_bytes = sizeof(BloomTailPush);
+      d.workgroup = tail_group;
+      d.specialization.push_back(tail_capacity);  // constant 4: TAIL_FLOATS
+      tail = detail::ComputePipeline(*context, d);
+    } else {
+      tail = detail::ComputePipeline();
+    }
     composite.clear();
     copy.clear();
     for (const char* v : {"rgba16f", "rgba32f"}) output_pipelines(v);
@@ -251,7 +292,9 @@ struct Bloom::Impl {
     const auto W = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
     auto c = composite.find(v);
     if (c == composite.end()) {
-      c = composite.emplace(v, detail::ComputePipeline(*context, desc("bloom_composite_" + v, {S, S, W}))).first;
+      detail::PipelineDesc d =
+          path.fuse_last_up ? desc("bloom_composite_up_" + v, {S, S, W, S}) : desc("bloom_composite_" + v, {S, S, W});
+      c = composite.emplace(v, detail::ComputePipeline(*context, d)).first;
     }
     auto k = copy.find(v);
     if (k == copy.end()) k = copy.emplace(v, detail::ComputePipeline(*context, desc("image_copy_" + v, {S, W}))).first;
@@ -287,6 +330,21 @@ struct Bloom::Impl {
     }
     P.extent = size;
     return made;
+  }
+
+  // T of the small-levels dispatch for `chain` (bloom_internal.h, small_levels_top()): the first
+  // level whose levels below (and for gauss9 the blur's scratch of the largest of them) fit its
+  // shared memory. -1: not run.
+  int small_levels_top(const std::vector<LevelSize>& chain) const {
+    if (!path.fuse_small_levels) return -1;
+    const size_t n = chain.size();
+    for (size_t t = 0; t + 1 < n; ++t) {
+      uint64_t floats = 0;
+      for (size_t k = t + 1; k < n; ++k) floats += 3ull * chain[k].width * chain[k].height;
+      if (config.filter == BloomFilter::gauss9) floats += 3ull * chain[t + 1].width * chain[t + 1].height;
+      if (floats <= tail_capacity) return static_cast<int>(t);
+    }
+    return -1;
   }
 
   BloomPush push(const Pyramid& P, LevelSize src, LevelSize dst, uint32_t flags = 0) const {
@@ -428,8 +486,10 @@ void Bloom::Impl::record(VkCommandBuffer cmd, Image& input, Image& output, Profi
   if (gauss) blur_level(0);
   if (profiler) profiler->mark(cmd, "bloom bright-pass + down 0");
 
-  // 2. Progressive downsample.
-  for (uint32_t k = 1; k < n; ++k) {
+  // 2. Progressive downsample, down to level T of the small-levels dispatch (docs/BLOOM.md "Dispatches").
+  const int top = small_levels_top(chain);
+  const uint32_t last_down = top >= 0 ? static_cast<uint32_t>(top) : n - 1;
+  for (uint32_t k = 1; k <= last_down; ++k) {
     b.use(levels[k - 1].state, G, kCompute, kSampled);
     b.use(levels[k].state, G, kCompute, kStorageWrite);
     b.flush(cmd);
@@ -437,25 +497,63 @@ void Bloom::Impl::record(VkCommandBuffer cmd, Image& input, Image& output, Profi
                   chain[k].width, chain[k].height);
     if (gauss) blur_level(k);
   }
-  if (profiler && n > 1) profiler->mark(cmd, "bloom downsample");
+  if (profiler && last_down > 0) profiler->mark(cmd, "bloom downsample");
 
-  // 3. Upsample with accumulation by gather, smallest level first.
-  for (uint32_t k = n - 1; k-- > 0;) {
+  // 2b. The levels below T in one workgroup: their downsamples and upsamples, A(T) over level T.
+  if (top >= 0) {
+    const auto t = static_cast<uint32_t>(top);
+    BloomTailPush tp{};
+    tp.count = static_cast<int32_t>(n - 1 - t);
+    tp.radius = config.radius;
+    for (uint32_t k = t; k < n; ++k) {
+      tp.sizes[2 * (k - t)] = static_cast<int32_t>(chain[k].width);
+      tp.sizes[2 * (k - t) + 1] = static_cast<int32_t>(chain[k].height);
+    }
+    b.use(levels[t].state, G, kCompute, kSampled | kStorageRead | kStorageWrite);
+    b.flush(cmd);
+    tail.dispatch(cmd, {{levels[t].state.view, G}, {levels[t].state.view, G}}, tp, tail_group.x, tail_group.y);
+    if (profiler) profiler->mark(cmd, "bloom small levels");
+  }
+
+  // 3. Upsample with accumulation by gather, smallest level first, from the level that holds its
+  // A(k) (T, or the last level) down to level 1 (0 when the composite does not evaluate A(0)).
+  const uint32_t have = top >= 0 ? static_cast<uint32_t>(top) : n - 1;
+  const uint32_t up_to = path.fuse_last_up ? std::min(1u, have) : 0u;
+  for (uint32_t k = have; k-- > up_to;) {
     b.use(levels[k + 1].state, G, kCompute, kSampled);
     b.use(levels[k].state, G, kCompute, kStorageRead | kStorageWrite);
     b.flush(cmd);
     up.dispatch(cmd, {{levels[k + 1].state.view, G}, {levels[k].state.view, G}}, push(P, chain[k + 1], chain[k]),
                 chain[k].width, chain[k].height);
   }
-  if (profiler && n > 1) profiler->mark(cmd, "bloom upsample");
+  if (profiler && have > up_to) profiler->mark(cmd, "bloom upsample");
 
-  // 4. Last upsample fused with the composite.
-  b.use(levels[0].state, G, kCompute, kSampled);
-  b.use(scene, scene_layout, kCompute, kSampled);
-  b.use(output, G, kCompute, in_place ? (kSampled | kStorageWrite) : kStorageWrite);
-  b.flush(cmd);
-  composite_pipeline->dispatch(cmd, {{input.view, scene_layout}, {levels[0].state.view, G}, {output.view, G}},
-                               push(P, chain[0], full), full.width, full.height);
+  // 4. The composite, with the last upsample (Up(A(0)) to full resolution) and, fused, the one
+  // before it (A(0) = level 0 + Up(A(1))) evaluated inside.
+  if (path.fuse_last_up) {
+    const bool level0_done = have == 0;  // one level, or T = 0: level 0 holds A(0)
+    BloomPush cp = push(P, chain[0], full, level0_done ? GLINT_BLOOM_FLAG_LEVEL0_DONE : 0u);
+    Image& next = level0_done ? levels[0].state : levels[1].state;
+    if (!level0_done) {
+      cp.next_width = static_cast<int32_t>(chain[1].width);
+      cp.next_height = static_cast<int32_t>(chain[1].height);
+      b.use(next, G, kCompute, kSampled);
+    }
+    b.use(levels[0].state, G, kCompute, kSampled);
+    b.use(scene, scene_layout, kCompute, kSampled);
+    b.use(output, G, kCompute, in_place ? (kSampled | kStorageWrite) : kStorageWrite);
+    b.flush(cmd);
+    composite_pipeline->dispatch(
+        cmd, {{input.view, scene_layout}, {levels[0].state.view, G}, {output.view, G}, {next.view, G}}, cp, full.width,
+        full.height);
+  } else {
+    b.use(levels[0].state, G, kCompute, kSampled);
+    b.use(scene, scene_layout, kCompute, kSampled);
+    b.use(output, G, kCompute, in_place ? (kSampled | kStorageWrite) : kStorageWrite);
+    b.flush(cmd);
+    composite_pipeline->dispatch(cmd, {{input.view, scene_layout}, {levels[0].state.view, G}, {output.view, G}},
+                                 push(P, chain[0], full), full.width, full.height);
+  }
   if (profiler) profiler->mark(cmd, "bloom composite");
   if (in_place) input = output;
 }
@@ -465,6 +563,13 @@ Bloom::Bloom(const Context& context, const BloomConfig& config) : impl_(std::mak
   impl_->context = &context;
   impl_->config = config;
   impl_->workgroup = bloom_workgroup(context);
+  impl_->tail_group = tail_workgroup(context);
+  impl_->tail_capacity = tail_floats(context);
+  // The composite that evaluates A(0) itself recomputes it on each tile's window of level 0 (about
+  // 3 times per texel of level 0 with 8x8 tiles) and adds two barriers: on CPU devices, which have
+  // no launch or drain to save, lavapipe measured it 1.6 times as long as the upsample dispatch
+  // and composite it replaces (docs/BLOOM.md "Dispatches"), so they keep that dispatch.
+  impl_->path.fuse_last_up = context.info().type != VK_PHYSICAL_DEVICE_TYPE_CPU;
   impl_->cache.bind(context);
   impl_->make_pipelines();
 }
@@ -526,5 +631,21 @@ uint64_t Bloom::min_bytes_moved(VkFormat input_format, VkFormat output_format) c
   for (const LevelSize& l : p.pre_chain) total += 2 * uint64_t(l.width) * l.height * level_bytes;
   return total;
 }
+
+namespace detail {
+
+void BloomAccess::set_path(Bloom& bloom, const BloomPath& path) {
+  bloom.impl_->path = path;
+  bloom.impl_->make_pipelines();
+}
+
+BloomPath BloomAccess::path(const Bloom& bloom) { return bloom.impl_->path; }
+
+int BloomAccess::small_levels_top(const Bloom& bloom) {
+  const Bloom::Impl& impl = *bloom.impl_;
+  return impl.cur ? impl.small_levels_top(impl.cur->chain) : -1;
+}
+
+}  // namespace detail
 
 }  // namespace glint

@@ -12,8 +12,16 @@ const uint WIN_W = gl_WorkGroupSize.x + 10u;
 const uint WIN_H = gl_WorkGroupSize.y + 10u;
 const uint UP_GROUP_SIZE = gl_WorkGroupSize.x * gl_WorkGroupSize.y;
 
-shared vec4 s_src[WIN_W * WIN_H];
-shared vec4 s_rows[gl_WorkGroupSize.x * WIN_H];
+// A kernel that also uses the two arrays for other things before the upsample
+// (bloom_composite_up.comp) defines larger sizes first.
+#ifndef UP_SRC_SIZE
+#define UP_SRC_SIZE (WIN_W * WIN_H)
+#endif
+#ifndef UP_ROWS_SIZE
+#define UP_ROWS_SIZE (gl_WorkGroupSize.x * WIN_H)
+#endif
+shared vec4 s_src[UP_SRC_SIZE];
+shared vec4 s_rows[UP_ROWS_SIZE];
 
 vec3 bilinear_window(vec2 q, ivec2 lo) {
   vec2 f = floor(q);
@@ -29,21 +37,12 @@ vec3 bilinear_window(vec2 q, ivec2 lo) {
 float tap_offset(int a) { return FILTER == GLINT_BLOOM_GAUSS9 ? 0.0 : float(a - 1); }
 float tap_weight(int a) { return FILTER == GLINT_BLOOM_GAUSS9 ? 1.0 : (a == 1 ? 0.5 : 0.25); }
 
-// Every invocation of the workgroup must call this (it has barriers).
-vec3 upsample_tiled(texture2D small, ivec2 small_size, ivec2 dst_size, float radius) {
+// Up from the window s_src (texels lo .. lo + win - 1 of the smaller image, clamped, as
+// upsample_tiled() loads them) to the invocation's texel. Every invocation must call this (it has
+// barriers, the first of which publishes s_src).
+vec3 upsample_window(ivec2 small_size, ivec2 dst_size, float radius, ivec2 lo, ivec2 win) {
   vec2 scale = vec2(small_size) / vec2(dst_size);
-  // Vector expressions of gl_WorkGroupSize are avoided: spirv-opt's spec-constant folding (used by
-  // the validation layer) miscompiles them. Runtime ids give the same values.
   ivec2 first = ivec2(gl_GlobalInvocationID.xy - gl_LocalInvocationID.xy);
-  ivec2 last = min(ivec2(first.x + int(gl_WorkGroupSize.x) - 1, first.y + int(gl_WorkGroupSize.y) - 1), dst_size - 1);
-  float reach = FILTER == GLINT_BLOOM_GAUSS9 ? 0.0 : radius;
-  ivec2 lo = ivec2(floor(level_map(first, dst_size, small_size) - reach));
-  ivec2 hi = ivec2(floor(level_map(last, dst_size, small_size) + reach)) + 1;
-  ivec2 win = hi - lo + 1;
-  for (uint i = gl_LocalInvocationIndex; i < uint(win.x * win.y); i += UP_GROUP_SIZE) {
-    ivec2 t = ivec2(int(i) % win.x, int(i) / win.x);
-    s_src[uint(t.y) * WIN_W + uint(t.x)] = fetch_clamped(small, lo + t, small_size);
-  }
   barrier();
   ivec2 xy = min(ivec2(gl_GlobalInvocationID.xy), dst_size - 1);  // outside: any valid texel
   vec2 c = level_map(xy, dst_size, small_size);
@@ -82,4 +81,28 @@ vec3 upsample_tiled(texture2D small, ivec2 small_size, ivec2 dst_size, float rad
     sum += tap_weight(b) * mix(s_rows[k].rgb, s_rows[k + gl_WorkGroupSize.x].rgb, q - f);
   }
   return sum;
+}
+
+// The window of the smaller image that the workgroup's tile reaches: texels lo .. lo + win - 1
+// (before clamping to the image).
+void up_window(ivec2 small_size, ivec2 dst_size, float radius, out ivec2 lo, out ivec2 win) {
+  // Vector expressions of gl_WorkGroupSize are avoided: spirv-opt's spec-constant folding (used by
+  // the validation layer) miscompiles them. Runtime ids give the same values.
+  ivec2 first = ivec2(gl_GlobalInvocationID.xy - gl_LocalInvocationID.xy);
+  ivec2 last = min(ivec2(first.x + int(gl_WorkGroupSize.x) - 1, first.y + int(gl_WorkGroupSize.y) - 1), dst_size - 1);
+  float reach = FILTER == GLINT_BLOOM_GAUSS9 ? 0.0 : radius;
+  lo = ivec2(floor(level_map(first, dst_size, small_size) - reach));
+  ivec2 hi = ivec2(floor(level_map(last, dst_size, small_size) + reach)) + 1;
+  win = hi - lo + 1;
+}
+
+// Every invocation of the workgroup must call this (it has barriers).
+vec3 upsample_tiled(texture2D small, ivec2 small_size, ivec2 dst_size, float radius) {
+  ivec2 lo, win;
+  up_window(small_size, dst_size, radius, lo, win);
+  for (uint i = gl_LocalInvocationIndex; i < uint(win.x * win.y); i += UP_GROUP_SIZE) {
+    ivec2 t = ivec2(int(i) % win.x, int(i) / win.x);
+    s_src[uint(t.y) * WIN_W + uint(t.x)] = fetch_clamped(small, lo + t, small_size);
+  }
+  return upsample_window(small_size, dst_size, radius, lo, win);
 }

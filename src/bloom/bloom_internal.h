@@ -1,0 +1,28 @@
+// Bloom's dispatch structure, switchable for benchmarks and tests (not installed, not public API):
+// docs/BLOOM.md "Dispatches" says what each switch fuses. The default is every fusion on, except
+// fuse_last_up on CPU devices (Bloom's constructor).
+#pragma once
+
+#include <glint/bloom.h>
+
+namespace glint::detail {
+
+struct BloomPath {
+  /// The levels that fit one workgroup's shared memory run in one dispatch (bloom_tail.comp):
+  /// their downsamples, blurs and upsamples back to the level above them.
+  bool fuse_small_levels = true;
+  /// The composite evaluates A(0) = level 0 + Up(A(1)) itself (bloom_composite_up.comp) instead of
+  /// an upsample dispatch writing A(0) over level 0. Default: on GPUs.
+  bool fuse_last_up = true;
+};
+
+struct BloomAccess {
+  /// Replaces the path; makes the pipelines it needs (here, not in record()).
+  static void set_path(Bloom& bloom, const BloomPath& path);
+  static BloomPath path(const Bloom& bloom);
+  /// The level T that the small-levels dispatch reads and accumulates into at the current size,
+  /// or -1 when it does not run (switched off, one level, or the levels below every T do not fit).
+  static int small_levels_top(const Bloom& bloom);
+};
+
+}  // namespace glint::detail
