@@ -100,7 +100,7 @@ void BM_Bloom(benchmark::State& state) {
 void bloom_args(benchmark::internal::Benchmark* b) {
   // Defaults (karis_smooth, level0_height 0) per filter and cod13 with fp32 levels; then cod13 with
   // the per-box guard and none (what the smooth guard costs), and with level0_height 540. Each with
-  // the fused dispatches (fused:3, the default) and one dispatch per level (fused:0); the default
+  // the fused dispatches (fused:3) and one dispatch per level (fused:0, the default); the default
   // configuration also with each fusion alone (fused:1 small levels, fused:2 the last upsample).
   for (auto size : {std::pair{640, 480}, std::pair{1920, 1080}, std::pair{3840, 2160}}) {
     for (int fused : {3, 0, 1, 2}) b->Args({size.first, size.second, 0, 0, 2, 0, fused});

@@ -35,7 +35,7 @@ mkdir -p "$out"
 
 filter_for() {
   case "$1:$cpu" in
-    bloom:*) echo 'BM_Bloom/w:1920/h:1080/' ;;
+    bloom:*) echo 'BM_Bloom/w:1920/h:1080/.*/fused:0/' ;;
     blur:0) echo 'BM_Blur(Separable|SeparableLinear|Pyramid|Dual|Auto)/sigma10:[0-9]+/w:3840/h:2160/' ;;
     blur:1) echo 'BM_Blur(Separable|SeparableLinear|Pyramid|Dual|Auto)/sigma10:[0-9]+/w:960/h:540/' ;;
     occlusion:*) echo 'BM_LightCull/n:1000000/grid:[0-9]+/results:0/hiz:0/pattern:[01]/' ;;

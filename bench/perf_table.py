@@ -18,11 +18,11 @@ import re
 
 # (label, glint benchmark name without /manual_time, copy-floor size or None, peer key, target us)
 ROWS = [
-    ("bloom 1920x1080, defaults (karis_smooth)", "BM_Bloom/w:1920/h:1080/filter:0/fp32:0/guard:2/l0h:0/fused:3",
+    ("bloom 1920x1080, defaults (karis_smooth)", "BM_Bloom/w:1920/h:1080/filter:0/fp32:0/guard:2/l0h:0/fused:0",
      "1920x1080", "bloom:1920x1080", 60),
-    ("bloom 1920x1080, per-box Karis guard", "BM_Bloom/w:1920/h:1080/filter:0/fp32:0/guard:1/l0h:0/fused:3",
+    ("bloom 1920x1080, per-box Karis guard", "BM_Bloom/w:1920/h:1080/filter:0/fp32:0/guard:1/l0h:0/fused:0",
      "1920x1080", "bloom:1920x1080", None),
-    ("bloom 3840x2160, defaults (karis_smooth)", "BM_Bloom/w:3840/h:2160/filter:0/fp32:0/guard:2/l0h:0/fused:3",
+    ("bloom 3840x2160, defaults (karis_smooth)", "BM_Bloom/w:3840/h:2160/filter:0/fp32:0/guard:2/l0h:0/fused:0",
      "3840x2160", "bloom:3840x2160", 150),
     ("9-tap separable blur 3840x2160", "BM_BlurSeparable/sigma10:12/w:3840/h:2160", "3840x2160", "blur:9tap", 60),
     ("3-level BlurPyramid 3840x2160", "BM_PyramidLevels3/w:3840/h:2160", "3840x2160", None, 50),

@@ -198,7 +198,7 @@ def bloom_points(run, size):
         if not b["name"].startswith("BM_Bloom/"):
             continue
         f = re.search(r"/fused:(\d)", b["name"])  # absent in files from before the fused dispatches
-        if f and f.group(1) != "3":
+        if f and f.group(1) != "0":  # the default path
             continue
         m = re.search(r"w:(\d+)/h:(\d+)/filter:(\d)/fp32:(\d)", b["name"])
         if not m or (m.group(1), m.group(2)) != (w, h) or b.get("rel_l2_vs_f64", -1) < 0:

@@ -631,7 +631,7 @@ TEST_F(BloomTest, ProfilerReportsEveryStage) {
   for (const bool fuse : {true, false}) {
     Profiler profiler(context());
     Bloom bloom(context());
-    if (!fuse) detail::BloomAccess::set_path(bloom, {false, false});
+    detail::BloomAccess::set_path(bloom, {fuse, fuse});
     run_bloom(bloom, random_hdr(640, 480, 4), kF16, kF16, &profiler);
     const bool fits = context().info().max_shared_memory_bytes >= 18000;
     EXPECT_EQ(detail::BloomAccess::small_levels_top(bloom), fuse && fits ? 2 : -1);

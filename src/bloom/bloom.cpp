@@ -565,11 +565,8 @@ Bloom::Bloom(const Context& context, const BloomConfig& config) : impl_(std::mak
   impl_->workgroup = bloom_workgroup(context);
   impl_->tail_group = tail_workgroup(context);
   impl_->tail_capacity = tail_floats(context);
-  // The composite that evaluates A(0) itself recomputes it on each tile's window of level 0 (about
-  // 3 times per texel of level 0 with 8x8 tiles) and adds two barriers: on CPU devices, which have
-  // no launch or drain to save, lavapipe measured it 1.6 times as long as the upsample dispatch
-  // and composite it replaces (docs/BLOOM.md "Dispatches"), so they keep that dispatch.
-  impl_->path.fuse_last_up = context.info().type != VK_PHYSICAL_DEVICE_TYPE_CPU;
+  // One dispatch per level by default (BloomPath): both fusions measured slower on the H100
+  // and on lavapipe (docs/BLOOM.md "Dispatches").
   impl_->cache.bind(context);
   impl_->make_pipelines();
 }

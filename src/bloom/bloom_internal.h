@@ -1,6 +1,6 @@
 // Bloom's dispatch structure, switchable for benchmarks and tests (not installed, not public API):
-// docs/BLOOM.md "Dispatches" says what each switch fuses. The default is every fusion on, except
-// fuse_last_up on CPU devices (Bloom's constructor).
+// docs/BLOOM.md "Dispatches" says what each switch fuses and what each costs. The default is one
+// dispatch per level (both off): on the NVIDIA H100 each fusion measured slower (docs/BLOOM.md).
 #pragma once
 
 #include <glint/bloom.h>
@@ -10,10 +10,10 @@ namespace glint::detail {
 struct BloomPath {
   /// The levels that fit one workgroup's shared memory run in one dispatch (bloom_tail.comp):
   /// their downsamples, blurs and upsamples back to the level above them.
-  bool fuse_small_levels = true;
+  bool fuse_small_levels = false;
   /// The composite evaluates A(0) = level 0 + Up(A(1)) itself (bloom_composite_up.comp) instead of
-  /// an upsample dispatch writing A(0) over level 0. Default: on GPUs.
-  bool fuse_last_up = true;
+  /// an upsample dispatch writing A(0) over level 0.
+  bool fuse_last_up = false;
 };
 
 struct BloomAccess {
