@@ -1,6 +1,6 @@
 # Bloom (include/glint/bloom.h, docs/BLOOM.md). image_copy is bloom's: what it records at
 # intensity 0 (it takes BloomPush).
-set(GLINT_EFFECT_SOURCES bloom.cpp)
+set(GLINT_EFFECT_SOURCES bloom.cpp bloom_config.cpp)
 set(GLINT_EFFECT_KERNELS
   "shaders/bloom_prefilter_down|rgba16f|DST_FORMAT=rgba16f"
   "shaders/bloom_prefilter_down|rgba32f|DST_FORMAT=rgba32f"
