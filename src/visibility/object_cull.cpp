@@ -18,6 +18,7 @@
 #include "core/resources.h"
 #include "visibility/object_cull_internal.h"
 #include "visibility/shaders/object_cull_params.h"
+#include "visibility/visibility_util.h"
 
 namespace glint {
 
@@ -48,39 +49,9 @@ constexpr VkAccessFlags2 kWrite = VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT;
 constexpr uint32_t kGroup = GLINT_OBJECT_GROUP;
 constexpr uint32_t kMaxObjects = 1u << 28;
 
-void check_uint(const char* name, uint64_t value, uint64_t lo, uint64_t hi) {
-  if (value < lo || value > hi) {
-    throw Error(ErrorCode::invalid_argument, concat(name, " = ", value, " is out of range: accepted ", lo, " to ", hi));
-  }
-}
-
-void check_buffer(const char* where, const char* role, const Buffer& b, VkDeviceSize need, VkBufferUsageFlags usage) {
-  if (!b.buffer) throw Error(ErrorCode::invalid_argument, concat(where, ": ", role, " buffer is null"));
-  if ((b.usage & usage) != usage) {
-    throw Error(ErrorCode::missing_usage, concat(where, ": ", role, " buffer lacks usage 0x", std::hex,
-                                                 usage & ~b.usage, std::dec, " (needs 0x", std::hex, usage, ")"));
-  }
-  if (b.size == 0 || b.size == VK_WHOLE_SIZE) {
-    throw Error(ErrorCode::invalid_argument,
-                concat(where, ": ", role, " buffer size must be its byte count (not 0 or VK_WHOLE_SIZE)"));
-  }
-  if (b.size < need) {
-    throw Error(ErrorCode::invalid_argument,
-                concat(where, ": ", role, " buffer holds ", b.size, " bytes; ", need, " needed"));
-  }
-  if (b.offset % 4 != 0) {
-    throw Error(ErrorCode::invalid_argument,
-                concat(where, ": ", role, " buffer offset = ", b.offset, " is not a multiple of 4"));
-  }
-}
-
-Buffer view_of(const detail::OwnedBuffer& b, VkBufferUsageFlags usage) {
-  Buffer v;
-  v.buffer = b.buffer();
-  v.size = b.size();
-  v.usage = usage;
-  return v;
-}
+using detail::check_buffer;
+using visibility_detail::check_uint;
+using visibility_detail::view_of;
 
 // Rounds a positive double up to a float.
 float round_up(double v) {
