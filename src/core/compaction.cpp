@@ -25,6 +25,8 @@ Compaction::Compaction(const Context& context, const Desc& desc) {
   if (desc.scan_outputs > kMaxBuffers || desc.scatter_inputs + desc.scatter_outputs > kMaxBuffers) {
     throw Error(ErrorCode::invalid_argument, concat("Compaction: at most ", kMaxBuffers, " buffers per kernel"));
   }
+  if (desc.scatter_groups < 1) throw Error(ErrorCode::invalid_argument, "Compaction: scatter_groups must be >= 1");
+  scatter_groups_ = desc.scatter_groups;
   VkPhysicalDeviceProperties props;
   vkGetPhysicalDeviceProperties(context.physical_device(), &props);
   max_groups_x_ = props.limits.maxComputeWorkGroupCount[0];
@@ -98,8 +100,10 @@ void Compaction::record_scatter(VkCommandBuffer cmd, Barriers& b, GlintCompactPu
   Bindings set{groups_state_};
   for (Buffer* in : inputs) set.push_back(*in);
   for (Buffer* o : outputs) set.push_back(*o);
-  uint32_t gx, gy;
-  grid(push.count, gx, gy);
+  // Workgroups of scatter_groups groups each, as a 2D grid of at most maxComputeWorkGroupCount[0] per row.
+  const uint32_t workgroups = ((push.count + kGroup - 1) / kGroup + scatter_groups_ - 1) / scatter_groups_;
+  const uint32_t gx = std::min(workgroups, max_groups_x_);
+  const uint32_t gy = (workgroups + gx - 1) / gx;
   push.tile_groups = scan_threads_;
   push.groups_x = gx;
   b.use(groups_state_, kCompute, kRead);

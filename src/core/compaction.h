@@ -29,13 +29,15 @@ class Compaction {
     /// the group buffer, then `scan_outputs` storage buffers it writes.
     std::string scan_kernel;
     uint32_t scan_outputs = 2;
-    /// The scatter: one workgroup of 64 invocations per group (a 2D grid, groups_x per row);
-    /// binding 0 the group buffer, then `scatter_inputs` storage buffers it reads and
-    /// `scatter_outputs` it writes. "compact_scatter_main" copies GlintCompactPush::step[0]
-    /// payload words per item (0: the item index) from one input into one output.
+    /// The scatter: one workgroup of 64 invocations per `scatter_groups` consecutive groups (a 2D
+    /// grid, groups_x per row); binding 0 the group buffer, then `scatter_inputs` storage buffers
+    /// it reads and `scatter_outputs` it writes. "compact_scatter_main" copies
+    /// GlintCompactPush::step[0] payload words per item (0: the item index) from one input into
+    /// one output, GLINT_COMPACT_SCATTER_GROUPS groups per workgroup.
     std::string scatter_kernel = "compact_scatter_main";
     uint32_t scatter_inputs = 1;
     uint32_t scatter_outputs = 1;
+    uint32_t scatter_groups = GLINT_COMPACT_SCATTER_GROUPS;
   };
 
   Compaction() = default;
@@ -67,6 +69,7 @@ class Compaction {
   static constexpr size_t kMaxBuffers = 6;  // user buffers of one kernel (after the group buffer)
   uint32_t max_groups_x_ = 65535;
   uint32_t scan_threads_ = 1;
+  uint32_t scatter_groups_ = 1;
   ComputePipeline scan_tiles_, scan_, scatter_;
   OwnedBuffer groups_;
   Buffer groups_state_;

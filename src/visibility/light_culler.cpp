@@ -99,6 +99,7 @@ LightCuller::LightCuller(const Context& context, const LightCullConfig& config) 
   cd.scan_kernel = "light_cull_scan_main";  // writes the indirect arguments and statistics
   cd.scan_outputs = 2;
   cd.scatter_kernel = "light_cull_scatter_main";  // reads lights and records; writes instances and results
+  cd.scatter_groups = 1;                          // one workgroup per 64-light group
   cd.scatter_inputs = 2;
   cd.scatter_outputs = 2;
   m.compact = detail::Compaction(context, cd);

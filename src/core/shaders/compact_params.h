@@ -19,6 +19,8 @@
 // Most invocations of a scan workgroup (its shared arrays are sized for it); a tile is that many
 // groups.
 #define GLINT_COMPACT_SCAN_MAX_THREADS 1024u
+// 64-item groups per workgroup of compact_scatter.comp (16 x 64 = 1024 items, 4 KiB of shared list).
+#define GLINT_COMPACT_SCATTER_GROUPS 16u
 
 // Push constants of every compaction dispatch (32 bytes). The first four words are the
 // compaction's; `step` holds the words of the user's top-level scan and scatter (each user's

@@ -1,16 +1,22 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
 // The ordered compaction's scatter of fixed-size payloads (the object cull's list; compact.glsl):
-// one workgroup of GLINT_COMPACT_GROUP invocations per 64-item group. The group's emitted items
-// take the consecutive slots first .. first + n - 1 (first: the tile's first slot + the group's
-// slot within the tile), in item order, so the output holds the emitted items in increasing index
-// on every run. Invocation t of an emitted item records its item in s_item[rank]; the group's
-// destination words are then copied cooperatively, invocation t taking words t, t + 64, ...:
-// consecutive invocations write consecutive words and read each item's consecutive payload words,
-// so both sides coalesce whatever the payload size (an invocation per item would write
-// payload_words-strided words); an index list (no payload) needs no copy loop: each emitted
-// invocation writes its index to its slot. Slots at or beyond the capacity are not written (the
-// overflow keeps the smallest indices). A slot receives the item's payload_words words (step[0] > 0) or its index.
+// one workgroup of GLINT_COMPACT_GROUP invocations per GLINT_COMPACT_SCATTER_GROUPS consecutive
+// 64-item groups. Consecutive groups' emitted items take consecutive slots (the scan is one
+// exclusive prefix sum over the groups in item order), so the workgroup's items go to the one
+// range first .. first + n - 1 (first: the first group's tile's first slot + its slot within the
+// tile), in item order, on every run.
+// 1. Invocation k < groups loads group k's mask (coalesced), invocation 0 also its tile's first
+//    slot: every load of the workgroup is issued before the first barrier.
+// 2. For each group in order, invocation t of an emitted item writes the item's index into the
+//    shared list at (items of the earlier groups) + (its rank in the mask).
+// 3. The range is copied cooperatively, invocation t taking words t, t + 64, ...: consecutive
+//    invocations write consecutive words and read each item's consecutive payload words, and all
+//    of the workgroup's payload loads are independent (one round trip to memory for up to 1024
+//    items, where one workgroup per group paid one per 64 items and the launch of 16 times as
+//    many workgroups). An index list (no payload) is the shared list itself.
+// Slots at or beyond the capacity are not written (the overflow keeps the smallest indices). A
+// slot receives the item's payload_words words (step[0] > 0) or its index.
 layout(local_size_x_id = 0, local_size_y_id = 1) in;  // GLINT_COMPACT_GROUP x 1
 
 #define COMPACT_GROUPS_BINDING 0
@@ -18,39 +24,51 @@ layout(local_size_x_id = 0, local_size_y_id = 1) in;  // GLINT_COMPACT_GROUP x 1
 #define COMPACT_NO_SCAN
 #include "compact.glsl"
 
-layout(std430, binding = 1) readonly buffer Payloads { uint payloads[]; };  // payload words per item
-layout(std430, binding = 2) writeonly buffer List { uint list[]; };         // max(1, payload words) per slot
-layout(push_constant) uniform Push { GlintCompactPush pc; };                // step[0]: payload words
+layout(std430, binding = 1) restrict readonly buffer Payloads { uint payloads[]; };  // payload words per item
+layout(std430, binding = 2) restrict writeonly buffer List { uint list[]; };         // max(1, payload words) per slot
+layout(push_constant) uniform Push { GlintCompactPush pc; };  // step[0]: payload words
 
-shared uint s_item[GLINT_COMPACT_GROUP];  // the group's emitted items (bit index), in order
+const uint kGroups = GLINT_COMPACT_SCATTER_GROUPS;
+shared uvec2 s_mask[kGroups];
+shared uint s_first;                                  // the slot of the workgroup's first emitted item
+shared uint s_item[kGroups * GLINT_COMPACT_GROUP];    // the workgroup's emitted items, in order
 
 void main() {
-  const uint group = gl_WorkGroupID.y * pc.groups_x + gl_WorkGroupID.x;
+  const uint wg = gl_WorkGroupID.y * pc.groups_x + gl_WorkGroupID.x;
   const uint group_count = (pc.count + GLINT_COMPACT_GROUP - 1u) / GLINT_COMPACT_GROUP;
-  if (group >= group_count) return;  // uniform in the workgroup
+  const uint g0 = wg * kGroups;
+  if (g0 >= group_count) return;  // uniform in the workgroup
+  const uint ng = min(kGroups, group_count - g0);
   const uint t = gl_LocalInvocationIndex;
-  const uvec4 g = groups[group];
-  const uint first = groups[group / pc.tile_groups * pc.tile_groups].w + g.z;
-  const uint word = t < 32u ? g.x : g.y;
+  if (t < ng) {
+    const uvec4 g = groups[g0 + t];
+    s_mask[t] = g.xy;
+    if (t == 0u) s_first = groups[g0 / pc.tile_groups * pc.tile_groups].w + g.z;
+  }
+  barrier();
   const uint bit = t & 31u;
-  const bool emitted = ((word >> bit) & 1u) != 0u;
-  const uint rank = uint(bitCount(word & ((1u << bit) - 1u))) + (t < 32u ? 0u : uint(bitCount(g.x)));
+  uint n = 0u;  // emitted items of the groups before k
+  for (uint k = 0u; k < ng; ++k) {
+    const uvec2 m = s_mask[k];
+    const uint word = t < 32u ? m.x : m.y;
+    if (((word >> bit) & 1u) != 0u) {
+      const uint rank = uint(bitCount(word & ((1u << bit) - 1u))) + (t < 32u ? 0u : uint(bitCount(m.x)));
+      s_item[n + rank] = (g0 + k) * GLINT_COMPACT_GROUP + t;
+    }
+    n += uint(bitCount(m.x) + bitCount(m.y));
+  }
+  barrier();
+  const uint first = s_first;
+  const uint kept = first >= pc.capacity ? 0u : min(n, pc.capacity - first);
   const uint pw = pc.step[0];
-  const uint base = group * GLINT_COMPACT_GROUP;
   if (pw == 0u) {  // uniform: a push constant
-    // Indices: the emitted invocation writes its own slot (consecutive ranks, so consecutive
-    // words); no shared list and no barrier.
-    if (emitted && first + rank < pc.capacity) list[first + rank] = base + t;
+    for (uint d = t; d < kept; d += GLINT_COMPACT_GROUP) list[first + d] = s_item[d];
     return;
   }
-  if (emitted) s_item[rank] = t;
-  barrier();
-  const uint n = uint(bitCount(g.x) + bitCount(g.y));
-  const uint kept = first >= pc.capacity ? 0u : min(n, pc.capacity - first);
   // Fewer than 2^30 words (list and payload buffers fit maxStorageBufferRange): no wrap.
   const uint words = kept * pw, dst = first * pw;
   for (uint d = t; d < words; d += GLINT_COMPACT_GROUP) {
     const uint k = d / pw;
-    list[dst + d] = payloads[(base + s_item[k]) * pw + (d - k * pw)];
+    list[dst + d] = payloads[s_item[k] * pw + (d - k * pw)];
   }
 }
