@@ -574,6 +574,46 @@ TEST_F(ObjectCullTest, PayloadsAndOverflow) {
   }
 }
 
+// A cull of no objects still writes its arguments and statistics (one workgroup finishes it): an
+// empty draw and dispatch, every count zero; a cull of the same culler after it is whole.
+TEST_F(ObjectCullTest, NoObjectsWritesEmptyArguments) {
+  SceneSpec s;
+  s.objects = 300;
+  std::mt19937 rng(77);
+  const TestCamera cam = make_camera(rng, s);
+  const auto depth = make_depth_image(rng, cam, s);
+  const auto objs = make_objects(rng, cam, s);
+  GpuScene g(depth, false, objs);
+  ObjectCullConfig cc;
+  cc.max_objects = s.objects;
+  cc.capacity = s.objects;
+  ObjectCuller culler(context(), cc);
+  for (uint32_t count : {0u, s.objects, 0u}) {
+    Outputs out(cc.capacity, 0);
+    context().run_once([&](VkCommandBuffer cmd) {
+      g.hiz.record(cmd, g.depth_image.state);
+      culler.record(cmd, g.hiz, g.depth_image.state, frame_of(cam.cam, count), g.buffers, out.out);
+      out.host(cmd);
+      to_host(cmd, g.buffers.visibility);
+    });
+    const auto args = out.args();
+    const auto st = out.st();
+    EXPECT_EQ(st.total, count);
+    EXPECT_EQ(st.frustum_culled + st.occluded + st.visible, count) << count;  // invalid ones count visible
+    EXPECT_EQ(st.emitted, st.visible);
+    EXPECT_EQ(args.draw_count, st.visible);
+    EXPECT_EQ(args.group_count_x, (st.visible + cc.objects_per_group - 1) / cc.objects_per_group);
+    EXPECT_EQ(args.group_count_y, 1u);
+    EXPECT_EQ(args.group_count_z, 1u);
+    if (count == 0) {
+      EXPECT_EQ(st.visible, 0u);
+      EXPECT_EQ(out.words(1)[0], 0xFFFFFFFFu) << "no slot is written";
+    } else {
+      EXPECT_GT(st.visible, 0u);
+    }
+  }
+}
+
 // The two-level scan over many tiles (a tile is up to 1024 groups of 64 objects, 64 groups on CPU
 // devices): the list holds exactly the objects the cull left VISIBLE, in increasing index, with
 // the count and statistics (every state's count) to match, for counts that end inside a group, on
@@ -666,9 +706,12 @@ TEST_F(ObjectCullTest, BrokenTileCountIsCaughtAndTheNextCullHeals) {
     }
     ASSERT_GT(expected.size(), count / 100);
     if (broken) {
-      EXPECT_EQ(out.st().emitted, 0u) << "a tile was scanned although its count never reached its size";
-      EXPECT_EQ(out.st().visible, 0u);
-      EXPECT_EQ(out.args().draw_count, 0u);
+      // No tile's count reaches its size, so no tile is scanned and no workgroup finishes the cull:
+      // the arguments and statistics keep what they held (the poison). The scatter zeroes the
+      // counts, so the next cull is whole.
+      EXPECT_EQ(out.st().emitted, 0xffffffffu) << "a tile was scanned although its count never reached its size";
+      EXPECT_EQ(out.st().visible, 0xffffffffu);
+      EXPECT_EQ(out.args().draw_count, 0xffffffffu);
     } else {
       EXPECT_EQ(out.st().emitted, expected.size());
       EXPECT_EQ(out.st().visible, expected.size());

@@ -288,24 +288,25 @@ ObjectCuller::ObjectCuller(const Context& context, const ObjectCullConfig& confi
   const VkSubgroupFeatureFlags need = VK_SUBGROUP_FEATURE_BASIC_BIT | VK_SUBGROUP_FEATURE_ARITHMETIC_BIT;
   m.subgroup = (sub.supportedStages & VK_SHADER_STAGE_COMPUTE_BIT) != 0 && (sub.supportedOperations & need) == need;
   d.kernel_id = m.subgroup ? "object_cull_main_subgroup" : "object_cull_main";
-  d.bindings = {S, S, B, B, B, B};
+  d.bindings = {S, S, B, B, B, B, B, B};
   d.push_constant_bytes = sizeof(GlintObjectCullPush);
   d.workgroup = {kGroup, 1};
+  d.specialization = {config.capacity, config.objects_per_group};  // the test writes the arguments
   m.cull = detail::ComputePipeline(context, d);
   d.kernel_id = m.subgroup ? "object_cull_phase1_subgroup" : "object_cull_phase1";
-  d.bindings = {B, B, B, B};
+  d.bindings = {B, B, B, B, B, B};
   m.phase1 = detail::ComputePipeline(context, d);
   detail::Compaction::Desc cd;
   cd.max_items = config.max_objects;
-  cd.scan_kernel = "object_cull_scan_main";    // writes the indirect arguments and statistics
-  cd.scan_outputs = 3;                         // and zeroes the test's tile counts
-  cd.scatter_kernel = "compact_scatter_main";  // payloads (or indices) into the list
-  cd.scatter_inputs = 1;
-  cd.scatter_outputs = 1;
+  cd.scan_kernel = "object_cull_scan_main";  // the previous kernel's: arguments and statistics
+  cd.scan_outputs = 2;
+  cd.scatter_kernel = "compact_scatter_main";  // payloads (or indices) into the list; zeroes the
+  cd.scatter_inputs = 1;                       // test's tile counts
+  cd.scatter_outputs = 2;
   m.compact = detail::Compaction(context, cd);
   const VkBufferUsageFlags tile_usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
   const uint64_t tiles = (groups + m.compact.tile_groups() - 1) / m.compact.tile_groups();
-  m.tile_done = detail::OwnedBuffer(context, std::max<uint64_t>(1, tiles) * 4, tile_usage, false);
+  m.tile_done = detail::OwnedBuffer(context, (tiles + 1) * 4, tile_usage, false);  // + the tiles scanned
   m.tile_done_state = view_of(m.tile_done, tile_usage);
   m.dummy = detail::OwnedBuffer(context, 16, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, false);
   m.dummy_state = view_of(m.dummy, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
@@ -335,8 +336,8 @@ void ObjectCuller::Impl::run(VkCommandBuffer cmd, HiZPyramid* hiz, Image* depth,
   const bool atomic = kernel == ObjectCullKernel::shared_atomics;
   // The previous kernel leaves the first level of the scan to compact_scan_tiles.comp.
   const bool v1 = kernel == ObjectCullKernel::previous && mode == GLINT_OBJECT_MODE_SINGLE;
-  // The test's descriptors: depth and Hi-Z (not in phase 1), objects, visibility, counters, the
-  // tiles' counts of written records (not in the previous kernel).
+  // The test's descriptors: depth and Hi-Z (not in phase 1), objects, visibility, counters; then
+  // (not in the previous kernel) the tiles' counts of written records, the arguments, the statistics.
   detail::Bindings test;
   if (images) {
     test.push_back({depth->view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL});
@@ -345,7 +346,11 @@ void ObjectCuller::Impl::run(VkCommandBuffer cmd, HiZPyramid* hiz, Image* depth,
   test.push_back(in.objects);
   test.push_back(in.visibility);
   test.push_back(groups_state);
-  if (!v1) test.push_back(tile_done_state);
+  if (!v1) {
+    test.push_back(tile_done_state);
+    test.push_back(out.indirect);
+    test.push_back(out.stats);
+  }
 
   detail::Barriers b;
   compact.record_clear_once(cmd, b);  // the scan resets the counters after every cull
@@ -367,8 +372,14 @@ void ObjectCuller::Impl::run(VkCommandBuffer cmd, HiZPyramid* hiz, Image* depth,
   b.use(in.visibility, kCompute, images ? (kRead | kWrite) : kRead);
   b.use(groups_state, kCompute, kRead | kWrite);
   b.use(tile_done_state, kCompute, kRead | kWrite);
+  if (!v1) {
+    b.use(out.indirect, kCompute, kWrite);
+    b.use(out.stats, kCompute, kWrite);
+  }
   b.flush(cmd);
-  if (count > 0) {
+  // The current kernel also runs for no objects: one workgroup writes the (empty) arguments and
+  // statistics.
+  if (count > 0 || !v1) {
     push.count = count;
     push.flags = mode | (config.reversed_z ? GLINT_OBJECT_REVERSED_Z : 0u);
     push.groups_x = gx;
@@ -385,18 +396,22 @@ void ObjectCuller::Impl::run(VkCommandBuffer cmd, HiZPyramid* hiz, Image* depth,
     test_pipeline.dispatch(cmd, test, push, gx * kGroup, gy);
   }
   if (profiler) profiler->mark(cmd, "object cull");
-  // 2. Scan: slots, arguments, statistics; counters reset. 3. Scatter: payloads in object order.
   GlintObjectCompactPush op{};
   op.count = count;
   op.capacity = config.capacity;
   op.payload_words = config.payload_words;
   op.objects_per_group = config.objects_per_group;
+  op.clear_words = static_cast<uint32_t>(tile_done_state.size / 4);
   GlintCompactPush cp;
   static_assert(sizeof(cp) == sizeof(op));
   std::memcpy(&cp, &op, sizeof(cp));
-  compact.record_scan(cmd, b, cp, {&out.indirect, &out.stats, &tile_done_state}, !v1);
-  if (profiler) profiler->mark(cmd, "object cull scan");
-  compact.record_scatter(cmd, b, cp, {&payloads}, {&out.list});
+  // The previous kernel: 2. the scan (tiles, then slots, arguments, statistics; counters reset).
+  if (v1) {
+    compact.record_scan(cmd, b, cp, {&out.indirect, &out.stats});
+    if (profiler) profiler->mark(cmd, "object cull scan");
+  }
+  // 3. Scatter: payloads in object order; the tile counts zeroed for the next cull.
+  compact.record_scatter(cmd, b, cp, {&payloads}, {&out.list, &tile_done_state});
   if (profiler) profiler->mark(cmd, "object cull scatter");
 }
 
@@ -460,10 +475,11 @@ void object_cull_select_kernel(ObjectCuller& culler, ObjectCullKernel kernel) {
   }
   if (kernel == ObjectCullKernel::shared_atomics && !m.cull_atomic) {
     d.kernel_id = "object_cull_main";
-    d.bindings = {S, S, B, B, B, B};
+    d.bindings = {S, S, B, B, B, B, B, B};
+    d.specialization = {m.config.capacity, m.config.objects_per_group};
     m.cull_atomic = ComputePipeline(*m.context, d);
     d.kernel_id = "object_cull_phase1";
-    d.bindings = {B, B, B, B};
+    d.bindings = {B, B, B, B, B, B};
     m.phase1_atomic = ComputePipeline(*m.context, d);
   }
   m.kernel = kernel;

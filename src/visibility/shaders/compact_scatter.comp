@@ -17,6 +17,9 @@
 //    many workgroups). An index list (no payload) is the shared list itself.
 // Slots at or beyond the capacity are not written (the overflow keeps the smallest indices). A
 // slot receives the item's payload_words words (step[0] > 0) or its index.
+// Workgroup 0 also zeroes the first step[2] words of binding 3, the user's per-run counters (the
+// object cull's tile counts, object_cull.comp): this dispatch runs after every cull whatever the
+// counts held, so a count left wrong (a cull cut short) is whole again for the next cull.
 layout(local_size_x_id = 0, local_size_y_id = 1) in;  // GLINT_COMPACT_GROUP x 1
 
 #define COMPACT_GROUPS_BINDING 0
@@ -26,6 +29,7 @@ layout(local_size_x_id = 0, local_size_y_id = 1) in;  // GLINT_COMPACT_GROUP x 1
 
 layout(std430, binding = 1) restrict readonly buffer Payloads { uint payloads[]; };  // payload words per item
 layout(std430, binding = 2) restrict writeonly buffer List { uint list[]; };         // max(1, payload words) per slot
+layout(std430, binding = 3) restrict writeonly buffer Clear { uint clear_words[]; };  // step[2] words zeroed
 layout(push_constant) uniform Push { GlintCompactPush pc; };  // step[0]: payload words
 
 const uint kGroups = GLINT_COMPACT_SCATTER_GROUPS;
@@ -37,9 +41,12 @@ void main() {
   const uint wg = gl_WorkGroupID.y * pc.groups_x + gl_WorkGroupID.x;
   const uint group_count = (pc.count + GLINT_COMPACT_GROUP - 1u) / GLINT_COMPACT_GROUP;
   const uint g0 = wg * kGroups;
+  const uint t = gl_LocalInvocationIndex;
+  if (wg == 0u) {
+    for (uint k = t; k < pc.step[2]; k += GLINT_COMPACT_GROUP) clear_words[k] = 0u;
+  }
   if (g0 >= group_count) return;  // uniform in the workgroup
   const uint ng = min(kGroups, group_count - g0);
-  const uint t = gl_LocalInvocationIndex;
   if (t < ng) {
     const uvec4 g = groups[g0 + t];
     s_mask[t] = g.xy;

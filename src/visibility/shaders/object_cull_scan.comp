@@ -1,11 +1,12 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
-// The object cull's top-level scan (the second level of the ordered compaction, compact.glsl;
-// compact_scan_tiles.comp is the first): one workgroup turns the tile totals into each tile's
-// first list slot (the first level ran in object_cull.comp, or compact_scan_tiles.comp after the
-// previous test kernel). Then invocation 0 writes the draw count (clamped to the capacity), the dispatch
-// arguments and the statistics, and zeroes the counters for the next cull (a separate dispatch
-// after the cull's atomics, so no reset races them).
+// The object cull's top-level scan after the previous test kernel (object_cull_v1.comp; the
+// second level of the ordered compaction, compact.glsl, after compact_scan_tiles.comp): one
+// workgroup turns the tile totals into each tile's first list slot. Then invocation 0 writes the
+// draw count (clamped to the capacity), the dispatch arguments and the statistics, and zeroes the
+// counters for the next cull (a separate dispatch after the cull's atomics, so no reset races
+// them). object_cull.comp runs the same top level
+// itself (finish_cull).
 layout(local_size_x_id = 0, local_size_y_id = 1) in;
 
 #define COMPACT_GROUPS_BINDING 0
@@ -14,14 +15,10 @@ layout(local_size_x_id = 0, local_size_y_id = 1) in;
 
 layout(std430, binding = 1) writeonly buffer Indirect { GlintObjectCullIndirect indirect; };
 layout(std430, binding = 2) writeonly buffer Stats { GlintObjectCullStats stats; };
-// The test's per-tile counts of written records (object_cull.comp): zeroed for the next cull.
-layout(std430, binding = 3) writeonly buffer TileDone { uint tile_done[]; };
 layout(push_constant) uniform Push { GlintObjectCompactPush pc; };
 
 void main() {
   const uint emitted = compact_top_scan(pc.count, pc.tile_groups);
-  const uint tiles = ((pc.count + GLINT_OBJECT_GROUP - 1u) / GLINT_OBJECT_GROUP + pc.tile_groups - 1u) / pc.tile_groups;
-  for (uint t = gl_LocalInvocationIndex; t < tiles; t += gl_WorkGroupSize.x * gl_WorkGroupSize.y) tile_done[t] = 0u;
   if (gl_LocalInvocationIndex != 0u) return;
   const uint written = min(emitted, pc.capacity);
   indirect.draw_count = written;
