@@ -1,6 +1,7 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_samplerless_texture_functions : require
+#extension GL_EXT_control_flow_attributes : require
 #ifdef GLINT_OBJECT_SUBGROUP
 // The variants the host picks where the device's subgroups support arithmetic in compute
 // (VkPhysicalDeviceSubgroupProperties); the others count with shared atomics alone.
@@ -315,27 +316,39 @@ uint workgroup_scan(uint n, out uint total) {
 // last workgroup of a tile to write its record: for each of the tile's `n` groups from `first`,
 // the emitted objects of the tile before it (z, replacing the packed counts); the tile's total in
 // its first group's w; the packed counts added to the header, one atomic per tile and counter.
-// Invocation t takes a run of consecutive groups (ceil(n / 64) of them, at most 16 for tiles of
-// 1024 groups); the runs' totals are scanned in shared memory (Hillis & Steele 1986).
+// Invocation t takes a run of consecutive groups (ceil(n / 64) of them, at most kMaxRun for tiles
+// of GLINT_COMPACT_SCAN_MAX_THREADS groups); the runs' totals are scanned in shared memory. The
+// run's records are loaded in one unrolled pass, every load in flight at once, and its counts
+// kept in registers for the stores: the last tile's scan is on the critical path of the cull,
+// where a loop of dependent loads cost one round trip to memory per group of the run.
+const uint kMaxRun = GLINT_COMPACT_SCAN_MAX_THREADS / GLINT_OBJECT_GROUP;
 void scan_tile(uint first, uint n) {
   const uint lid = gl_LocalInvocationIndex;
-  const uint per = (n + GLINT_OBJECT_GROUP - 1u) / GLINT_OBJECT_GROUP;
-  const uint g0 = first + min(lid * per, n), g1 = first + min(lid * per + per, n);
+  const uint per = (n + GLINT_OBJECT_GROUP - 1u) / GLINT_OBJECT_GROUP;  // <= kMaxRun
+  const uint g0 = first + lid * per, g1 = first + min(lid * per + per, n);
+  uint cnt[kMaxRun];
+  // The packed counts (bytes: frustum, occluded, visible, invalid) summed as two pairs of 16-bit
+  // lanes: at most kMaxRun * 64 = 1024 per lane, no carry between lanes.
+  uint lo = 0u, hi = 0u;
   uint run = 0u;
-  uvec4 c = uvec4(0u);
-  for (uint g = g0; g < g1; ++g) {
-    const uvec4 v = groups[g];
-    run += uint(bitCount(v.x) + bitCount(v.y));
-    c += (uvec4(v.z) >> uvec4(0u, 8u, 16u, 24u)) & 0xffu;
+  [[unroll]] for (uint k = 0u; k < kMaxRun; ++k) {
+    cnt[k] = 0u;
+    if (g0 + k < g1) {
+      const uvec4 v = groups[g0 + k];
+      cnt[k] = uint(bitCount(v.x) + bitCount(v.y));
+      lo += v.z & 0x00ff00ffu;
+      hi += (v.z >> 8u) & 0x00ff00ffu;
+    }
+    run += cnt[k];
   }
   uint total;
   uint before = workgroup_scan(run, total) - run;  // exclusive
-  for (uint g = g0; g < g1; ++g) {
-    const uvec4 v = groups[g];
-    groups[g].z = before;
-    before += uint(bitCount(v.x) + bitCount(v.y));
+  [[unroll]] for (uint k = 0u; k < kMaxRun; ++k) {
+    if (g0 + k < g1) groups[g0 + k].z = before;
+    before += cnt[k];
   }
   if (lid == 0u) groups[first].w = total;
+  const uvec4 c = uvec4(lo & 0xffffu, hi & 0xffffu, lo >> 16u, hi >> 16u);
   for (uint f = 0u; f < 4u; ++f) {
     if (c[f] != 0u) atomicAdd(s_tile_counts[f], c[f]);
   }
