@@ -691,7 +691,7 @@ TEST_F(ObjectCullTest, BrokenTileCountIsCaughtAndTheNextCullHeals) {
     Outputs out(count, 0);
     g.visibility.poison();
     context().run_once([&](VkCommandBuffer cmd) {
-      if (broken) detail::object_cull_fill_tile_counts(culler, cmd, 0x40000000u);
+      if (broken) detail::object_cull_fill_tiles_done(culler, cmd, 0x40000000u);
       g.hiz.record(cmd, g.depth_image.state);
       culler.record(cmd, g.hiz, g.depth_image.state, frame, g.buffers, out.out);
       out.host(cmd);

@@ -27,6 +27,7 @@ Compaction::Compaction(const Context& context, const Desc& desc) {
   }
   if (desc.scatter_groups < 1) throw Error(ErrorCode::invalid_argument, "Compaction: scatter_groups must be >= 1");
   scatter_groups_ = desc.scatter_groups;
+  scan_in_one_dispatch_ = desc.scan_in_one_dispatch;
   VkPhysicalDeviceProperties props;
   vkGetPhysicalDeviceProperties(context.physical_device(), &props);
   max_groups_x_ = props.limits.maxComputeWorkGroupCount[0];
@@ -73,22 +74,30 @@ void Compaction::record_clear_once(VkCommandBuffer cmd, Barriers& b) {
 }
 
 void Compaction::record_scan(VkCommandBuffer cmd, Barriers& b, GlintCompactPush push,
-                             std::initializer_list<Buffer*> outputs, bool tiles_scanned) {
+                             std::initializer_list<Buffer*> outputs) {
   // The top-level scan's descriptors: the group buffer, then the user's outputs.
   Bindings top{groups_state_};
   for (Buffer* o : outputs) top.push_back(*o);
   push.tile_groups = scan_threads_;
-  // 1. Tiles of scan_threads groups in parallel: slots within each tile, tile totals.
   const uint32_t group_count = (push.count + kGroup - 1) / kGroup;
-  if (group_count > 0 && !tiles_scanned) {
+  const uint32_t tiles = (group_count + scan_threads_ - 1) / scan_threads_;
+  if (scan_in_one_dispatch_) {
+    // One workgroup per tile (at least one: a run of no items still writes its outputs).
+    b.use(groups_state_, kCompute, kRead | kWrite);
+    for (Buffer* o : outputs) b.use(*o, kCompute, kRead | kWrite);
+    b.flush(cmd);
+    scan_.dispatch(cmd, top, push, std::max(1u, tiles) * scan_threads_, 1);
+    return;
+  }
+  // 1. Tiles of scan_threads groups in parallel: slots within each tile, tile totals.
+  if (group_count > 0) {
     b.use(groups_state_, kCompute, kRead | kWrite);
     b.flush(cmd);
-    scan_tiles_.dispatch(cmd, {groups_state_}, push, (group_count + scan_threads_ - 1) / scan_threads_ * scan_threads_,
-                         1);
+    scan_tiles_.dispatch(cmd, {groups_state_}, push, tiles * scan_threads_, 1);
   }
   // 2. One workgroup: the tiles' first slots, then the user's outputs.
   b.use(groups_state_, kCompute, kRead | kWrite);
-  for (Buffer* o : outputs) b.use(*o, kCompute, kWrite);
+  for (Buffer* o : outputs) b.use(*o, kCompute, kRead | kWrite);
   b.flush(cmd);
   scan_.dispatch(cmd, top, push, scan_threads_, 1);
 }

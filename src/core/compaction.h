@@ -29,6 +29,10 @@ class Compaction {
     /// the group buffer, then `scan_outputs` storage buffers it writes.
     std::string scan_kernel;
     uint32_t scan_outputs = 2;
+    /// The user's scan kernel runs both levels in one dispatch of one workgroup per tile (each scans
+    /// its tile with compact_tile_scan, the last to finish runs compact_top_scan), so
+    /// compact_scan_tiles.comp is not recorded.
+    bool scan_in_one_dispatch = false;
     /// The scatter: one workgroup of 64 invocations per `scatter_groups` consecutive groups (a 2D
     /// grid, groups_x per row); binding 0 the group buffer, then `scatter_inputs` storage buffers
     /// it reads and `scatter_outputs` it writes. "compact_scatter_main" copies
@@ -54,12 +58,9 @@ class Compaction {
 
   /// Zeroes the header's counters the first time (the top-level scan resets them after every run).
   void record_clear_once(VkCommandBuffer cmd, Barriers& b);
-  /// The two-level scan of `push.count` items; `outputs` are the top-level scan's buffers (written).
-  /// Fills push.tile_groups. `tiles_scanned`: the user's test kernel already ran the first level
-  /// (its last workgroup per tile scans the tile, as object_cull.comp does), so only the top level
-  /// is recorded.
-  void record_scan(VkCommandBuffer cmd, Barriers& b, GlintCompactPush push, std::initializer_list<Buffer*> outputs,
-                   bool tiles_scanned = false);
+  /// The two-level scan of `push.count` items; `outputs` are the top-level scan's buffers (read and
+  /// written). Fills push.tile_groups.
+  void record_scan(VkCommandBuffer cmd, Barriers& b, GlintCompactPush push, std::initializer_list<Buffer*> outputs);
   /// The scatter of `push.count` items: `inputs` read, `outputs` written. Fills push.tile_groups and
   /// push.groups_x.
   void record_scatter(VkCommandBuffer cmd, Barriers& b, GlintCompactPush push, std::initializer_list<Buffer*> inputs,
@@ -70,6 +71,7 @@ class Compaction {
   uint32_t max_groups_x_ = 65535;
   uint32_t scan_threads_ = 1;
   uint32_t scatter_groups_ = 1;
+  bool scan_in_one_dispatch_ = false;
   ComputePipeline scan_tiles_, scan_, scatter_;
   OwnedBuffer groups_;
   Buffer groups_state_;

@@ -186,12 +186,12 @@ struct ObjectCuller::Impl {
   detail::Compaction compact;
   detail::OwnedBuffer dummy;
   Buffer dummy_state;
-  // Per tile of the scan, the test's workgroups that have written their record (object_cull.comp:
-  // the last one scans the tile); zero-filled at the first record, zeroed by the top-level scan
-  // after every cull.
-  detail::OwnedBuffer tile_done;
-  Buffer tile_done_state;
-  bool tile_done_cleared = false;
+  // The scan's count of scanned tiles (object_cull_scan.comp: the last tile finishes the scan),
+  // zero-filled at the first cull, zeroed by the last tile and by the scatter after every cull;
+  // then the tiles' counts of each state.
+  detail::OwnedBuffer tiles_done;
+  Buffer tiles_done_state;
+  bool tiles_done_cleared = false;
 
   void check_common(const char* where, const ObjectCullFrame& frame, ObjectCullBuffers& in, ObjectCullOutputs& out,
                     GlintObjectCullPush& push) const {
@@ -288,26 +288,27 @@ ObjectCuller::ObjectCuller(const Context& context, const ObjectCullConfig& confi
   const VkSubgroupFeatureFlags need = VK_SUBGROUP_FEATURE_BASIC_BIT | VK_SUBGROUP_FEATURE_ARITHMETIC_BIT;
   m.subgroup = (sub.supportedStages & VK_SHADER_STAGE_COMPUTE_BIT) != 0 && (sub.supportedOperations & need) == need;
   d.kernel_id = m.subgroup ? "object_cull_main_subgroup" : "object_cull_main";
-  d.bindings = {S, S, B, B, B, B, B, B};
+  d.bindings = {S, S, B, B, B};
   d.push_constant_bytes = sizeof(GlintObjectCullPush);
   d.workgroup = {kGroup, 1};
-  d.specialization = {config.capacity, config.objects_per_group};  // the test writes the arguments
   m.cull = detail::ComputePipeline(context, d);
   d.kernel_id = m.subgroup ? "object_cull_phase1_subgroup" : "object_cull_phase1";
-  d.bindings = {B, B, B, B, B, B};
+  d.bindings = {B, B, B};
   m.phase1 = detail::ComputePipeline(context, d);
   detail::Compaction::Desc cd;
   cd.max_items = config.max_objects;
-  cd.scan_kernel = "object_cull_scan_main";  // the previous kernel's: arguments and statistics
-  cd.scan_outputs = 2;
+  cd.scan_kernel = "object_cull_scan_main";  // both levels; the arguments and statistics
+  cd.scan_outputs = 3;                       // (and the count of scanned tiles)
+  cd.scan_in_one_dispatch = true;
   cd.scatter_kernel = "compact_scatter_main";  // payloads (or indices) into the list; zeroes the
-  cd.scatter_inputs = 1;                       // test's tile counts
+  cd.scatter_inputs = 1;                       // count of scanned tiles
   cd.scatter_outputs = 2;
   m.compact = detail::Compaction(context, cd);
-  const VkBufferUsageFlags tile_usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+  const VkBufferUsageFlags tiles_usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+  // The count of scanned tiles (16 bytes with padding), then each tile's four counts.
   const uint64_t tiles = (groups + m.compact.tile_groups() - 1) / m.compact.tile_groups();
-  m.tile_done = detail::OwnedBuffer(context, (tiles + 1) * 4, tile_usage, false);  // + the tiles scanned
-  m.tile_done_state = view_of(m.tile_done, tile_usage);
+  m.tiles_done = detail::OwnedBuffer(context, 16 + tiles * 16, tiles_usage, false);
+  m.tiles_done_state = view_of(m.tiles_done, tiles_usage);
   m.dummy = detail::OwnedBuffer(context, 16, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, false);
   m.dummy_state = view_of(m.dummy, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
 }
@@ -334,10 +335,8 @@ void ObjectCuller::Impl::run(VkCommandBuffer cmd, HiZPyramid* hiz, Image* depth,
   const bool images = mode != GLINT_OBJECT_MODE_PHASE1;
   using detail::ObjectCullKernel;
   const bool atomic = kernel == ObjectCullKernel::shared_atomics;
-  // The previous kernel leaves the first level of the scan to compact_scan_tiles.comp.
   const bool v1 = kernel == ObjectCullKernel::previous && mode == GLINT_OBJECT_MODE_SINGLE;
-  // The test's descriptors: depth and Hi-Z (not in phase 1), objects, visibility, counters; then
-  // (not in the previous kernel) the tiles' counts of written records, the arguments, the statistics.
+  // The test's descriptors: depth and Hi-Z (not in phase 1), objects, visibility, group records.
   detail::Bindings test;
   if (images) {
     test.push_back({depth->view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL});
@@ -346,24 +345,19 @@ void ObjectCuller::Impl::run(VkCommandBuffer cmd, HiZPyramid* hiz, Image* depth,
   test.push_back(in.objects);
   test.push_back(in.visibility);
   test.push_back(groups_state);
-  if (!v1) {
-    test.push_back(tile_done_state);
-    test.push_back(out.indirect);
-    test.push_back(out.stats);
-  }
 
   detail::Barriers b;
   compact.record_clear_once(cmd, b);  // the scan resets the counters after every cull
-  if (!tile_done_cleared) {           // the top-level scan zeroes them after every cull
-    b.use(tile_done_state, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);
+  if (!tiles_done_cleared) {          // the scan and the scatter zero it after every cull
+    b.use(tiles_done_state, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);
     b.flush(cmd);
-    vkCmdFillBuffer(cmd, tile_done_state.buffer, 0, tile_done_state.size, 0);
+    vkCmdFillBuffer(cmd, tiles_done_state.buffer, 0, tiles_done_state.size, 0);
     detail::count_recorded_command();
-    tile_done_cleared = true;
+    tiles_done_cleared = true;
   }
   uint32_t gx, gy;
   compact.grid(count, gx, gy);
-  // 1. Test: masks, counters, states; the last workgroup of each tile scans the tile.
+  // 1. Test: masks, counts, states.
   if (images) {
     b.use(*depth, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, kCompute, kSampled);
     b.use(hiz->image(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, kCompute, kSampled, std::max(1u, hiz->levels()));
@@ -371,15 +365,8 @@ void ObjectCuller::Impl::run(VkCommandBuffer cmd, HiZPyramid* hiz, Image* depth,
   b.use(in.objects, kCompute, kRead);
   b.use(in.visibility, kCompute, images ? (kRead | kWrite) : kRead);
   b.use(groups_state, kCompute, kRead | kWrite);
-  b.use(tile_done_state, kCompute, kRead | kWrite);
-  if (!v1) {
-    b.use(out.indirect, kCompute, kWrite);
-    b.use(out.stats, kCompute, kWrite);
-  }
   b.flush(cmd);
-  // The current kernel also runs for no objects: one workgroup writes the (empty) arguments and
-  // statistics.
-  if (count > 0 || !v1) {
+  if (count > 0) {
     push.count = count;
     push.flags = mode | (config.reversed_z ? GLINT_OBJECT_REVERSED_Z : 0u);
     push.groups_x = gx;
@@ -401,17 +388,15 @@ void ObjectCuller::Impl::run(VkCommandBuffer cmd, HiZPyramid* hiz, Image* depth,
   op.capacity = config.capacity;
   op.payload_words = config.payload_words;
   op.objects_per_group = config.objects_per_group;
-  op.clear_words = static_cast<uint32_t>(tile_done_state.size / 4);
+  op.clear_words = 1;  // the count of scanned tiles
   GlintCompactPush cp;
   static_assert(sizeof(cp) == sizeof(op));
   std::memcpy(&cp, &op, sizeof(cp));
-  // The previous kernel: 2. the scan (tiles, then slots, arguments, statistics; counters reset).
-  if (v1) {
-    compact.record_scan(cmd, b, cp, {&out.indirect, &out.stats});
-    if (profiler) profiler->mark(cmd, "object cull scan");
-  }
-  // 3. Scatter: payloads in object order; the tile counts zeroed for the next cull.
-  compact.record_scatter(cmd, b, cp, {&payloads}, {&out.list, &tile_done_state});
+  // 2. Scan, one dispatch: slots, arguments, statistics; counters reset.
+  compact.record_scan(cmd, b, cp, {&out.indirect, &out.stats, &tiles_done_state});
+  if (profiler) profiler->mark(cmd, "object cull scan");
+  // 3. Scatter: payloads in object order; the count of scanned tiles zeroed again.
+  compact.record_scatter(cmd, b, cp, {&payloads}, {&out.list, &tiles_done_state});
   if (profiler) profiler->mark(cmd, "object cull scatter");
 }
 
@@ -475,24 +460,23 @@ void object_cull_select_kernel(ObjectCuller& culler, ObjectCullKernel kernel) {
   }
   if (kernel == ObjectCullKernel::shared_atomics && !m.cull_atomic) {
     d.kernel_id = "object_cull_main";
-    d.bindings = {S, S, B, B, B, B, B, B};
-    d.specialization = {m.config.capacity, m.config.objects_per_group};
+    d.bindings = {S, S, B, B, B};
     m.cull_atomic = ComputePipeline(*m.context, d);
     d.kernel_id = "object_cull_phase1";
-    d.bindings = {B, B, B, B, B, B};
+    d.bindings = {B, B, B};
     m.phase1_atomic = ComputePipeline(*m.context, d);
   }
   m.kernel = kernel;
 }
 
-void object_cull_fill_tile_counts(ObjectCuller& culler, VkCommandBuffer cmd, uint32_t value) {
+void object_cull_fill_tiles_done(ObjectCuller& culler, VkCommandBuffer cmd, uint32_t value) {
   ObjectCuller::Impl& m = ObjectCullerAccess::impl(culler);
   Barriers b;
-  b.use(m.tile_done_state, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);
+  b.use(m.tiles_done_state, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);
   b.flush(cmd);
-  vkCmdFillBuffer(cmd, m.tile_done_state.buffer, 0, m.tile_done_state.size, value);
+  vkCmdFillBuffer(cmd, m.tiles_done_state.buffer, 0, 4, value);
   count_recorded_command();
-  m.tile_done_cleared = true;
+  m.tiles_done_cleared = true;
 }
 
 bool object_cull_has_subgroup_variant(const ObjectCuller& culler) { return ObjectCullerAccess::impl(culler).subgroup; }

@@ -57,10 +57,9 @@ uint compact_workgroup_scan(uint n, out uint total) {
 #ifndef COMPACT_GROUPS_READONLY
 // Level 1: workgroup k takes the tile of `threads` consecutive groups, invocation t group
 // k * threads + t (coalesced loads); writes each group's z and the tile total into its first
-// group's w. It also adds the groups' packed counts (z, from the test) to the header: one atomic
-// per tile and counter, where one per group and counter made many workgroups contend for the same
-// few words (atomics on one address are serialised).
-void compact_tile_scan(uint count) {
+// group's w. Returns the tile's count f of the groups' packed counts (z, from the test) in
+// invocation f < 4 (0 in the others).
+uint compact_tile_scan_counts(uint count) {
   const uint threads = gl_WorkGroupSize.x * gl_WorkGroupSize.y;
   const uint t = gl_LocalInvocationIndex;
   const uint group_count = (count + GLINT_COMPACT_GROUP - 1u) / GLINT_COMPACT_GROUP;
@@ -81,11 +80,19 @@ void compact_tile_scan(uint count) {
     if (c != 0u) atomicAdd(s_compact_counts[f][t & 31u], c);
   }
   barrier();
+  uint c = 0u;
   if (t < 4u) {
-    uint c = 0u;
     for (uint k = 0u; k < 32u; ++k) c += s_compact_counts[t][k];
-    if (c != 0u) atomicAdd(counters[1u + t], c);
   }
+  return c;
+}
+
+// Level 1 with the tile's counts added to the header: one atomic per tile and counter, where one
+// per group and counter made many workgroups contend for the same few words (atomics on one
+// address are serialised).
+void compact_tile_scan(uint count) {
+  const uint c = compact_tile_scan_counts(count);
+  if (c != 0u) atomicAdd(counters[1u + gl_LocalInvocationIndex], c);  // c != 0 only where t < 4
 }
 
 // Level 2, one workgroup: turns the tile totals into each tile's first slot, an exclusive prefix

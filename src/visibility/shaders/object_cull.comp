@@ -1,7 +1,6 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_samplerless_texture_functions : require
-#extension GL_EXT_control_flow_attributes : require
 #ifdef GLINT_OBJECT_SUBGROUP
 // The variants the host picks where the device's subgroups support arithmetic in compute
 // (VkPhysicalDeviceSubgroupProperties); the others count with shared atomics alone.
@@ -28,11 +27,10 @@
 //    pyramid, writes its state and emits the visible ones phase 1 did not. Emission is a bit in the
 //    workgroup's mask; the ordered compaction (compact.glsl) turns the masks into
 //    slots in object order, so the list is the same bits on every run.
-// 6. The compaction's scan, in this dispatch: the last workgroup of each tile to write its record
-//    (a per-tile count after a buffer memory barrier) scans the tile (scan_tile); the last
-//    workgroup to finish a tile scan (a count of scanned tiles, the same pattern one level up)
-//    scans the tile totals and writes the indirect arguments and statistics (finish_cull). Only the
-//    scatter (compact_scatter.comp) is a dispatch of its own: the cull is two dispatches.
+// 6. The scan of the masks is the next dispatch (object_cull_scan.comp), then the scatter
+//    (compact_scatter.comp). Folding the scan into this kernel (the last workgroup of each tile
+//    scans it, the last tile the tile totals) was measured slower on the H100 (docs/OCCLUSION.md,
+//    "Cost"): every workgroup then pays a device-scope barrier and an atomic before it retires.
 // GLINT_OBJECT_PHASE1 builds the phase-1 variant, which binds no image (the depth image may be a
 // render target while phase 1 runs).
 // Cost (docs/OCCLUSION.md, "Cost"): one wave of latency-bound invocations, so the kernel keeps
@@ -69,28 +67,11 @@ layout(std430, binding = BINDING_VISIBILITY) readonly buffer Visibility { uint v
 layout(std430, binding = BINDING_VISIBILITY) buffer Visibility { uint visibility[]; };
 #endif
 #define COMPACT_GROUPS_BINDING BINDING_GROUPS  // the compaction's group buffer: this writes the masks (x, y)
-// and, in the last workgroup of each tile, scans the tile (so the separate tile-scan dispatch is
-// not needed). Coherent: the last workgroup reads records other workgroups wrote in this dispatch.
-#define COMPACT_GROUPS_COHERENT
-#define COMPACT_NO_SCAN
+#define COMPACT_NO_SCAN                        // and the packed counts (z)
 #include "compact.glsl"
-// Per tile of the scan: the workgroups of the tile that have written their record; then one more
-// word: the tiles scanned. Zero between culls (zero-filled once; compact_scatter.comp zeroes them
-// after every cull).
-layout(std430, binding = BINDING_GROUPS + 1) coherent buffer TileDone { uint tile_done[]; };
-layout(std430, binding = BINDING_GROUPS + 2) writeonly buffer Indirect { GlintObjectCullIndirect indirect; };
-layout(std430, binding = BINDING_GROUPS + 3) writeonly buffer Stats { GlintObjectCullStats stats; };
 layout(push_constant) uniform Push { GlintObjectCullPush pc; };
-// ObjectCullConfig::capacity and ::objects_per_group (per culler; the push constants are full).
-layout(constant_id = 2) const uint kCapacity = 1u;
-layout(constant_id = 3) const uint kObjectsPerGroup = 1u;
-
 shared uint s_mask[2];
 shared uint s_counts;  // the group's counts, packed as compact_pack_counts packs them
-shared bool s_last;    // this workgroup is the last of its tile to write its record
-shared bool s_last_tile;  // ... and the last workgroup to finish a tile scan
-shared uint s_scan[2][GLINT_OBJECT_GROUP];
-shared uint s_tile_counts[4];
 
 const float kEps = float(GLINT_OBJECT_EPS);
 
@@ -292,117 +273,14 @@ uint test_object(vec4 w0, vec4 w1, bool frustum_only, out bool invalid, out vec4
   return GLINT_OBJECT_STATE_NONE;
 }
 
-// Inclusive prefix sum of `n` over the workgroup (Hillis & Steele 1986, ping-pong arrays); `total`
-// is the workgroup's. Every invocation calls it.
-uint workgroup_scan(uint n, out uint total) {
-  const uint lid = gl_LocalInvocationIndex;
-  s_scan[0][lid] = n;
-  barrier();
-  uint src = 0u;
-  for (uint d = 1u; d < GLINT_OBJECT_GROUP; d <<= 1u) {
-    uint v = s_scan[src][lid];
-    if (lid >= d) v += s_scan[src][lid - d];
-    s_scan[src ^ 1u][lid] = v;
-    barrier();
-    src ^= 1u;
-  }
-  total = s_scan[src][GLINT_OBJECT_GROUP - 1u];
-  const uint mine = s_scan[src][lid];
-  barrier();  // the arrays are rewritten by the next call
-  return mine;
-}
-
-// The first level of the ordered compaction's scan (compact.glsl, compact_tile_scan), run by the
-// last workgroup of a tile to write its record: for each of the tile's `n` groups from `first`,
-// the emitted objects of the tile before it (z, replacing the packed counts); the tile's total in
-// its first group's w; the packed counts added to the header, one atomic per tile and counter.
-// Invocation t takes a run of consecutive groups (ceil(n / 64) of them, at most kMaxRun for tiles
-// of GLINT_COMPACT_SCAN_MAX_THREADS groups); the runs' totals are scanned in shared memory. The
-// run's records are loaded in one unrolled pass, every load in flight at once, and its counts
-// kept in registers for the stores: the last tile's scan is on the critical path of the cull,
-// where a loop of dependent loads cost one round trip to memory per group of the run.
-const uint kMaxRun = GLINT_COMPACT_SCAN_MAX_THREADS / GLINT_OBJECT_GROUP;
-void scan_tile(uint first, uint n) {
-  const uint lid = gl_LocalInvocationIndex;
-  const uint per = (n + GLINT_OBJECT_GROUP - 1u) / GLINT_OBJECT_GROUP;  // <= kMaxRun
-  const uint g0 = first + lid * per, g1 = first + min(lid * per + per, n);
-  uint cnt[kMaxRun];
-  // The packed counts (bytes: frustum, occluded, visible, invalid) summed as two pairs of 16-bit
-  // lanes: at most kMaxRun * 64 = 1024 per lane, no carry between lanes.
-  uint lo = 0u, hi = 0u;
-  uint run = 0u;
-  [[unroll]] for (uint k = 0u; k < kMaxRun; ++k) {
-    cnt[k] = 0u;
-    if (g0 + k < g1) {
-      const uvec4 v = groups[g0 + k];
-      cnt[k] = uint(bitCount(v.x) + bitCount(v.y));
-      lo += v.z & 0x00ff00ffu;
-      hi += (v.z >> 8u) & 0x00ff00ffu;
-    }
-    run += cnt[k];
-  }
-  uint total;
-  uint before = workgroup_scan(run, total) - run;  // exclusive
-  [[unroll]] for (uint k = 0u; k < kMaxRun; ++k) {
-    if (g0 + k < g1) groups[g0 + k].z = before;
-    before += cnt[k];
-  }
-  if (lid == 0u) groups[first].w = total;
-  const uvec4 c = uvec4(lo & 0xffffu, hi & 0xffffu, lo >> 16u, hi >> 16u);
-  for (uint f = 0u; f < 4u; ++f) {
-    if (c[f] != 0u) atomicAdd(s_tile_counts[f], c[f]);
-  }
-  barrier();
-  if (lid < 4u && s_tile_counts[lid] != 0u) atomicAdd(counters[1u + lid], s_tile_counts[lid]);
-}
-
-// The top level of the scan, run by the last workgroup to finish a tile scan (every tile total is
-// written): each tile's first slot (the exclusive prefix of the tile totals, 64 tiles at a time
-// with a carry), then the draw count clamped to the capacity, the dispatch arguments and the
-// statistics; the counters are zeroed for the next cull as they are read (the tile counts are
-// zeroed by the scatter, which runs after every cull).
-void finish_cull(uint tiles) {
-  const uint lid = gl_LocalInvocationIndex;
-  uint carry = 0u;  // emitted objects of the tiles before
-  for (uint base = 0u; base < tiles; base += GLINT_OBJECT_GROUP) {
-    const uint k = base + lid;
-    const uint n = k < tiles ? groups[k * pc.tile_groups].w : 0u;
-    uint total;
-    const uint sum = workgroup_scan(n, total);
-    if (k < tiles) groups[k * pc.tile_groups].w = carry + sum - n;
-    carry += total;
-  }
-  if (lid != 0u) return;
-  const uint written = min(carry, kCapacity);
-  indirect.draw_count = written;
-  indirect.group_count_x = (written + kObjectsPerGroup - 1u) / kObjectsPerGroup;
-  indirect.group_count_y = 1u;
-  indirect.group_count_z = 1u;
-  stats.total = pc.count;
-  stats.frustum_culled = atomicExchange(counters[GLINT_OBJECT_COUNTER_FRUSTUM], 0u);
-  stats.occluded = atomicExchange(counters[GLINT_OBJECT_COUNTER_OCCLUDED], 0u);
-  stats.visible = atomicExchange(counters[GLINT_OBJECT_COUNTER_VISIBLE], 0u);
-  stats.emitted = carry;
-  stats.written = written;
-  stats.overflow = carry - written;
-  stats.invalid = atomicExchange(counters[GLINT_OBJECT_COUNTER_INVALID], 0u);
-}
-
 void main() {
   const uint lid = gl_LocalInvocationIndex;  // < GLINT_OBJECT_GROUP: the bit of this object
   if (lid == 0u) {
     s_mask[0] = 0u;
     s_mask[1] = 0u;
     s_counts = 0u;
-    s_last = false;
-    s_last_tile = false;
   }
-  if (lid < 4u) s_tile_counts[lid] = 0u;
   barrier();
-  if (pc.count == 0u) {  // one workgroup: the empty list's arguments and statistics
-    finish_cull(0u);
-    return;
-  }
   const uint group = gl_WorkGroupID.y * pc.groups_x + gl_WorkGroupID.x;
   const uint group_count = (pc.count + GLINT_OBJECT_GROUP - 1u) / GLINT_OBJECT_GROUP;
   const uint i = group * GLINT_OBJECT_GROUP + lid;
@@ -451,30 +329,5 @@ void main() {
   if (packed != 0u) atomicAdd(s_counts, packed);
 #endif
   barrier();
-  const uint tile = group / pc.tile_groups, first = tile * pc.tile_groups;
-  const uint tile_size = group < group_count ? min(pc.tile_groups, group_count - first) : 0u;
-  if (lid == 0u && group < group_count) {  // the counts go to the header through the tile scan
-    groups[group] = uvec4(s_mask[0], s_mask[1], s_counts, 0u);
-    // The record, then the count that announces it (the "last block" pattern: the workgroup that
-    // brings the count to the tile's size sees every record of the tile).
-    memoryBarrierBuffer();
-    s_last = atomicAdd(tile_done[tile], 1u) == tile_size - 1u;
-  }
-  barrier();
-  if (!s_last) return;  // uniform in the workgroup
-  memoryBarrierBuffer();
-  scan_tile(first, tile_size);
-  // The tile's slots and total, then the count of scanned tiles that announces them (the same
-  // "last block" pattern; scan_tile's atomics on the counters come before it too).
-  const uint tiles = (group_count + pc.tile_groups - 1u) / pc.tile_groups;
-  memoryBarrierBuffer();  // every invocation's slot writes, before the count
-  barrier();
-  if (lid == 0u) {
-    memoryBarrierBuffer();
-    s_last_tile = atomicAdd(tile_done[tiles], 1u) == tiles - 1u;
-  }
-  barrier();
-  if (!s_last_tile) return;  // uniform in the workgroup
-  memoryBarrierBuffer();
-  finish_cull(tiles);
+  if (lid == 0u && group < group_count) groups[group] = uvec4(s_mask[0], s_mask[1], s_counts, 0u);
 }
