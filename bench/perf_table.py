@@ -11,6 +11,16 @@ glint / copy, the best peer's median and peer / glint, and the target. Medians c
         --peer object_cull=object_cull_torch.json
 
 Peer files are those bench/peers/*.py write; a missing peer leaves its column blank.
+
+CPU devices (lavapipe) take some rows at a smaller size (CPU_SIZES: a row whose run would take
+minutes per repetition there); --cpu selects that row set, and the label names the size run.
+--filter prints the --benchmark_filter for the rows and their copies, nothing else:
+
+    glint_bench --benchmark_filter="$(python3 bench/perf_table.py --filter --cpu)" ...
+    python3 bench/perf_table.py --cpu --commit abc1234 --glint lavapipe.json
+
+A row whose benchmark is not in the run is listed under the table, with the benchmark's error
+where it reported one (e.g. a buffer above the device's maxStorageBufferRange).
 """
 import argparse
 import json
@@ -33,7 +43,7 @@ ROWS = [
     ("Gaussian sigma 4, 3840x2160, pyramid", "BM_BlurPyramid/sigma10:40/w:3840/h:2160", "3840x2160", None, 120),
     ("Gaussian sigma 4, 3840x2160, auto", "BM_BlurAuto/sigma10:40/w:3840/h:2160", "3840x2160", None, 120),
     ("Hi-Z 3840x2160 D32, all levels", "BM_HiZBuild/w:3840/h:2160", None, "hiz:3840x2160", 20),
-    ("cull + 4x4 occlusion + ordered compaction, 1 M lights", "BM_LightCull/n:1000000/grid:4/results:0/hiz:0",
+    ("cull + 4x4 occlusion + ordered compaction, 1 M lights", "BM_LightCull/n:1000000/grid:4/results:0/hiz:0/pattern:0",
      None, "compaction:1000000", 60),
     ("10 lights end to end 1080p, compute", "BM_FlareEndToEnd/lights:10/compute:1", None, None, 30),
     ("10 lights end to end 1080p, raster", "BM_FlareEndToEnd/lights:10/compute:0", None, None, 30),
@@ -45,13 +55,49 @@ ROWS = [
     ("object cull, 10 M objects", "BM_ObjectCull/objects:10000000", None, "object_cull:10000000", None),
 ]
 
+# --cpu: benchmark of a row -> the size run instead on CPU devices. The separable blur that `auto`
+# resolves to at sigma 64 (2 x 513 taps) takes about a minute per 3840x2160 frame on lavapipe (9
+# frames for 3 repetitions); 960x540 is the size bench/blur_bench.cpp registers for CPU devices.
+CPU_SIZES = {
+    "BM_BlurAuto/sigma10:640/w:3840/h:2160": "960x540",
+}
+# Sizes BM_CopyFloor is registered at (bench/copy_bench.cpp).
+COPY_SIZES = ("640x480", "1920x1080", "3840x2160", "7680x4320")
+
+
+def sized_rows(cpu):
+    """ROWS with CPU_SIZES applied when cpu: the benchmark name, label and copy size say the size run."""
+    out = []
+    for label, name, floor, peer, target in ROWS:
+        size = CPU_SIZES.get(name) if cpu else None
+        if size:
+            w, h = size.split("x")
+            old = re.search(r"w:(\d+)/h:(\d+)", name).groups()
+            name = re.sub(r"w:\d+/h:\d+", f"w:{w}/h:{h}", name)
+            label = label.replace("x".join(old), f"{size} (GPU row: {'x'.join(old)})")
+            floor = size if floor else None
+        out.append((label, name, floor, peer, target))
+    return out
+
+
+def benchmark_filter(rows):
+    """A --benchmark_filter regex matching exactly the rows' benchmarks and their copies."""
+    names = [name for _, name, _, _, _ in rows]
+    names += sorted({f"BM_CopyFloor/w:{f.split('x')[0]}/h:{f.split('x')[1]}" for _, _, f, _, _ in rows
+                     if f and f in COPY_SIZES})
+    return "|".join("^" + re.escape(n).replace("\\/", "/") + "/" for n in names)
+
 
 def glint_medians(path):
-    """name (no /manual_time, no aggregate suffix) -> median time in us, and the context."""
+    """name (no /manual_time, no aggregate suffix) -> median time in us, the context, and
+    name -> error message of the benchmarks that reported one."""
     data = json.load(open(path))
-    out, single = {}, {}
+    out, single, errors = {}, {}, {}
     for b in data["benchmarks"]:
         name = re.sub(r"/manual_time.*$", "", b["run_name"] if "run_name" in b else b["name"])
+        if b.get("error_occurred"):
+            errors[name] = b.get("error_message", "error")
+            continue
         scale = {"ns": 1e-3, "us": 1.0, "ms": 1e3, "s": 1e6}[b.get("time_unit", "ns")]
         t = b.get("median_us", b["real_time"] * scale) if b.get("aggregate_name") != "median" else \
             b["real_time"] * scale
@@ -61,7 +107,7 @@ def glint_medians(path):
             single.setdefault(name, t)
     for k, v in single.items():
         out.setdefault(k, v)
-    return out, data.get("context", {})
+    return out, data.get("context", {}), errors
 
 
 def peer_medians(specs):
@@ -95,17 +141,27 @@ def peer_medians(specs):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--glint", required=True, help="glint_bench JSON")
+    ap.add_argument("--glint", help="glint_bench JSON")
     ap.add_argument("--peer", action="append", default=[], help="KIND=FILE, KIND one of bloom, blur, occlusion, "
                     "object_cull")
-    ap.add_argument("--commit", required=True)
+    ap.add_argument("--commit")
+    ap.add_argument("--cpu", action="store_true", help="the CPU-device row set (CPU_SIZES)")
+    ap.add_argument("--filter", action="store_true", help="print the rows' --benchmark_filter and exit")
     args = ap.parse_args()
-    g, ctx = glint_medians(args.glint)
+    rows = sized_rows(args.cpu)
+    if args.filter:
+        print(benchmark_filter(rows))
+        return
+    if not args.glint or not args.commit:
+        ap.error("--glint and --commit are required (or --filter)")
+    g, ctx, errors = glint_medians(args.glint)
     peers = peer_medians(args.peer)
     print("| job | glint median | copy of the same image | glint / copy | best peer | peer / glint | target | met |")
     print("| --- | ---: | ---: | ---: | --- | ---: | ---: | --- |")
-    for label, name, floor, peer, target in ROWS:
+    missing = []
+    for label, name, floor, peer, target in rows:
         if name not in g:
+            missing.append((label, name))
             continue
         t = g[name]
         f = g.get(f"BM_CopyFloor/w:{floor.split('x')[0]}/h:{floor.split('x')[1]}") if floor else None
@@ -115,6 +171,12 @@ def main():
                  f"{target} us" if target else "", ("yes" if t <= target else "no") if target else ""]
         print("| " + " | ".join(cells) + " |")
     print(f"\nglint at {args.commit}; {ctx.get('date', '')}")
+    for label, name, floor, _, _ in rows:
+        if name in g and floor and floor not in COPY_SIZES:
+            print(f"- {label}: no BM_CopyFloor at {floor} (registered: {', '.join(COPY_SIZES)})")
+    for label, name in missing:
+        why = f"error: {errors[name]}" if name in errors else "not in this run"
+        print(f"- {label} (`{name}`): {why}")
 
 
 if __name__ == "__main__":
