@@ -1,9 +1,10 @@
 #!/usr/bin/env python3
-"""The speed table of docs/PERF.md, from one glint_bench JSON and the peers' JSON of the same run.
+r"""The speed table of docs/PERF.md, from one glint_bench JSON and the peers' JSON of the same run.
 
 Each row is one job of the speed targets: glint's median GPU time, the time of a copy of the same
 image measured in the same run (BM_CopyFloor; a blank where the job has no image of that size),
-glint / copy, the best peer's median and peer / glint, and the target. Medians come from
+glint / copy, the best peer's median and peer / glint, the glint commit and the target (the H100's;
+with --cpu the cell says so and "met" stays blank). Times of 10 ms or more print in ms. Medians come from
 --benchmark_repetitions aggregates when present, single runs otherwise.
 
     python3 bench/perf_table.py --commit abc1234 --glint h100.json \
@@ -56,8 +57,9 @@ ROWS = [
 ]
 
 # --cpu: benchmark of a row -> the size run instead on CPU devices. The separable blur that `auto`
-# resolves to at sigma 64 (2 x 513 taps) takes about a minute per 3840x2160 frame on lavapipe (9
-# frames for 3 repetitions); 960x540 is the size bench/blur_bench.cpp registers for CPU devices.
+# resolves to at sigma 64 (2 x 513 taps) took 2.4 s per 960x540 frame on lavapipe (2 cores), so
+# about 40 s per 3840x2160 frame and 6 minutes for the 9 frames of 3 repetitions; 960x540 is the
+# size bench/blur_bench.cpp registers for CPU devices.
 CPU_SIZES = {
     "BM_BlurAuto/sigma10:640/w:3840/h:2160": "960x540",
 }
