@@ -172,6 +172,7 @@ struct ObjectCuller::Impl {
   const Context* context = nullptr;
   ObjectCullConfig config;
   uint64_t max_range = 1u << 27;  // the device's maxStorageBufferRange
+  uint32_t max_groups_x = 65535;  // the device's maxComputeWorkGroupCount[0]
   // The test kernel of each mode: cull (single phase and phase 2) and phase1, the subgroup variants
   // where the device supports them; cull_atomic / phase1_atomic count with shared atomics alone.
   detail::ComputePipeline cull, phase1, cull_atomic, phase1_atomic;
@@ -179,6 +180,10 @@ struct ObjectCuller::Impl {
   // detail::object_cull_select_kernel (benchmarks time it against `cull`).
   detail::ComputePipeline cull_v1;
   bool subgroup = false;
+  // Invocations per workgroup of object_cull.comp: 256 (four groups of 64 objects, sorted by kind
+  // for the test) where the device allows, else the largest multiple of 64 it does (Vulkan
+  // guarantees 128). The previous kernel keeps one group per workgroup.
+  uint32_t test_threads = kGroup;
   detail::ObjectCullKernel kernel = detail::ObjectCullKernel::current;
   // The ordered compaction of the emitted objects (core/compaction.h): its group buffer holds the
   // test's masks and counters; object_cull_scan.comp finishes the scan, compact_scatter.comp
@@ -270,12 +275,15 @@ ObjectCuller::ObjectCuller(const Context& context, const ObjectCullConfig& confi
                        " bytes exceeds the device's maxStorageBufferRange = ", m.max_range));
   }
   const uint64_t groups = (uint64_t(config.max_objects) + kGroup - 1) / kGroup;
-  const uint32_t max_groups_x = props.limits.maxComputeWorkGroupCount[0];
-  if ((groups + max_groups_x - 1) / max_groups_x > props.limits.maxComputeWorkGroupCount[1]) {
+  m.max_groups_x = props.limits.maxComputeWorkGroupCount[0];
+  if ((groups + m.max_groups_x - 1) / m.max_groups_x > props.limits.maxComputeWorkGroupCount[1]) {
     throw Error(ErrorCode::invalid_argument,
                 concat("ObjectCullConfig::max_objects = ", config.max_objects,
                        " needs more workgroups than the device's maxComputeWorkGroupCount allows"));
   }
+  m.test_threads =
+      std::min({256u, props.limits.maxComputeWorkGroupInvocations, props.limits.maxComputeWorkGroupSize[0]}) / kGroup *
+      kGroup;
   const auto S = VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE;
   const auto B = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
   detail::PipelineDesc d;
@@ -290,7 +298,7 @@ ObjectCuller::ObjectCuller(const Context& context, const ObjectCullConfig& confi
   d.kernel_id = m.subgroup ? "object_cull_main_subgroup" : "object_cull_main";
   d.bindings = {S, S, B, B, B};
   d.push_constant_bytes = sizeof(GlintObjectCullPush);
-  d.workgroup = {kGroup, 1};
+  d.workgroup = {m.test_threads, 1};
   m.cull = detail::ComputePipeline(context, d);
   d.kernel_id = m.subgroup ? "object_cull_phase1_subgroup" : "object_cull_phase1";
   d.bindings = {B, B, B};
@@ -355,8 +363,11 @@ void ObjectCuller::Impl::run(VkCommandBuffer cmd, HiZPyramid* hiz, Image* depth,
     detail::count_recorded_command();
     tiles_done_cleared = true;
   }
-  uint32_t gx, gy;
-  compact.grid(count, gx, gy);
+  // The test's workgroups (test_threads objects each; the previous kernel's one group each) as a 2D
+  // grid of at most maxComputeWorkGroupCount[0] per row.
+  const uint32_t threads = v1 ? kGroup : test_threads;
+  const uint32_t workgroups = std::max(1u, (count + threads - 1) / threads);
+  const uint32_t gx = std::min(workgroups, max_groups_x), gy = (workgroups + gx - 1) / gx;
   // 1. Test: masks, counts, states.
   if (images) {
     b.use(*depth, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, kCompute, kSampled);
@@ -380,7 +391,7 @@ void ObjectCuller::Impl::run(VkCommandBuffer cmd, HiZPyramid* hiz, Image* depth,
                                                    : v1     ? cull_v1
                                                    : atomic ? cull_atomic
                                                             : cull;
-    test_pipeline.dispatch(cmd, test, push, gx * kGroup, gy);
+    test_pipeline.dispatch(cmd, test, push, gx * threads, gy);
   }
   if (profiler) profiler->mark(cmd, "object cull");
   GlintObjectCompactPush op{};
@@ -458,6 +469,7 @@ void object_cull_select_kernel(ObjectCuller& culler, ObjectCullKernel kernel) {
     d.bindings = {S, S, B, B, B};
     m.cull_v1 = ComputePipeline(*m.context, d);
   }
+  d.workgroup = {m.test_threads, 1};
   if (kernel == ObjectCullKernel::shared_atomics && !m.cull_atomic) {
     d.kernel_id = "object_cull_main";
     d.bindings = {S, S, B, B, B};

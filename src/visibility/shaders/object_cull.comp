@@ -70,8 +70,21 @@ layout(std430, binding = BINDING_VISIBILITY) buffer Visibility { uint visibility
 #define COMPACT_NO_SCAN                        // and the packed counts (z)
 #include "compact.glsl"
 layout(push_constant) uniform Push { GlintObjectCullPush pc; };
-shared uint s_mask[2];
-shared uint s_counts;  // the group's counts, packed as compact_pack_counts packs them
+
+// A workgroup is kGroups groups of 64 objects (the host picks 256 invocations where the device
+// allows, else fewer, a multiple of 64).
+const uint kThreads = gl_WorkGroupSize.x;
+const uint kGroups = (kThreads + GLINT_OBJECT_GROUP - 1u) / GLINT_OBJECT_GROUP;  // kThreads is a multiple of 64
+const uint kNotTested = 0x80000000u;
+// The workgroup's objects sorted by kind for the test (main, step 1), the local index of the
+// object in each slot (kNotTested: beyond the count, or not tested in phase 1), and each object's
+// result by local index: state | invalid << 2.
+shared vec4 s_obj[2][kThreads];
+shared uint s_who[kThreads];
+shared uint s_state[kThreads];
+shared uint s_ends[2];  // slots taken: spheres from the front, boxes from the back
+shared uint s_mask[2 * kGroups];
+shared uint s_counts[kGroups];  // each group's counts, packed as compact_pack_counts packs them
 
 const float kEps = float(GLINT_OBJECT_EPS);
 
@@ -274,60 +287,93 @@ uint test_object(vec4 w0, vec4 w1, bool frustum_only, out bool invalid, out vec4
 }
 
 void main() {
-  const uint lid = gl_LocalInvocationIndex;  // < GLINT_OBJECT_GROUP: the bit of this object
-  if (lid == 0u) {
-    s_mask[0] = 0u;
-    s_mask[1] = 0u;
-    s_counts = 0u;
-  }
+  const uint lid = gl_LocalInvocationIndex;  // < kThreads: the object's place in the workgroup
+  if (lid < 2u * kGroups) s_mask[lid] = 0u;
+  if (lid < kGroups) s_counts[lid] = 0u;
+  if (lid < 2u) s_ends[lid] = 0u;
   barrier();
-  const uint group = gl_WorkGroupID.y * pc.groups_x + gl_WorkGroupID.x;
+  const uint wg = gl_WorkGroupID.y * pc.groups_x + gl_WorkGroupID.x;
   const uint group_count = (pc.count + GLINT_OBJECT_GROUP - 1u) / GLINT_OBJECT_GROUP;
-  const uint i = group * GLINT_OBJECT_GROUP + lid;
+  const uint i = wg * kThreads + lid;
   const uint mode = pc.flags & GLINT_OBJECT_MODE_MASK;
-  uint state = GLINT_OBJECT_STATE_NONE;
-  bool emit = false, invalid = false;
-  if (group < group_count && i < pc.count) {
-    const uint history = mode == GLINT_OBJECT_MODE_SINGLE ? GLINT_OBJECT_STATE_NONE : visibility[i];
-    if (mode != GLINT_OBJECT_MODE_PHASE1 || history == GLINT_OBJECT_STATE_VISIBLE) {
+  // 1. Load (coalesced: invocation t, object t) and place the object by kind: spheres (and the
+  //    objects not tested) from the first slot up, boxes from the last slot down.
+  uint history = GLINT_OBJECT_STATE_NONE;
+  bool tested = false;
+  if (i < pc.count) {
+    history = mode == GLINT_OBJECT_MODE_SINGLE ? GLINT_OBJECT_STATE_NONE : visibility[i];
+    tested = mode != GLINT_OBJECT_MODE_PHASE1 || history == GLINT_OBJECT_STATE_VISIBLE;
+  }
+  vec4 w0 = vec4(0.0), w1 = vec4(0.0);
+  if (tested) {
+    w0 = object_words[2u * i];
+    w1 = object_words[2u * i + 1u];
+  }
+  const bool box = tested && floatBitsToUint(w1.w) == GLINT_OBJECT_BOX;
+  const uint slot = box ? kThreads - 1u - atomicAdd(s_ends[1], 1u) : atomicAdd(s_ends[0], 1u);
+  s_obj[0][slot] = w0;
+  s_obj[1][slot] = w1;
+  s_who[slot] = lid | (tested ? 0u : kNotTested);
+  barrier();
+  // 2. Test the object of slot `lid`: a subgroup runs one kind's code (one subgroup of the
+  //    workgroup at most holds both kinds).
+  {
+    const uint who = s_who[lid];
+    uint st = GLINT_OBJECT_STATE_NONE;
+    bool inv = false;
+    if ((who & kNotTested) == 0u) {
       vec4 rect;
       float z;
-      state = test_object(object_words[2u * i], object_words[2u * i + 1u], mode == GLINT_OBJECT_MODE_PHASE1, invalid,
-                          rect, z);
+      st = test_object(s_obj[0][lid], s_obj[1][lid], mode == GLINT_OBJECT_MODE_PHASE1, inv, rect, z);
 #ifndef GLINT_OBJECT_PHASE1
       // One Hi-Z test for both kinds of bound.
-      if (state == GLINT_OBJECT_STATE_NONE)
-        state = hiz_test(rect.xy, rect.zw, z, (pc.flags & GLINT_OBJECT_REVERSED_Z) != 0u);
-      visibility[i] = state;
+      if (st == GLINT_OBJECT_STATE_NONE) st = hiz_test(rect.xy, rect.zw, z, (pc.flags & GLINT_OBJECT_REVERSED_Z) != 0u);
 #endif
-      emit = state == GLINT_OBJECT_STATE_VISIBLE &&
-             (mode != GLINT_OBJECT_MODE_PHASE2 || history != GLINT_OBJECT_STATE_VISIBLE);
     }
+    s_state[who & ~kNotTested] = st | (inv ? 4u : 0u);
   }
-  // Counter 1 + f of the header is byte f of the packed word (compact_pack_counts): frustum,
-  // occluded, visible, invalid; each at most 64 per workgroup, so no byte carries into the next.
+  barrier();
+  // 3. In object order again: the state, the emission bit and the counts of object i.
+  const uint r = s_state[lid];
+  const uint state = r & 3u;
+  const bool invalid = (r & 4u) != 0u;
+  bool emit = false;
+  if (tested) {
+#ifndef GLINT_OBJECT_PHASE1
+    visibility[i] = state;
+#endif
+    emit = state == GLINT_OBJECT_STATE_VISIBLE &&
+           (mode != GLINT_OBJECT_MODE_PHASE2 || history != GLINT_OBJECT_STATE_VISIBLE);
+  }
+  // Counter 1 + f is byte f of the packed word (compact_pack_counts): frustum, occluded, visible,
+  // invalid; each at most 64 per group of 64 objects, so no byte carries into the next.
   uint packed = invalid ? (1u << 24u) : 0u;
   if (state != GLINT_OBJECT_STATE_NONE) {
     packed += 1u << (8u * (state == GLINT_OBJECT_STATE_FRUSTUM ? 0u : state == GLINT_OBJECT_STATE_OCCLUDED ? 1u : 2u));
   }
+  const uint word = lid >> 5u;  // the object's mask word: group word >> 1, half word & 1
 #ifdef GLINT_OBJECT_SUBGROUP
   // Reduced over the subgroup first (uniform control flow: every invocation gets here), then one
   // invocation per subgroup adds the subgroup's part: a few shared atomics per workgroup instead of
-  // two per invocation on the same words, which serialise. Integer OR and sums: the same bits
-  // whatever the subgroup size or the mapping of invocations to subgroups.
+  // two per invocation on the same words, which serialise. The loops run over the words and groups
+  // the subgroup's invocations touch (one of each for subgroups of 32 consecutive invocations).
+  // Integer OR and sums: the same bits whatever the subgroup size or the mapping of invocations
+  // to subgroups.
   const uint bit = emit ? 1u << (lid & 31u) : 0u;
-  const uint lo = subgroupOr(lid < 32u ? bit : 0u);
-  const uint hi = subgroupOr(lid < 32u ? 0u : bit);
-  const uint sum = subgroupAdd(packed);
-  if (subgroupElect()) {
-    if (lo != 0u) atomicOr(s_mask[0], lo);
-    if (hi != 0u) atomicOr(s_mask[1], hi);
-    if (sum != 0u) atomicAdd(s_counts, sum);
+  const uint w_lo = subgroupMin(word), w_hi = subgroupMax(word);
+  for (uint w = w_lo; w <= w_hi; ++w) {
+    const uint m = subgroupOr(word == w ? bit : 0u);
+    if (subgroupElect() && m != 0u) atomicOr(s_mask[w], m);
+  }
+  for (uint k = w_lo >> 1u; k <= (w_hi >> 1u); ++k) {
+    const uint c = subgroupAdd((word >> 1u) == k ? packed : 0u);
+    if (subgroupElect() && c != 0u) atomicAdd(s_counts[k], c);
   }
 #else
-  if (emit) atomicOr(s_mask[lid >> 5u], 1u << (lid & 31u));
-  if (packed != 0u) atomicAdd(s_counts, packed);
+  if (emit) atomicOr(s_mask[word], 1u << (lid & 31u));
+  if (packed != 0u) atomicAdd(s_counts[word >> 1u], packed);
 #endif
   barrier();
-  if (lid == 0u && group < group_count) groups[group] = uvec4(s_mask[0], s_mask[1], s_counts, 0u);
+  const uint g = wg * kGroups + lid;  // the group record invocation lid < kGroups writes
+  if (lid < kGroups && g < group_count) groups[g] = uvec4(s_mask[2u * lid], s_mask[2u * lid + 1u], s_counts[lid], 0u);
 }
