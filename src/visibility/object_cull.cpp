@@ -293,7 +293,8 @@ ObjectCuller::ObjectCuller(const Context& context, const ObjectCullConfig& confi
   VkPhysicalDeviceProperties2 props2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
   props2.pNext = &sub;
   vkGetPhysicalDeviceProperties2(context.physical_device(), &props2);
-  const VkSubgroupFeatureFlags need = VK_SUBGROUP_FEATURE_BASIC_BIT | VK_SUBGROUP_FEATURE_ARITHMETIC_BIT;
+  const VkSubgroupFeatureFlags need =
+      VK_SUBGROUP_FEATURE_BASIC_BIT | VK_SUBGROUP_FEATURE_ARITHMETIC_BIT | VK_SUBGROUP_FEATURE_BALLOT_BIT;
   m.subgroup = (sub.supportedStages & VK_SHADER_STAGE_COMPUTE_BIT) != 0 && (sub.supportedOperations & need) == need;
   d.kernel_id = m.subgroup ? "object_cull_main_subgroup" : "object_cull_main";
   d.bindings = {S, S, B, B, B};

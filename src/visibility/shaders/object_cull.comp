@@ -1,11 +1,13 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_samplerless_texture_functions : require
+#extension GL_EXT_control_flow_attributes : require
 #ifdef GLINT_OBJECT_SUBGROUP
-// The variants the host picks where the device's subgroups support arithmetic in compute
+// The variants the host picks where the device's subgroups support arithmetic and ballots in compute
 // (VkPhysicalDeviceSubgroupProperties); the others count with shared atomics alone.
 #extension GL_KHR_shader_subgroup_basic : require
 #extension GL_KHR_shader_subgroup_arithmetic : require
+#extension GL_KHR_shader_subgroup_ballot : require
 #endif
 // Frustum and Hi-Z occlusion test of caller objects (world-space spheres or boxes), the first of
 // the three dispatches of the object cull (include/glint/object_cull.h, docs/OCCLUSION.md "Object
@@ -117,6 +119,19 @@ vec2 plane_margin(float c, float w, float r, float s, float o, vec2 len) {
   const vec2 nx = vec2(s, -s), nw = vec2(1.0 + o, 1.0 - o);
   const vec2 d = nx * c + nw * w;
   return d + len * r * (1.0 + kEps) + kEps * (abs(nx * c) + abs(nw * w));
+}
+
+// plane_margin's two planes of one axis, largest over the corners of a box given as its centre
+// `c` = (c, w) and half axes e0, e1, e2 (each a (c, w) change): the centre's margin plus the sum of
+// |margin change| along the half axes (a linear function's largest value over a box), widened by
+// the corners' error r and by the rounding of the evaluation (kEps times its terms' absolute
+// values, which bound every corner's: |c_j| <= |c| + sum |e_k.x|, likewise w).
+vec2 box_margin(vec2 c, vec2 e0, vec2 e1, vec2 e2, float r, float s, float o, vec2 len) {
+  const vec2 nx = vec2(s, -s), nw = vec2(1.0 + o, 1.0 - o);
+  const vec2 d = nx * c.x + nw * c.y;
+  const vec2 spread = abs(nx * e0.x + nw * e0.y) + abs(nx * e1.x + nw * e1.y) + abs(nx * e2.x + nw * e2.y);
+  const float tc = abs(c.x) + abs(e0.x) + abs(e1.x) + abs(e2.x), tw = abs(c.y) + abs(e0.y) + abs(e1.y) + abs(e2.y);
+  return d + spread + len * r * (1.0 + kEps) + kEps * (abs(nx) * tc + abs(nw) * tw);
 }
 
 // The slopes c / w of the two lines through the eye tangent to the disc of centre (c, w) and
@@ -239,43 +254,53 @@ uint test_object(vec4 w0, vec4 w1, bool frustum_only, out bool invalid, out vec4
       invalid = true;
       return GLINT_OBJECT_STATE_VISIBLE;
     }
-    // The corners' error bound: the largest terms of any corner.
+    // The corners' error bound: the largest terms of any corner (to_view of the largest absolute
+    // coordinates). Below 1e32, every sum of those terms is far from overflow (r is 2^-18 of it), so
+    // no corner coordinate below is checked for Inf; a NaN r fails the comparison.
     float r;
     to_view(max(abs(a), abs(b)), r);
-    float w_min = 3.4028235e38, w_max = -3.4028235e38;
-    // Max over corners of the four side-plane margins less their corner-independent term
-    // len * r * (1 + kEps) (plane_margin), which is added once after the loop: max(d_j + C) =
-    // max(d_j) + C.
-    vec4 side = vec4(-3.4028235e38);
-    bool finite = true;
-    // The corners' slope intervals, in the same pass (no array of corners is kept; used only
-    // when the box is in front of the near plane, where w - r > 0). Each slope is widened by its
-    // point error r (|d(c / w)| <= r (1 + |c / w|) / (w - r)) and the rounding of the reciprocal
-    // and products (a few units in the last place of |m|, within kEps |m|).
-    vec2 sx = vec2(3.4028235e38, -3.4028235e38), sy = sx;
-    for (int j = 0; j < 8; ++j) {
-      float unused;
-      const vec3 v = to_view(vec3((j & 1) != 0 ? b.x : a.x, (j & 2) != 0 ? b.y : a.y, (j & 4) != 0 ? b.z : a.z), unused);
-      finite = finite && finite3(v);  // checked after the loop (no exit from inside it)
-      w_min = min(w_min, v.z);
-      w_max = max(w_max, v.z);
-      side = max(side, vec4(plane_margin(v.x, v.z, 0.0, pc.proj_x, pc.proj_ox, len_x),
-                            plane_margin(v.y, v.z, 0.0, pc.proj_y, pc.proj_oy, len_y)));
-#ifndef GLINT_OBJECT_PHASE1
-      const vec2 m = v.xy * (1.0 / v.z);
-      const vec2 e = (r * (1.0 / (v.z - r))) * (1.0 + abs(m)) + kEps * abs(m);
-      sx = vec2(min(sx.x, m.x - e.x), max(sx.y, m.x + e.x));
-      sy = vec2(min(sy.x, m.y - e.y), max(sy.y, m.y + e.y));
-#endif
-    }
-    if (!finite || !finite_f(r)) return GLINT_OBJECT_STATE_VISIBLE;
-    side += vec4(len_x, len_y) * (r * (1.0 + kEps));
+    if (!(r < 1e32)) return GLINT_OBJECT_STATE_VISIBLE;  // overflow possible: conservative
+    // The box as its centre and three half axes in view space (x, y, w): corner j is
+    // c + (+-e0) + (+-e1) + (+-e2). The centre's and half extents' roundings and the sums' are a
+    // few units in the last place of the terms r bounds (64 of them): each computed corner is within
+    // r of the exact one, as the eight transformed corners were.
+    const vec3 mid = (a + b) * 0.5, half_ext = (b - a) * 0.5;
+    float unused;
+    const vec3 c = to_view(mid, unused);
+    const vec3 e0 = vec3(pc.view_x[0], pc.view_y[0], pc.view_w[0]) * half_ext.x;
+    const vec3 e1 = vec3(pc.view_x[1], pc.view_y[1], pc.view_w[1]) * half_ext.y;
+    const vec3 e2 = vec3(pc.view_x[2], pc.view_y[2], pc.view_w[2]) * half_ext.z;
+    // w over the corners: the centre's w plus or minus the sum of the half axes' |w| (the extremes
+    // of a linear function over a box), each side moved by r.
+    const float w_spread = abs(e0.z) + abs(e1.z) + abs(e2.z);
+    const float w_min = c.z - w_spread, w_max = c.z + w_spread;
     if (w_min - r > far_hi || w_max + r < near_lo) return GLINT_OBJECT_STATE_FRUSTUM;
-    if (min(min(side.x, side.y), min(side.z, side.w)) < 0.0) return GLINT_OBJECT_STATE_FRUSTUM;
+    // The side planes: all corners outside one plane when its largest margin is negative.
+    const vec2 mx = box_margin(c.xz, e0.xz, e1.xz, e2.xz, r, pc.proj_x, pc.proj_ox, len_x);
+    const vec2 my = box_margin(c.yz, e0.yz, e1.yz, e2.yz, r, pc.proj_y, pc.proj_oy, len_y);
+    if (min(min(mx.x, mx.y), min(my.x, my.y)) < 0.0) return GLINT_OBJECT_STATE_FRUSTUM;
     if (frustum_only || w_min - r < near_hi) return GLINT_OBJECT_STATE_VISIBLE;
 #ifndef GLINT_OBJECT_PHASE1
-    rect.xy = slopes_to_ndc(sx, pc.proj_x, pc.proj_ox);
-    rect.zw = slopes_to_ndc(sy, pc.proj_y, pc.proj_oy);
+    // The corners' slopes x / w and y / w (in front of the near plane, where every w > r > 0 up to
+    // rounding), only for a box that reaches the Hi-Z test. The widening of each slope by its point
+    // error r, |d(c / w)| <= r (1 + |c / w|) / (w - r), and the rounding of the reciprocal and
+    // product (within kEps |m|) is applied once to the interval: it grows with |m| and 1 / (w - r),
+    // so the interval's largest |m| and the smallest corner w bound every corner's.
+    vec2 sx = vec2(3.4028235e38, -3.4028235e38), sy = sx;
+    float w_lo = 3.4028235e38;
+    [[unroll]] for (int j = 0; j < 8; ++j) {
+      const vec3 v = c + ((j & 1) != 0 ? e0 : -e0) + ((j & 2) != 0 ? e1 : -e1) + ((j & 4) != 0 ? e2 : -e2);
+      const vec2 m = v.xy * (1.0 / v.z);
+      sx = vec2(min(sx.x, m.x), max(sx.y, m.x));
+      sy = vec2(min(sy.x, m.y), max(sy.y, m.y));
+      w_lo = min(w_lo, v.z);
+    }
+    if (!(w_lo - r > 0.0)) return GLINT_OBJECT_STATE_VISIBLE;  // rounding at the near plane: conservative
+    const float k = r * (1.0 / (w_lo - r));
+    const float ax = max(abs(sx.x), abs(sx.y)), ay = max(abs(sy.x), abs(sy.y));
+    const float ex = k * (1.0 + ax) + kEps * ax, ey = k * (1.0 + ay) + kEps * ay;
+    rect.xy = slopes_to_ndc(sx + vec2(-ex, ex), pc.proj_x, pc.proj_ox);
+    rect.zw = slopes_to_ndc(sy + vec2(-ey, ey), pc.proj_y, pc.proj_oy);
 #endif
     w_near = w_min - r;
   } else {
@@ -310,31 +335,58 @@ void main() {
     w1 = object_words[2u * i + 1u];
   }
   const bool box = tested && floatBitsToUint(w1.w) == GLINT_OBJECT_BOX;
-  const uint slot = box ? kThreads - 1u - atomicAdd(s_ends[1], 1u) : atomicAdd(s_ends[0], 1u);
-  s_obj[0][slot] = w0;
-  s_obj[1][slot] = w1;
-  s_who[slot] = lid | (tested ? 0u : kNotTested);
-  barrier();
-  // 2. Test the object of slot `lid`: a subgroup runs one kind's code (one subgroup of the
-  //    workgroup at most holds both kinds).
-  {
-    const uint who = s_who[lid];
-    uint st = GLINT_OBJECT_STATE_NONE;
-    bool inv = false;
-    if ((who & kNotTested) == 0u) {
-      vec4 rect;
-      float z;
-      st = test_object(s_obj[0][lid], s_obj[1][lid], mode == GLINT_OBJECT_MODE_PHASE1, inv, rect, z);
-#ifndef GLINT_OBJECT_PHASE1
-      // One Hi-Z test for both kinds of bound.
-      if (st == GLINT_OBJECT_STATE_NONE) st = hiz_test(rect.xy, rect.zw, z, (pc.flags & GLINT_OBJECT_REVERSED_Z) != 0u);
-#endif
-    }
-    s_state[who & ~kNotTested] = st | (inv ? 4u : 0u);
+  // The slot of the object once sorted: a rank among the workgroup's objects of its kind.
+#ifdef GLINT_OBJECT_SUBGROUP
+  // One shared atomic per subgroup and kind (per invocation, the invocations of a subgroup
+  // contended for the same two words); ranks within the subgroup from the ballot.
+  const uvec4 boxes = subgroupBallot(box), others = subgroupBallot(!box);
+  uint base_s = 0u, base_b = 0u;
+  if (subgroupElect()) {
+    base_s = atomicAdd(s_ends[0], subgroupBallotBitCount(others));
+    base_b = atomicAdd(s_ends[1], subgroupBallotBitCount(boxes));
   }
+  base_s = subgroupBroadcastFirst(base_s);
+  base_b = subgroupBroadcastFirst(base_b);
+  const uint rank = box ? base_b + subgroupBallotExclusiveBitCount(boxes) : base_s + subgroupBallotExclusiveBitCount(others);
+#else
+  const uint rank = atomicAdd(s_ends[box ? 1 : 0], 1u);
+#endif
+  const uint slot = box ? kThreads - 1u - rank : rank;
   barrier();
+  // A workgroup of one kind (a scene of spheres only, say) tests its objects where they are; a
+  // mixed one sorts them through shared memory first (uniform in the workgroup: the barriers
+  // below are reached by all or none).
+  const bool mixed = s_ends[0] != 0u && s_ends[1] != 0u;
+  vec4 a0 = w0, a1 = w1;
+  uint who = lid | (tested ? 0u : kNotTested);
+  if (mixed) {
+    s_obj[0][slot] = w0;
+    s_obj[1][slot] = w1;
+    s_who[slot] = who;
+    barrier();
+    a0 = s_obj[0][lid];
+    a1 = s_obj[1][lid];
+    who = s_who[lid];
+  }
+  // 2. Test the object of slot `lid`: in a mixed workgroup, one subgroup at most holds both kinds.
+  uint st = GLINT_OBJECT_STATE_NONE;
+  bool inv = false;
+  if ((who & kNotTested) == 0u) {
+    vec4 rect;
+    float z;
+    st = test_object(a0, a1, mode == GLINT_OBJECT_MODE_PHASE1, inv, rect, z);
+#ifndef GLINT_OBJECT_PHASE1
+    // One Hi-Z test for both kinds of bound.
+    if (st == GLINT_OBJECT_STATE_NONE) st = hiz_test(rect.xy, rect.zw, z, (pc.flags & GLINT_OBJECT_REVERSED_Z) != 0u);
+#endif
+  }
+  uint r = st | (inv ? 4u : 0u);
+  if (mixed) {
+    s_state[who & ~kNotTested] = r;
+    barrier();
+    r = s_state[lid];
+  }
   // 3. In object order again: the state, the emission bit and the counts of object i.
-  const uint r = s_state[lid];
   const uint state = r & 3u;
   const bool invalid = (r & 4u) != 0u;
   bool emit = false;
