@@ -672,61 +672,6 @@ TEST_F(ObjectCullTest, ManyTilesCompactInObjectOrder) {
   }
 }
 
-// The test kernel's last workgroup of each tile scans the tile, found by a per-tile count of
-// written records. A count that is wrong at the start of a cull (here: far above any tile's size,
-// so no workgroup sees itself last) leaves every tile unscanned: nothing is emitted and the
-// statistics count nothing, which the checks of the other tests catch. The top-level scan zeroes
-// the counts, so the next cull is right again.
-TEST_F(ObjectCullTest, BrokenTileCountIsCaughtAndTheNextCullHeals) {
-  SceneSpec s;
-  s.objects = 1500;
-  std::mt19937 rng(23);
-  const TestCamera cam = make_camera(rng, s);
-  const auto depth = make_depth_image(rng, cam, s);
-  const auto base = make_objects(rng, cam, s);
-  const uint32_t count = 9000;  // 3 tiles of 64 groups on CPU devices, 1 of 1024 on GPUs
-  std::vector<GlintCullObject> objs(count);
-  for (uint32_t i = 0; i < count; ++i) objs[i] = base[(i * 2654435761u) % base.size()];
-  GpuScene g(depth, false, objs);
-  ObjectCullConfig cc;
-  cc.max_objects = count;
-  cc.capacity = count;
-  ObjectCuller culler(context(), cc);
-  const ObjectCullFrame frame = frame_of(cam.cam, count);
-  for (bool broken : {true, false}) {
-    Outputs out(count, 0);
-    g.visibility.poison();
-    context().run_once([&](VkCommandBuffer cmd) {
-      if (broken) detail::object_cull_fill_tiles_done(culler, cmd, 0x40000000u);
-      g.hiz.record(cmd, g.depth_image.state);
-      culler.record(cmd, g.hiz, g.depth_image.state, frame, g.buffers, out.out);
-      out.host(cmd);
-      to_host(cmd, g.buffers.visibility);
-    });
-    const auto states = g.states(count);
-    std::vector<uint32_t> expected;
-    for (uint32_t i = 0; i < count; ++i) {
-      ASSERT_GE(states[i], 1u) << i;  // the states do not depend on the scan
-      ASSERT_LE(states[i], 3u) << i;
-      if (states[i] == GLINT_OBJECT_STATE_VISIBLE) expected.push_back(i);
-    }
-    ASSERT_GT(expected.size(), count / 100);
-    if (broken) {
-      // No tile's count reaches its size, so no tile is scanned and no workgroup finishes the cull:
-      // the arguments and statistics keep what they held (the poison). The scatter zeroes the
-      // counts, so the next cull is whole.
-      EXPECT_EQ(out.st().emitted, 0xffffffffu) << "a tile was scanned although its count never reached its size";
-      EXPECT_EQ(out.st().visible, 0xffffffffu);
-      EXPECT_EQ(out.args().draw_count, 0xffffffffu);
-    } else {
-      EXPECT_EQ(out.st().emitted, expected.size());
-      EXPECT_EQ(out.st().visible, expected.size());
-      EXPECT_EQ(out.args().draw_count, expected.size());
-      EXPECT_TRUE(out.words(expected.size()) == expected) << "the list is not the visible objects in order";
-    }
-  }
-}
-
 // Bad input throws glint::Error naming the problem, before anything is recorded.
 TEST_F(ObjectCullTest, ErrorsBeforeRecording) {
   SceneSpec s;

@@ -27,7 +27,7 @@ Compaction::Compaction(const Context& context, const Desc& desc) {
   }
   if (desc.scatter_groups < 1) throw Error(ErrorCode::invalid_argument, "Compaction: scatter_groups must be >= 1");
   scatter_groups_ = desc.scatter_groups;
-  scan_in_one_dispatch_ = desc.scan_in_one_dispatch;
+  scan_tiles_only_ = desc.scan_tiles_only;
   VkPhysicalDeviceProperties props;
   vkGetPhysicalDeviceProperties(context.physical_device(), &props);
   max_groups_x_ = props.limits.maxComputeWorkGroupCount[0];
@@ -81,12 +81,12 @@ void Compaction::record_scan(VkCommandBuffer cmd, Barriers& b, GlintCompactPush 
   push.tile_groups = scan_threads_;
   const uint32_t group_count = (push.count + kGroup - 1) / kGroup;
   const uint32_t tiles = (group_count + scan_threads_ - 1) / scan_threads_;
-  if (scan_in_one_dispatch_) {
-    // One workgroup per tile (at least one: a run of no items still writes its outputs).
+  if (scan_tiles_only_) {  // one workgroup per tile
+    if (tiles == 0) return;
     b.use(groups_state_, kCompute, kRead | kWrite);
-    for (Buffer* o : outputs) b.use(*o, kCompute, kRead | kWrite);
+    for (Buffer* o : outputs) b.use(*o, kCompute, kWrite);
     b.flush(cmd);
-    scan_.dispatch(cmd, top, push, std::max(1u, tiles) * scan_threads_, 1);
+    scan_.dispatch(cmd, top, push, tiles * scan_threads_, 1);
     return;
   }
   // 1. Tiles of scan_threads groups in parallel: slots within each tile, tile totals.
@@ -97,20 +97,20 @@ void Compaction::record_scan(VkCommandBuffer cmd, Barriers& b, GlintCompactPush 
   }
   // 2. One workgroup: the tiles' first slots, then the user's outputs.
   b.use(groups_state_, kCompute, kRead | kWrite);
-  for (Buffer* o : outputs) b.use(*o, kCompute, kRead | kWrite);
+  for (Buffer* o : outputs) b.use(*o, kCompute, kWrite);
   b.flush(cmd);
   scan_.dispatch(cmd, top, push, scan_threads_, 1);
 }
 
 void Compaction::record_scatter(VkCommandBuffer cmd, Barriers& b, GlintCompactPush push,
                                 std::initializer_list<Buffer*> inputs, std::initializer_list<Buffer*> outputs) {
-  if (push.count == 0) return;
   // The scatter's descriptors: the group buffer, the user's inputs, then its outputs.
   Bindings set{groups_state_};
   for (Buffer* in : inputs) set.push_back(*in);
   for (Buffer* o : outputs) set.push_back(*o);
   // Workgroups of scatter_groups groups each, as a 2D grid of at most maxComputeWorkGroupCount[0] per row.
-  const uint32_t workgroups = ((push.count + kGroup - 1) / kGroup + scatter_groups_ - 1) / scatter_groups_;
+  const uint32_t workgroups =
+      std::max(1u, ((push.count + kGroup - 1) / kGroup + scatter_groups_ - 1) / scatter_groups_);
   const uint32_t gx = std::min(workgroups, max_groups_x_);
   const uint32_t gy = (workgroups + gx - 1) / gx;
   push.tile_groups = scan_threads_;

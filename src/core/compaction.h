@@ -29,16 +29,14 @@ class Compaction {
     /// the group buffer, then `scan_outputs` storage buffers it writes.
     std::string scan_kernel;
     uint32_t scan_outputs = 2;
-    /// The user's scan kernel runs both levels in one dispatch of one workgroup per tile (each scans
-    /// its tile with compact_tile_scan, the last to finish runs compact_top_scan), so
-    /// compact_scan_tiles.comp is not recorded.
-    bool scan_in_one_dispatch = false;
+    /// The user's scan kernel is the first level only, one workgroup per tile (compact_tile_scan or
+    /// compact_tile_scan_counts), in place of compact_scan_tiles.comp and the top-level dispatch:
+    /// the user's scatter then adds the totals of the tiles before each item's tile itself.
+    bool scan_tiles_only = false;
     /// The scatter: one workgroup of 64 invocations per `scatter_groups` consecutive groups (a 2D
-    /// grid, groups_x per row); binding 0 the group buffer, then `scatter_inputs` storage buffers
-    /// it reads and `scatter_outputs` it writes. "compact_scatter_main" copies
-    /// GlintCompactPush::step[0] payload words per item (0: the item index) from one input into
-    /// one output, GLINT_COMPACT_SCATTER_GROUPS groups per workgroup.
-    std::string scatter_kernel = "compact_scatter_main";
+    /// grid, groups_x per row; at least one workgroup, also for no items); binding 0 the group
+    /// buffer, then `scatter_inputs` storage buffers it reads and `scatter_outputs` it writes.
+    std::string scatter_kernel;
     uint32_t scatter_inputs = 1;
     uint32_t scatter_outputs = 1;
     uint32_t scatter_groups = GLINT_COMPACT_SCATTER_GROUPS;
@@ -71,7 +69,7 @@ class Compaction {
   uint32_t max_groups_x_ = 65535;
   uint32_t scan_threads_ = 1;
   uint32_t scatter_groups_ = 1;
-  bool scan_in_one_dispatch_ = false;
+  bool scan_tiles_only_ = false;
   ComputePipeline scan_tiles_, scan_, scatter_;
   OwnedBuffer groups_;
   Buffer groups_state_;

@@ -1,13 +1,12 @@
 # Visibility (docs/OCCLUSION.md): the Hi-Z pyramid and the light cull (include/glint/occlusion.h,
 # hiz_pyramid.cpp, light_culler.cpp) and the object cull (include/glint/object_cull.h, object_cull.cpp).
 set(GLINT_EFFECT_SOURCES hiz_pyramid.cpp light_culler.cpp object_cull.cpp)
-# compact_scan_tiles and compact_scatter are the ordered compaction's own kernels (both culls use
-# them through src/core/compaction.h; its shared GLSL is src/core/shaders/compact.glsl).
+# compact_scan_tiles is the ordered compaction's own first-level scan (the light cull uses it through
+# src/core/compaction.h; the shared GLSL is src/core/shaders/compact.glsl).
 set(GLINT_EFFECT_KERNELS
   "shaders/hiz_stream|main|"
   "shaders/hiz_build|main|"
   "shaders/compact_scan_tiles|main|"
-  "shaders/compact_scatter|main|"
   "shaders/light_cull|main|"
   "shaders/light_cull_scan|main|"
   "shaders/light_cull_scatter|main|"
@@ -17,4 +16,5 @@ set(GLINT_EFFECT_KERNELS
   "shaders/object_cull|phase1_subgroup|GLINT_OBJECT_PHASE1=1+GLINT_OBJECT_SUBGROUP=1"
   "shaders/object_cull_v1|main|"
   "shaders/object_cull_scan|main|"
+  "shaders/object_cull_scatter|main|"
 )

@@ -186,17 +186,15 @@ struct ObjectCuller::Impl {
   uint32_t test_threads = kGroup;
   detail::ObjectCullKernel kernel = detail::ObjectCullKernel::current;
   // The ordered compaction of the emitted objects (core/compaction.h): its group buffer holds the
-  // test's masks and counters; object_cull_scan.comp finishes the scan, compact_scatter.comp
-  // writes the payloads.
+  // test's masks and packed counts; object_cull_scan.comp scans each tile, object_cull_scatter.comp
+  // writes the payloads, the arguments and the statistics.
   detail::Compaction compact;
   detail::OwnedBuffer dummy;
   Buffer dummy_state;
-  // The scan's count of scanned tiles (object_cull_scan.comp: the last tile finishes the scan),
-  // zero-filled at the first cull, zeroed by the last tile and by the scatter after every cull;
-  // then the tiles' counts of each state.
-  detail::OwnedBuffer tiles_done;
-  Buffer tiles_done_state;
-  bool tiles_done_cleared = false;
+  // Each tile's counts of the four states (object_cull_scan.comp writes them every cull, the
+  // scatter's workgroup 0 sums them): nothing is carried from one cull to the next.
+  detail::OwnedBuffer tile_counts;
+  Buffer tile_counts_state;
 
   void check_common(const char* where, const ObjectCullFrame& frame, ObjectCullBuffers& in, ObjectCullOutputs& out,
                     GlintObjectCullPush& push) const {
@@ -306,18 +304,17 @@ ObjectCuller::ObjectCuller(const Context& context, const ObjectCullConfig& confi
   m.phase1 = detail::ComputePipeline(context, d);
   detail::Compaction::Desc cd;
   cd.max_items = config.max_objects;
-  cd.scan_kernel = "object_cull_scan_main";  // both levels; the arguments and statistics
-  cd.scan_outputs = 3;                       // (and the count of scanned tiles)
-  cd.scan_in_one_dispatch = true;
-  cd.scatter_kernel = "compact_scatter_main";  // payloads (or indices) into the list; zeroes the
-  cd.scatter_inputs = 1;                       // count of scanned tiles
-  cd.scatter_outputs = 2;
+  cd.scan_kernel = "object_cull_scan_main";  // tiles only: slots, totals, counts
+  cd.scan_outputs = 1;                       // (the tile counts)
+  cd.scan_tiles_only = true;
+  cd.scatter_kernel = "object_cull_scatter_main";  // reads payloads and tile counts; writes the
+  cd.scatter_inputs = 2;                           // list, the arguments and the statistics
+  cd.scatter_outputs = 3;
   m.compact = detail::Compaction(context, cd);
-  const VkBufferUsageFlags tiles_usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
-  // The count of scanned tiles (16 bytes with padding), then each tile's four counts.
   const uint64_t tiles = (groups + m.compact.tile_groups() - 1) / m.compact.tile_groups();
-  m.tiles_done = detail::OwnedBuffer(context, 16 + tiles * 16, tiles_usage, false);
-  m.tiles_done_state = view_of(m.tiles_done, tiles_usage);
+  m.tile_counts =
+      detail::OwnedBuffer(context, std::max<uint64_t>(1, tiles) * 16, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, false);
+  m.tile_counts_state = view_of(m.tile_counts, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
   m.dummy = detail::OwnedBuffer(context, 16, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, false);
   m.dummy_state = view_of(m.dummy, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
 }
@@ -356,14 +353,6 @@ void ObjectCuller::Impl::run(VkCommandBuffer cmd, HiZPyramid* hiz, Image* depth,
   test.push_back(groups_state);
 
   detail::Barriers b;
-  compact.record_clear_once(cmd, b);  // the scan resets the counters after every cull
-  if (!tiles_done_cleared) {          // the scan and the scatter zero it after every cull
-    b.use(tiles_done_state, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);
-    b.flush(cmd);
-    vkCmdFillBuffer(cmd, tiles_done_state.buffer, 0, tiles_done_state.size, 0);
-    detail::count_recorded_command();
-    tiles_done_cleared = true;
-  }
   // The test's workgroups (test_threads objects each; the previous kernel's one group each) as a 2D
   // grid of at most maxComputeWorkGroupCount[0] per row.
   const uint32_t threads = v1 ? kGroup : test_threads;
@@ -400,15 +389,15 @@ void ObjectCuller::Impl::run(VkCommandBuffer cmd, HiZPyramid* hiz, Image* depth,
   op.capacity = config.capacity;
   op.payload_words = config.payload_words;
   op.objects_per_group = config.objects_per_group;
-  op.clear_words = 1;  // the count of scanned tiles
   GlintCompactPush cp;
   static_assert(sizeof(cp) == sizeof(op));
   std::memcpy(&cp, &op, sizeof(cp));
-  // 2. Scan, one dispatch: slots, arguments, statistics; counters reset.
-  compact.record_scan(cmd, b, cp, {&out.indirect, &out.stats, &tiles_done_state});
+  // 2. Scan: each tile's slots, total and counts.
+  compact.record_scan(cmd, b, cp, {&tile_counts_state});
   if (profiler) profiler->mark(cmd, "object cull scan");
-  // 3. Scatter: payloads in object order; the count of scanned tiles zeroed again.
-  compact.record_scatter(cmd, b, cp, {&payloads}, {&out.list, &tiles_done_state});
+  // 3. Scatter: payloads in object order (each workgroup adds the earlier tiles' totals); the
+  //    arguments and statistics.
+  compact.record_scatter(cmd, b, cp, {&payloads, &tile_counts_state}, {&out.list, &out.indirect, &out.stats});
   if (profiler) profiler->mark(cmd, "object cull scatter");
 }
 
@@ -480,16 +469,6 @@ void object_cull_select_kernel(ObjectCuller& culler, ObjectCullKernel kernel) {
     m.phase1_atomic = ComputePipeline(*m.context, d);
   }
   m.kernel = kernel;
-}
-
-void object_cull_fill_tiles_done(ObjectCuller& culler, VkCommandBuffer cmd, uint32_t value) {
-  ObjectCuller::Impl& m = ObjectCullerAccess::impl(culler);
-  Barriers b;
-  b.use(m.tiles_done_state, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);
-  b.flush(cmd);
-  vkCmdFillBuffer(cmd, m.tiles_done_state.buffer, 0, 4, value);
-  count_recorded_command();
-  m.tiles_done_cleared = true;
 }
 
 bool object_cull_has_subgroup_variant(const ObjectCuller& culler) { return ObjectCullerAccess::impl(culler).subgroup; }

@@ -22,10 +22,6 @@ enum class ObjectCullKernel : uint32_t {
 
 /// Selects the kernel `culler` records from now on.
 void object_cull_select_kernel(ObjectCuller& culler, ObjectCullKernel kernel);
-/// Test hook: records a fill of `culler`'s count of scanned tiles (object_cull_scan.comp; 0
-/// between culls) with `value`, as a broken counter would leave it; the scatter of the next cull
-/// zeroes it.
-void object_cull_fill_tiles_done(ObjectCuller& culler, VkCommandBuffer cmd, uint32_t value);
 /// Whether `culler` runs the subgroup variants in ObjectCullKernel::current (the device supports them).
 bool object_cull_has_subgroup_variant(const ObjectCuller& culler);
 

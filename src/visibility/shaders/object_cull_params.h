@@ -1,9 +1,8 @@
-// Internal layouts of the object occlusion cull (not installed): the push constants of its
-// dispatches: object_cull.comp (frustum + Hi-Z test; the last workgroup of each tile scans it and
-// the last tile scanned scans the tiles and writes the indirect arguments and statistics), then
-// compact_scatter.comp of the ordered compaction (compact_params.h: payloads into their slots in
-// object order). The previous test kernel, object_cull_v1.comp, is followed by
-// compact_scan_tiles.comp and object_cull_scan.comp instead.
+// Internal layouts of the object occlusion cull (not installed): the push constants of its three
+// dispatches: object_cull.comp (frustum + Hi-Z test: masks and counts per group of 64 objects),
+// object_cull_scan.comp (each tile's slots, total and counts) and object_cull_scatter.comp
+// (payloads into their slots in object order; the arguments and statistics). The previous test
+// kernel, object_cull_v1.comp, runs with the same scan and scatter.
 // Declared once for GLSL and C++; src/visibility/object_cull.cpp static_asserts the layouts.
 #ifndef GLINT_OBJECT_CULL_PARAMS_H
 #define GLINT_OBJECT_CULL_PARAMS_H
@@ -68,17 +67,16 @@ struct GlintObjectCullPush {
   GLINT_FLOAT plane_len[4];
 };
 
-// Push constants of the object cull's compaction (32 bytes): GlintCompactPush with its step words
-// named (compact_scatter.comp reads step[0] as the payload words, step[2] as the words to zero).
+// Push constants of the object cull's scan and scatter (32 bytes): GlintCompactPush with its step
+// words named.
 struct GlintObjectCompactPush {
   GLINT_UINT count;              // objects
   GLINT_UINT capacity;           // payload slots of the output list
   GLINT_UINT tile_groups;        // 64-object groups per tile of the two-level scan
   GLINT_UINT groups_x;           // scatter: workgroups per row of its 2D dispatch
   GLINT_UINT payload_words;      // 0: the list holds object indices (one uint); else words copied per object
-  GLINT_UINT objects_per_group;  // scan: dispatch group_count_x = ceil(written / this)
-  GLINT_UINT clear_words;        // scatter: words of the test's tile counts it zeroes (tiles + 1)
-  GLINT_UINT reserved;
+  GLINT_UINT objects_per_group;  // scatter: dispatch group_count_x = ceil(written / this)
+  GLINT_UINT reserved[2];
 };
 
 #endif
