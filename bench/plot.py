@@ -46,14 +46,27 @@ to the panel of that device.
         "lavapipe=docs/perf/object_cull_lavapipe.json" "H100=docs/perf/object_cull_h100.json" \
         --peer "H100=docs/perf/object_cull_torch_h100.json"
 
---chart firefly draws docs/stability/ from what build/bench/glint_stability_report writes there
+--chart firefly draws docs/stability/ from what build/bench/glint_stability_report writes
 (firefly_energy.json, firefly_frames_raw.png): firefly_energy.png, the bloom energy of every frame
 of the moving 1e4 point relative to that configuration's mean over its 64 frames, one line per
 filter and guard (max_brightness 1000), the whole range and a zoom on +-3%; and
 firefly_frames.png, the frames of the raw filmstrip with their frame number, point position and
-guard. The one argument is the report's directory.
+guard. Each argument is one report's directory, DIR or DEVICE=DIR (without DEVICE the panel is
+named by the JSON's "device"). One directory: the whole range and the zoom side by side, both
+charts written into that directory (or --out-dir, or --out FILE for the energy chart and the
+frames beside it).
+Several: one column per device (top the whole range, bottom the zoom, each panel titled with its
+device and commit, one legend below giving each line's spread on every device) and one filmstrip
+block per device stacked vertically, written into --out-dir (default docs/stability). The report
+does not record the commit: give --commit NAME=COMMIT per device (NAME as the panel is named) or a
+bare --commit COMMIT for all; a panel without either is captioned with git rev-parse --short HEAD.
 
+    # one device (lavapipe)
     python3 bench/plot.py --chart firefly --commit COMMIT docs/stability
+    # both devices: the H100's report in docs/stability/h100, lavapipe's in docs/stability
+    python3 bench/plot.py --chart firefly --out-dir docs/stability \
+        --commit H100=COMMIT_H100 --commit lavapipe=COMMIT_LAVAPIPE \
+        "H100=docs/stability/h100" "lavapipe=docs/stability"
 """
 import argparse
 import json
@@ -479,80 +492,203 @@ def brightness(v):
     return f"{v / 10 ** e:g}e{e}" if v >= 1000 else f"{v:g}"
 
 
-def main_firefly(args):
-    folder = args.inputs[0]
-    data = json.load(open(os.path.join(folder, "firefly_energy.json")))
-    commits = commit_map(args.commit)
-    commit = commits.get("") or head_commit()
-    caption = f"{data['device']}, glint {commit}"
-    series = [s for s in data["series"] if s["max_brightness"] == 1000 and s["value"] == 1e4]
-    if not series:
-        raise SystemExit("firefly_energy.json has no max_brightness 1000, value 1e4 series")
-    fig, axes, legend_axes = panels(2, width=6.4, height=4.6, legend_height=1.3)
-    for k, ax in enumerate(axes):
-        for s in series:
-            e = s["energy"]
-            mean = sum(e) / len(e)
-            rel = [v / mean for v in e]
-            label = s["filter"] + ", " + s["firefly_guard"]
-            if s["filter"] == "cod13" and s["firefly_guard"] == "karis_smooth":
-                label += " (defaults)"
-            spread = (max(rel) - min(rel)) * 100.0
-            if k == 1 and max(abs(v - 1.0) for v in rel) > 0.03:
-                continue  # the zoom shows the lines that stay inside it
-            ax.plot(range(len(rel)), rel, GUARD_STYLE.get(s["firefly_guard"], "-"),
-                    color=FILTER_COLOUR.get(s["filter"], "C7"), lw=1.4, label=f"{label}: spread {spread:.2g}%")
-        for v in (0.98, 1.02):
-            ax.axhline(v, color="grey", lw=0.8, alpha=0.7)
-        ax.set_xlabel(f"frame (point at x = {data['x0_px']:g} + {data['step_px']:g} x frame px)")
-        ax.set_xlim(0, len(series[0]["energy"]) - 1)
-        ax.grid(True, alpha=0.3)
-        if k == 0:
-            ax.set_ylabel("bloom energy / its mean over the 64 frames")
-            ax.set_title("all configurations (grey: +-2%)", fontsize=9)
-        else:
-            ax.set_ylim(0.97, 1.03)
-            ax.set_ylabel("bloom energy / its mean over the 64 frames (zoom)")
-            ax.set_title("zoom on +-3%: the lines that stay inside it (grey: the 2% target)", fontsize=9)
-    handles, labels = axes[0].get_legend_handles_labels()
-    legend_below(legend_axes, handles, "filter, firefly_guard (max_brightness 1000); spread = (max - min) / mean", 3,
-                 labels)
-    w, h = data["image"]
-    fig.suptitle(f"Moving firefly of {brightness(series[0]['value'])} on a {w}x{h} image, bloom energy per frame\n{caption}",
-                 fontsize=10)
-    out = args.out or os.path.join(folder, "firefly_energy.png")
+class FireflyRun:
+    """One glint_stability_report directory: its firefly_energy.json, the folder its raw filmstrip
+    lies in, the panel's name (DEVICE of DEVICE=DIR, else the JSON's device) and the commit."""
+
+    def __init__(self, spec, commits):
+        # DEVICE=DIR, or a bare DIR (also one whose name holds '=': it is a directory).
+        name, folder = (None, spec) if os.path.isdir(spec) or "=" not in spec else spec.split("=", 1)
+        path = os.path.join(folder, "firefly_energy.json")
+        if not os.path.isfile(path):
+            raise SystemExit(f"--chart firefly: {path} does not exist (write it with "
+                             f"build/bench/glint_stability_report --out {folder})")
+        self.data = json.load(open(path))
+        self.folder = folder
+        self.device = self.data.get("device", "")
+        self.name = name or self.device or folder
+        self.commit = commits.get(self.name) or commits.get("")
+        self.series = [s for s in self.data["series"] if s["max_brightness"] == 1000 and s["value"] == 1e4]
+        if not self.series:
+            raise SystemExit(f"{path} has no max_brightness 1000, value 1e4 series")
+
+    def caption(self):
+        """'NAME: DEVICE, glint COMMIT' (the name once where it is the device)."""
+        who = self.device if self.name == self.device else f"{self.name}: {self.device or 'device not recorded'}"
+        return f"{who}, glint {self.commit}"
+
+
+def firefly_label(s):
+    label = s["filter"] + ", " + s["firefly_guard"]
+    if s["filter"] == "cod13" and s["firefly_guard"] == "karis_smooth":
+        label += " (defaults)"
+    return label
+
+
+def relative_energy(s):
+    e = s["energy"]
+    mean = sum(e) / len(e)
+    return [v / mean for v in e]
+
+
+def firefly_panel(ax, run, zoom):
+    """One device's energy lines: every configuration, or (zoom) those that stay inside +-3%."""
+    data = run.data
+    for s in run.series:
+        rel = relative_energy(s)
+        if zoom and max(abs(v - 1.0) for v in rel) > 0.03:
+            continue  # the zoom shows the lines that stay inside it
+        ax.plot(range(len(rel)), rel, GUARD_STYLE.get(s["firefly_guard"], "-"),
+                color=FILTER_COLOUR.get(s["filter"], "C7"), lw=1.4, label=firefly_label(s))
+    for v in (0.98, 1.02):
+        ax.axhline(v, color="grey", lw=0.8, alpha=0.7)
+    ax.set_xlabel(f"frame (point at x = {data['x0_px']:g} + {data['step_px']:g} x frame px)")
+    ax.set_xlim(0, len(run.series[0]["energy"]) - 1)
+    ax.grid(True, alpha=0.3)
+    if zoom:
+        ax.set_ylim(0.97, 1.03)
+
+
+def firefly_energy_chart(runs, out):
+    """firefly_energy.png: one device, the whole range and the zoom side by side; several devices,
+    one column per device (top: all configurations, bottom: the zoom). One legend below for all
+    panels, each line's spread per device in its label."""
+    n = len(runs)
+    labels, spreads = [], {}
+    for run in runs:
+        for s in run.series:
+            rel = relative_energy(s)
+            label = firefly_label(s)
+            if label not in labels:
+                labels.append(label)
+            spreads.setdefault(label, []).append((run.name, (max(rel) - min(rel)) * 100.0))
+
+    def with_spread(label):
+        if n == 1:
+            return f"{label}: spread {spreads[label][0][1]:.2g}%"
+        return f"{label}: spread " + ", ".join(f"{v:.2g}% {name}" for name, v in spreads[label])
+
+    legend_labels = [with_spread(l) for l in labels]
+    # Up to 3 legend columns, fewer where long labels (long device names) would not fit the
+    # figure's width: about 0.05 in per character at 8 pt, plus the line sample and the gap.
+    column_in = 0.05 * max(len(l) for l in legend_labels) + 0.6
+    ncol = max(1, min(3, int(6.4 * max(n, 2) // column_in)))
+    legend_height = 0.3 * math.ceil(len(labels) / ncol) + 0.4
+    if n == 1:
+        fig = plt.figure(figsize=(12.8, 4.6 + legend_height), layout="constrained")
+        grid = fig.add_gridspec(2, 2, height_ratios=[4.6, legend_height])
+        full, zoom = [fig.add_subplot(grid[0, 0])], [fig.add_subplot(grid[0, 1])]
+        legend_axes = fig.add_subplot(grid[1, :])
+    else:
+        fig = plt.figure(figsize=(6.4 * n, 8.4 + legend_height), layout="constrained")
+        grid = fig.add_gridspec(3, n, height_ratios=[4.2, 4.2, legend_height])
+        full, zoom = [], []
+        for i in range(n):
+            full.append(fig.add_subplot(grid[0, i], sharey=full[0] if full else None))
+            zoom.append(fig.add_subplot(grid[1, i], sharey=zoom[0] if zoom else None))
+        legend_axes = fig.add_subplot(grid[2, :])
+    legend_axes.axis("off")
+    for run, a, z in zip(runs, full, zoom):
+        firefly_panel(a, run, False)
+        firefly_panel(z, run, True)
+        where = "" if n == 1 else f"{run.caption()}\n"
+        a.set_title(f"{where}all configurations (grey: +-2%)", fontsize=9)
+        z.set_title(f"{where}zoom on +-3%: the lines that stay inside it (grey: the 2% target)", fontsize=9)
+    full[0].set_ylabel("bloom energy / its mean over the 64 frames")
+    zoom[0].set_ylabel("bloom energy / its mean over the 64 frames (zoom)")
+    # One handle per configuration (the same colour and style in every panel).
+    handles = {}
+    for ax in full:
+        for h, label in zip(*ax.get_legend_handles_labels()):
+            handles.setdefault(label, h)
+
+    legend_below(legend_axes, [handles[l] for l in labels],
+                 "filter, firefly_guard (max_brightness 1000); spread = (max - min) / mean", ncol, legend_labels)
+    w, h = runs[0].data["image"]
+    title = f"Moving firefly of {brightness(runs[0].series[0]['value'])} on a {w}x{h} image, bloom energy per frame"
+    fig.suptitle(title + (f"\n{runs[0].caption()}" if n == 1 else ""), fontsize=10)
     fig.savefig(out, dpi=110)
     print("wrote", out)
 
-    strip = data["filmstrip"]
-    raw = plt.imread(os.path.join(folder, strip["file"]))
-    tw, th = strip["tile"]
-    rows, frames = strip["rows"], strip["frames"]
-    fig, axes = plt.subplots(len(rows), frames, figsize=(2.9 * frames, 1.75 * len(rows) + 0.9), squeeze=False,
-                             layout="constrained")
-    for r, guard in enumerate(rows):
-        for f in range(frames):
-            ax = axes[r][f]
-            ax.imshow(raw[r * th:(r + 1) * th, f * tw:(f + 1) * tw], interpolation="nearest")
-            ax.set_xticks([])
-            ax.set_yticks([])
-            ax.set_title(f"frame {f}, x = {data['x0_px'] + data['step_px'] * f:g} px", fontsize=8)
-            if f == 0:
-                name = guard + (" (default)" if guard == "karis_smooth" else "")
-                ax.set_ylabel(f"cod13\n{name}", fontsize=8)
-    fig.suptitle(f"Frames of the moving {brightness(strip['value'])} point ({tw}x{th} crops around it), intensity "
-                 f"{strip['intensity']:g}, exposure {strip['exposure']:g}\n{caption}", fontsize=9)
-    out = os.path.join(os.path.dirname(out), "firefly_frames.png")
+
+def firefly_frames_chart(runs, out):
+    """firefly_frames.png: each device's raw filmstrip (firefly_frames_raw.png, one row per guard,
+    one column per frame), one block per device stacked vertically and labelled with it."""
+    n = len(runs)
+    strips = [r.data["filmstrip"] for r in runs]
+    frames = max(s["frames"] for s in strips)
+    heights = [1.75 * len(s["rows"]) + (0.45 if n > 1 else 0.0) for s in strips]
+    fig = plt.figure(figsize=(2.9 * frames, sum(heights) + 0.9), layout="constrained")
+    blocks = [fig] if n == 1 else fig.subfigures(n, 1, height_ratios=heights)
+    for block, run, strip in zip(blocks, runs, strips):
+        data = run.data
+        raw = plt.imread(os.path.join(run.folder, strip["file"]))
+        tw, th = strip["tile"]
+        rows = strip["rows"]
+        axes = block.subplots(len(rows), frames, squeeze=False)
+        for r, guard in enumerate(rows):
+            for f in range(frames):
+                ax = axes[r][f]
+                ax.set_xticks([])
+                ax.set_yticks([])
+                if f >= strip["frames"]:
+                    ax.axis("off")
+                    continue
+                ax.imshow(raw[r * th:(r + 1) * th, f * tw:(f + 1) * tw], interpolation="nearest")
+                ax.set_title(f"frame {f}, x = {data['x0_px'] + data['step_px'] * f:g} px", fontsize=8)
+                if f == 0:
+                    name = guard + (" (default)" if guard == "karis_smooth" else "")
+                    ax.set_ylabel(f"cod13\n{name}", fontsize=8)
+        if n > 1:
+            block.suptitle(run.caption(), fontsize=9, fontweight="bold")
+    s = strips[0]
+    tw, th = s["tile"]
+    title = (f"Frames of the moving {brightness(s['value'])} point ({tw}x{th} crops around it), intensity "
+             f"{s['intensity']:g}, exposure {s['exposure']:g}")
+    if n == 1:
+        fig.suptitle(f"{title}\n{runs[0].caption()}", fontsize=9)
+    else:
+        fig.suptitle(title, fontsize=10)
     fig.savefig(out, dpi=110)
     print("wrote", out)
+
+
+def main_firefly(args):
+    commits = commit_map(args.commit)
+    runs = [FireflyRun(spec, commits) for spec in args.inputs]
+    names = [r.name for r in runs]
+    if len(set(names)) != len(names):
+        raise SystemExit(f"--chart firefly: two inputs are named alike ({', '.join(names)}): use DEVICE=DIR")
+    for key in commits:
+        if key and key not in names:
+            raise SystemExit(f"--commit {key}=...: no input is named {key} (inputs: {', '.join(names)})")
+    if args.out and args.out_dir:
+        raise SystemExit("--chart firefly: give --out (the energy chart's file) or --out-dir, not both")
+    for run in runs:
+        if not run.commit:  # the report's JSON does not record the commit: take HEAD, and say so
+            head = head_commit()
+            run.commit = head or "commit not recorded"
+            print(f"{run.name}: no --commit: " + (f"captioned with HEAD ({head})" if head else "no git HEAD either"))
+    if args.out:
+        out_dir = os.path.dirname(args.out) or "."
+    else:
+        out_dir = args.out_dir or (runs[0].folder if len(runs) == 1 else "docs/stability")
+    os.makedirs(out_dir, exist_ok=True)
+    firefly_energy_chart(runs, args.out or os.path.join(out_dir, "firefly_energy.png"))
+    firefly_frames_chart(runs, os.path.join(out_dir, "firefly_frames.png"))
 
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("inputs", nargs="+", help="DEVICE=results.json (--chart firefly: the report's directory)")
+    ap.add_argument("inputs", nargs="+",
+                    help="DEVICE=results.json (--chart firefly: DEVICE=DIR or DIR, the report's directory)")
     ap.add_argument("--chart", choices=["bloom", "blur", "occlusion", "object_cull", "firefly"], default="bloom")
     ap.add_argument("--size", default=None, help="WxH (bloom default 1920x1080; blur default: each file's largest)")
-    ap.add_argument("--out", default=None, help="default docs/charts/<chart>_pareto.svg")
+    ap.add_argument("--out", default=None, help="default docs/charts/<chart>_pareto.svg "
+                                                "(--chart firefly: the energy chart's PNG; frames go beside it)")
+    ap.add_argument("--out-dir", default=None,
+                    help="--chart firefly: folder of firefly_energy.png and firefly_frames.png (default: the "
+                         "input's folder for one input, docs/stability for several)")
     ap.add_argument("--lights", type=int, default=None, help="occlusion chart: light count (default: each file's most)")
     ap.add_argument("--objects", type=int, default=1000000, help="object count of the object_cull chart")
     ap.add_argument("--peer", action="append", help="DEVICE=object_cull_torch.json (object_cull chart)")
@@ -561,6 +697,8 @@ def main():
                          "a bare COMMIT applies to every panel (firefly default: git rev-parse --short HEAD)")
     ap.add_argument("--png", action="store_true", help="also write a PNG next to the SVG")
     args = ap.parse_args()
+    if args.out_dir and args.chart != "firefly":
+        ap.error("--out-dir is for --chart firefly (the other charts take --out FILE)")
     if args.out is None and args.chart != "firefly":
         args.out = "docs/charts/object_cull_fp_time.svg" if args.chart == "object_cull" else \
             f"docs/charts/{args.chart}_pareto.svg"

@@ -6,21 +6,29 @@
 // Writes, into DIR, firefly_energy.json (the device and the bloom energy of every frame of every
 // firefly configuration) and firefly_frames_raw.png (frames 0 to 2 of the 1e4 firefly, one row
 // per guard, tiles described in the JSON); bench/plot.py --chart firefly draws the charts from
-// them (docs/PERF.md).
+// them (docs/PERF.md). DIR and its parents are created when missing, before any measurement, so
+// that a path that cannot be written fails at once; the two files replace the previous ones
+// together (io::AtomicOutputs), so a failed run leaves the old pair untouched.
 //
 //   build/bench/glint_stability_report [--out DIR]     (DIR default docs/stability)
 #include <glint/bloom.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
+#include <cstdarg>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <string>
+#include <system_error>
 #include <vector>
 
 #include "analysis/light_stats.h"
 #include "core/resources.h"
+#include "io/atomic_outputs.h"
 #include "io/png_io.h"
 #include "support/environment.h"
 #include "support/transfer.h"
@@ -74,8 +82,9 @@ struct FilmstripLayout {
   double exposure = 0.5, intensity = 1.0, value = 1e4;
 };
 constexpr FilmstripLayout kFilmstrip;
+constexpr const char* kFilmstripFile = "firefly_frames_raw.png";
 
-void filmstrip(const Context& ctx, const std::string& path) {
+CpuImage filmstrip(const Context& ctx) {
   const uint32_t w = 256, h = 128, cw = kFilmstrip.tile_w, ch = kFilmstrip.tile_h;
   CpuImage strip(3 * cw, 2 * ch, 0.0f);
   for (int row = 0; row < 2; ++row) {
@@ -95,7 +104,7 @@ void filmstrip(const Context& ctx, const std::string& path) {
         }
     }
   }
-  io::write_png_tonemapped(path, strip, float(kFilmstrip.exposure));
+  return strip;
 }
 
 // One firefly configuration and its per-frame bloom energy (absolute: the light the bloom adds,
@@ -115,36 +124,90 @@ std::string json_string(const std::string& s) {
   return out + "\"";
 }
 
+// printf into a std::string.
+void appendf(std::string& out, const char* format, ...) __attribute__((format(printf, 2, 3)));
+void appendf(std::string& out, const char* format, ...) {
+  va_list args, copy;
+  va_start(args, format);
+  va_copy(copy, args);
+  const int n = std::vsnprintf(nullptr, 0, format, copy);
+  va_end(copy);
+  if (n > 0) {
+    const size_t at = out.size();
+    out.resize(at + size_t(n) + 1);
+    std::vsnprintf(out.data() + at, size_t(n) + 1, format, args);
+    out.resize(at + size_t(n));
+  }
+  va_end(args);
+}
+
 // firefly_energy.json: what bench/plot.py --chart firefly draws. Frame f has the point at
 // x = 100 + 0.25 f px on a 256x128 image.
-void write_energy_json(const std::string& path, const std::string& device, const std::vector<EnergyRecord>& rows) {
-  FILE* f = std::fopen(path.c_str(), "w");
-  if (!f) throw Error(ErrorCode::io_failure, "cannot write " + path);
-  std::fprintf(f, "{\n  \"device\": %s,\n  \"image\": [256, 128],\n  \"x0_px\": 100.0,\n  \"step_px\": 0.25,\n",
-               json_string(device).c_str());
-  std::fprintf(f,
-               "  \"filmstrip\": {\"file\": \"firefly_frames_raw.png\", \"tile\": [%u, %u], \"frames\": %u, "
-               "\"rows\": [\"%s\", \"%s\"], \"value\": %g, \"intensity\": %g, \"exposure\": %g},\n",
-               kFilmstrip.tile_w, kFilmstrip.tile_h, kFilmstrip.frames, kFilmstrip.rows[0], kFilmstrip.rows[1],
-               kFilmstrip.value, kFilmstrip.intensity, kFilmstrip.exposure);
-  std::fprintf(f, "  \"series\": [\n");
+std::string energy_json(const std::string& device, const std::vector<EnergyRecord>& rows) {
+  std::string j;
+  appendf(j, "{\n  \"device\": %s,\n  \"image\": [256, 128],\n  \"x0_px\": 100.0,\n  \"step_px\": 0.25,\n",
+          json_string(device).c_str());
+  appendf(j,
+          "  \"filmstrip\": {\"file\": \"%s\", \"tile\": [%u, %u], \"frames\": %u, "
+          "\"rows\": [\"%s\", \"%s\"], \"value\": %g, \"intensity\": %g, \"exposure\": %g},\n",
+          kFilmstripFile, kFilmstrip.tile_w, kFilmstrip.tile_h, kFilmstrip.frames, kFilmstrip.rows[0],
+          kFilmstrip.rows[1], kFilmstrip.value, kFilmstrip.intensity, kFilmstrip.exposure);
+  appendf(j, "  \"series\": [\n");
   for (size_t i = 0; i < rows.size(); ++i) {
     const auto& r = rows[i];
-    std::fprintf(
-        f, "    {\"filter\": \"%s\", \"firefly_guard\": \"%s\", \"max_brightness\": %g, \"value\": %g, \"energy\": [",
-        r.filter.c_str(), r.guard.c_str(), r.max_brightness, r.value);
-    for (size_t k = 0; k < r.energy.size(); ++k) std::fprintf(f, "%s%.9g", k ? ", " : "", r.energy[k]);
-    std::fprintf(f, "]}%s\n", i + 1 < rows.size() ? "," : "");
+    appendf(j,
+            "    {\"filter\": \"%s\", \"firefly_guard\": \"%s\", \"max_brightness\": %g, \"value\": %g, \"energy\": [",
+            r.filter.c_str(), r.guard.c_str(), r.max_brightness, r.value);
+    for (size_t k = 0; k < r.energy.size(); ++k) appendf(j, "%s%.9g", k ? ", " : "", r.energy[k]);
+    appendf(j, "]}%s\n", i + 1 < rows.size() ? "," : "");
   }
-  std::fprintf(f, "  ]\n}\n");
-  if (std::fclose(f) != 0) throw Error(ErrorCode::io_failure, "cannot write " + path);
+  appendf(j, "  ]\n}\n");
+  return j;
+}
+
+// Creates `dir` and its missing parents, then checks that files can be created in it; throws
+// Error(io_failure) naming the path and the reason. Runs before the measurements (up to a minute
+// on lavapipe), so that a bad --out fails at once instead of after them.
+void prepare_out_dir(const std::string& dir) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec) throw Error(ErrorCode::io_failure, "cannot create " + dir + ": " + ec.message());
+  if (!fs::is_directory(dir, ec)) throw Error(ErrorCode::io_failure, "cannot create " + dir + ": not a directory");
+  // access(2) with W_OK | X_OK: creating a file in a directory needs write and search permission.
+  if (::access(dir.c_str(), W_OK | X_OK) != 0) {
+    throw Error(ErrorCode::io_failure, "cannot write into " + dir + ": " + std::strerror(errno));
+  }
+}
+
+// Replaces DIR/firefly_energy.json and DIR/firefly_frames_raw.png together; on failure both old
+// files stay and the error names the file and the reason.
+void write_outputs(const std::string& dir, const std::string& json, const CpuImage& strip) {
+  try {
+    io::AtomicOutputs out;
+    out.write(dir + "/firefly_energy.json", [&](const std::string& tmp) { io::write_text_file(tmp, json); });
+    out.write(dir + "/" + kFilmstripFile,
+              [&](const std::string& tmp) { io::write_png_tonemapped(tmp, strip, float(kFilmstrip.exposure)); });
+    out.commit();
+  } catch (const Error& e) {
+    throw Error(e.code(), std::string("cannot write ") + e.what());
+  }
 }
 
 int main_impl(int argc, char** argv) {
   std::string out_dir = "docs/stability";
   for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--out") && i + 1 < argc) out_dir = argv[++i];
+    if (!std::strcmp(argv[i], "--out")) {
+      if (i + 1 >= argc || argv[i + 1][0] == '\0') {
+        throw Error(ErrorCode::invalid_argument, "--out needs a directory: accepted --out DIR");
+      }
+      out_dir = argv[++i];
+    } else {
+      throw Error(ErrorCode::invalid_argument,
+                  std::string("unknown argument '") + argv[i] + "': accepted [--out DIR] (default docs/stability)");
+    }
   }
+  prepare_out_dir(out_dir);
   const Context ctx = Context::create(tools::context_options_from_environment());
   std::printf("device: %s\n\n", ctx.info().name.c_str());
   std::printf(
@@ -179,8 +242,7 @@ int main_impl(int argc, char** argv) {
     const auto ev = analysis::relative_variation(firefly(ctx, c, 1e4f, 256, 128, true).energy);
     std::printf("| %s | %.4f | %.4f |\n", bloom_filter_name(f), ev.spread, ev.max_step);
   }
-  write_energy_json(out_dir + "/firefly_energy.json", ctx.info().name, records);
-  filmstrip(ctx, out_dir + "/firefly_frames_raw.png");
+  write_outputs(out_dir, energy_json(ctx.info().name, records), filmstrip(ctx));
   std::printf(
       "\n| filter | iterations | level0_height | size | r50 / width | r90 / width | sigma / width "
       "|\n|---|---|---|---|---|---|---|\n");
@@ -213,6 +275,12 @@ int main_impl(int argc, char** argv) {
                     e.width, e.height, r50 / e.width, r90 / e.width, std::sqrt(st.xx + st.yy) / e.width);
       }
     }
+  }
+  // With validation on (GLINT_VALIDATION=1), any message fails the run: the data came from
+  // commands the validation layers reject.
+  if (const uint32_t messages = ctx.validation_messages()) {
+    std::fprintf(stderr, "glint_stability_report: %u validation messages (printed above)\n", messages);
+    return 1;
   }
   return 0;
 }
