@@ -2,9 +2,9 @@
 // docs/OCCLUSION.md "The shared compaction core"): the user's test kernel sets one bit per emitted item in
 // its 64-item group's mask of the group buffer this owns; record_scan() runs the two-level scan
 // (compact_scan_tiles.comp, then the user's top-level scan, which writes the user's indirect
-// arguments and statistics and resets the header's counters); record_scatter() runs the user's
-// scatter (or compact_scatter.comp, fixed-size payloads), which puts every emitted item's record
-// into its slot in item order, clamped to the capacity.
+// arguments and statistics and resets the header's counters; or, with Desc::scan_tiles_only, the
+// user's own tile scan alone); record_scatter() runs the user's scatter, which puts every emitted
+// item's record into its slot in item order, clamped to the capacity.
 #pragma once
 
 #include <glint/glint.h>

@@ -1,7 +1,8 @@
 // The ordered compaction shared by the object cull and the light cull (docs/OCCLUSION.md,
 // "The shared compaction core"): a test kernel sets one bit per emitted item in its workgroup's 64-bit
 // mask; a two-level scan (compact_scan_tiles.comp per tile of groups, then a cull's top-level scan
-// built on compact.glsl) turns the masks into slots; a scatter writes each emitted item's record
+// built on compact.glsl; the object cull scans its tiles itself and its scatter adds the earlier
+// tiles' totals) turns the masks into slots; a scatter writes each emitted item's record
 // into its slot, so the output holds the emitted items in increasing index on every run. Declared
 // once for GLSL and C++; src/core/compaction.cpp static_asserts the layouts.
 #ifndef GLINT_COMPACT_PARAMS_H
@@ -19,7 +20,8 @@
 // Most invocations of a scan workgroup (its shared arrays are sized for it); a tile is that many
 // groups.
 #define GLINT_COMPACT_SCAN_MAX_THREADS 1024u
-// 64-item groups per workgroup of compact_scatter.comp (16 x 64 = 1024 items, 4 KiB of shared list).
+// 64-item groups per workgroup of the object cull's scatter (object_cull_scatter.comp; 16 x 64 =
+// 1024 items, 4 KiB of shared list).
 #define GLINT_COMPACT_SCATTER_GROUPS 16u
 
 // Push constants of every compaction dispatch (32 bytes). The first four words are the

@@ -30,18 +30,24 @@
 //    workgroup's mask; the ordered compaction (compact.glsl) turns the masks into
 //    slots in object order, so the list is the same bits on every run.
 // 6. The scan of the masks is the next dispatch (object_cull_scan.comp), then the scatter
-//    (compact_scatter.comp). Folding the scan into this kernel (the last workgroup of each tile
-//    scans it, the last tile the tile totals) was measured slower on the H100 (docs/OCCLUSION.md,
-//    "Cost"): every workgroup then pays a device-scope barrier and an atomic before it retires.
+//    (object_cull_scatter.comp). Folding the scan into this kernel (the last workgroup of each
+//    tile scans it, the last tile the tile totals) was measured slower on the H100
+//    (docs/OCCLUSION.md, "Cost"): every workgroup then pays a device-scope barrier and an atomic
+//    before it retires.
+// 7. A workgroup is 256 objects (four groups of 64). When it holds both kinds, it sorts them
+//    through shared memory (spheres from the first slot, boxes from the last) before the test, so
+//    a subgroup runs one kind's code; the results go back to object order for the writes. A
+//    workgroup of one kind tests its objects where they are.
 // GLINT_OBJECT_PHASE1 builds the phase-1 variant, which binds no image (the depth image may be a
 // render target while phase 1 runs).
 // Cost (docs/OCCLUSION.md, "Cost"): one wave of latency-bound invocations, so the kernel keeps
 // few live values and one copy of each expensive step: the record is two 16-byte loads; spheres
 // and boxes only reduce their bound to an NDC rectangle and a nearest depth, and one Hi-Z test
 // after the branch serves both (a subgroup holding both kinds fetches once, not once per kind);
-// each slope pair takes two reciprocals instead of three divisions; the box's per-corner terms
-// that do not depend on the corner are added once after the max; the per-group counts are one
-// packed shared atomic per invocation. object_cull_v1.comp is the previous form, kept for the
+// each slope pair takes two reciprocals instead of three divisions; a box's frustum test and depth
+// range are closed forms over its centre and half axes, and its corners are projected (one
+// reciprocal each, the error widening applied once) only when it reaches the Hi-Z test; the
+// per-group counts are packed shared atomics, one per subgroup. object_cull_v1.comp is the previous form, kept for the
 // benchmark's comparison.
 layout(local_size_x_id = 0, local_size_y_id = 1) in;
 
