@@ -237,7 +237,7 @@ void BM_BlurAutoVsBest(benchmark::State& state) {
 void auto_vs_best_args(benchmark::internal::Benchmark* b) {
   for (auto size : {std::pair{3840, 2160}, std::pair{1920, 1080}, std::pair{512, 512}, std::pair{256, 256}})
     for (int bound : {20, 100})  // 0.1 lets the dual in (its error is 0.07 to 0.3)
-      for (int s : {20, 80, 200, 500}) b->Args({s, size.first, size.second, bound});
+      for (int s : {20, 40, 80, 200, 500}) b->Args({s, size.first, size.second, bound});
   b->ArgNames({"sigma10", "w", "h", "bound1000"});
   b->UseManualTime();
   b->Iterations(1);
