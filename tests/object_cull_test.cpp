@@ -157,6 +157,21 @@ std::vector<GlintCullObject> make_objects(std::mt19937& rng, const TestCamera& c
   return out;
 }
 
+// A random scene of `s` from `seed`: camera, depth image and objects, drawn in that order.
+struct RandomScene {
+  TestCamera cam;
+  reference::DepthImage depth;
+  std::vector<GlintCullObject> objs;
+};
+RandomScene random_scene(const SceneSpec& s, uint32_t seed) {
+  std::mt19937 rng(seed);
+  RandomScene r;
+  r.cam = make_camera(rng, s);
+  r.depth = make_depth_image(rng, r.cam, s);
+  r.objs = make_objects(rng, r.cam, s);
+  return r;
+}
+
 ObjectCullFrame frame_of(const reference::ObjectCamera& cam, uint32_t count) {
   ObjectCullFrame f;
   std::copy(cam.view, cam.view + 16, f.view);
@@ -529,10 +544,7 @@ TEST_F(ObjectCullTest, TwoPhaseMovingCameraMissesNothing) {
 TEST_F(ObjectCullTest, PayloadsAndOverflow) {
   SceneSpec s;
   s.objects = 700;
-  std::mt19937 rng(5);
-  const TestCamera cam = make_camera(rng, s);
-  const auto depth = make_depth_image(rng, cam, s);
-  const auto objs = make_objects(rng, cam, s);
+  const auto [cam, depth, objs] = random_scene(s, 5);
   GpuScene g(depth, false, objs);
   HostBuffer payloads(objs.size() * 5 * 4);
   auto* pw = static_cast<uint32_t*>(payloads.owned.mapped());
@@ -585,10 +597,7 @@ TEST_F(ObjectCullTest, PayloadsAndOverflow) {
 TEST_F(ObjectCullTest, NoObjectsWritesEmptyArguments) {
   SceneSpec s;
   s.objects = 300;
-  std::mt19937 rng(77);
-  const TestCamera cam = make_camera(rng, s);
-  const auto depth = make_depth_image(rng, cam, s);
-  const auto objs = make_objects(rng, cam, s);
+  const auto [cam, depth, objs] = random_scene(s, 77);
   GpuScene g(depth, false, objs);
   ObjectCullConfig cc;
   cc.max_objects = s.objects;
@@ -627,10 +636,7 @@ TEST_F(ObjectCullTest, NoObjectsWritesEmptyArguments) {
 TEST_F(ObjectCullTest, ManyTilesCompactInObjectOrder) {
   SceneSpec s;
   s.objects = 4096;
-  std::mt19937 rng(21);
-  const TestCamera cam = make_camera(rng, s);
-  const auto depth = make_depth_image(rng, cam, s);
-  const auto base = make_objects(rng, cam, s);
+  const auto [cam, depth, base] = random_scene(s, 21);
   const uint32_t most = 3 * 65536 + 64 + 1;  // more than two tiles of 1024 groups
   std::vector<GlintCullObject> objs(most);
   for (uint32_t i = 0; i < most; ++i) objs[i] = base[(i * 2654435761u) % base.size()];
@@ -676,10 +682,7 @@ TEST_F(ObjectCullTest, ManyTilesCompactInObjectOrder) {
 TEST_F(ObjectCullTest, ErrorsBeforeRecording) {
   SceneSpec s;
   s.objects = 64;
-  std::mt19937 rng(3);
-  const TestCamera cam = make_camera(rng, s);
-  const auto depth = make_depth_image(rng, cam, s);
-  const auto objs = make_objects(rng, cam, s);
+  const auto [cam, depth, objs] = random_scene(s, 3);
   GpuScene g(depth, false, objs);
   ObjectCullConfig cc;
   cc.max_objects = 64;
