@@ -103,7 +103,8 @@ class ObjectCuller {
 
   /// Single phase: tests all `frame.count` objects against the frustum and `hiz` (built from
   /// `depth`), writes every state to buffers.visibility and emits the visible objects. Three
-  /// dispatches (test, one-workgroup scan, scatter); the outputs are the same bits on every run.
+  /// dispatches (test, tile scan, scatter, which also writes `indirect` and `stats`); the outputs
+  /// are the same bits on every run, and nothing is carried from one record to the next.
   /// Afterwards the outputs and the visibility were last written by the compute shader stage: a
   /// draw needs a barrier to DRAW_INDIRECT / INDIRECT_COMMAND_READ for `indirect` (and `list` when
   /// it holds draw commands). Throws Error before recording anything if: frame.count exceeds

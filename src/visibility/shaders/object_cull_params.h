@@ -14,10 +14,11 @@
 #endif
 #include "glint/gpu/object_cull.h"
 
-// Objects per workgroup of object_cull.comp: one workgroup's emitted objects are one 64-bit mask
-// of the compaction's group buffer (compact_params.h), whose header words count the states.
+// Objects per group of object_cull.comp (a workgroup is several groups): one group's emitted
+// objects are one 64-bit mask of the compaction's group buffer (compact_params.h).
 #define GLINT_OBJECT_GROUP GLINT_COMPACT_GROUP
-// Counter 1 + f is count f the test packs into its group record (compact_pack_counts).
+// Count 1 + f is byte f the test packs into its group record (compact_pack_counts), and word f of
+// a tile's counts (object_cull_scan.comp); the scatter's shared totals use the same indices.
 #define GLINT_OBJECT_COUNTER_FRUSTUM 1u
 #define GLINT_OBJECT_COUNTER_OCCLUDED 2u
 #define GLINT_OBJECT_COUNTER_VISIBLE 3u
