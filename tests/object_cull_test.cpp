@@ -705,36 +705,20 @@ TEST_F(ObjectCullTest, ErrorsBeforeRecording) {
     culler.record(cmd, g.hiz, g.depth_image.state, f, g.buffers, out.out);
   };
   ObjectCullFrame f = frame_of(cam.cam, 64);
-  expect_throw("count = 65", [&](VkCommandBuffer c) {
-    auto x = f;
-    x.count = 65;
-    rec(x, c);
-  });
-  expect_throw("proj[4]", [&](VkCommandBuffer c) {
-    auto x = f;
-    x.proj[4] = 0.5f;
-    rec(x, c);
-  });
-  expect_throw("proj[11]", [&](VkCommandBuffer c) {
-    auto x = f;
-    x.proj[11] = -2.0f;
-    rec(x, c);
-  });
-  expect_throw("proj[14]", [&](VkCommandBuffer c) {
-    auto x = f;
-    x.proj[14] = -x.proj[14];
-    rec(x, c);
-  });
-  expect_throw("view[7]", [&](VkCommandBuffer c) {
-    auto x = f;
-    x.view[7] = 1.0f;
-    rec(x, c);
-  });
-  expect_throw("view[5]", [&](VkCommandBuffer c) {
-    auto x = f;
-    x.view[5] = std::nanf("");
-    rec(x, c);
-  });
+  // The frame with one field changed: record() throws naming it.
+  auto expect_frame_throw = [&](const std::string& needle, const std::function<void(ObjectCullFrame&)>& change) {
+    expect_throw(needle, [&](VkCommandBuffer c) {
+      auto x = f;
+      change(x);
+      rec(x, c);
+    });
+  };
+  expect_frame_throw("count = 65", [](ObjectCullFrame& x) { x.count = 65; });
+  expect_frame_throw("proj[4]", [](ObjectCullFrame& x) { x.proj[4] = 0.5f; });
+  expect_frame_throw("proj[11]", [](ObjectCullFrame& x) { x.proj[11] = -2.0f; });
+  expect_frame_throw("proj[14]", [](ObjectCullFrame& x) { x.proj[14] = -x.proj[14]; });
+  expect_frame_throw("view[7]", [](ObjectCullFrame& x) { x.view[7] = 1.0f; });
+  expect_frame_throw("view[5]", [](ObjectCullFrame& x) { x.view[5] = std::nanf(""); });
   expect_throw("objects buffer holds", [&](VkCommandBuffer c) {
     auto saved = g.buffers.objects;
     g.buffers.objects.size = 32;
