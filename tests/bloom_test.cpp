@@ -24,6 +24,20 @@ constexpr VkFormat kF32 = VK_FORMAT_R32G32B32A32_SFLOAT;
 
 class BloomTest : public GpuTest {};
 
+// Relative L2 error of the light a bloom added (output - input, R, G and B) against the
+// reference's; `norm` receives the reference's squared norm (0 would make the ratio meaningless).
+double added_light_rel_l2(const CpuImage& gpu, const reference::DoubleImage& ref, const CpuImage& input, double& norm) {
+  double diff = 0.0;
+  norm = 0.0;
+  for (size_t i = 0; i < gpu.rgba.size(); ++i) {
+    if (i % 4 == 3) continue;
+    const double want = ref.rgba[i] - input.rgba[i], got = double(gpu.rgba[i]) - input.rgba[i];
+    diff += (got - want) * (got - want);
+    norm += want * want;
+  }
+  return std::sqrt(diff / norm);
+}
+
 // Runs one bloom of `input` and reads the output back. The output starts poisoned with NaN.
 CpuImage run_bloom(Bloom& bloom, const CpuImage& input, VkFormat in_format, VkFormat out_format,
                    Profiler* profiler = nullptr) {
@@ -172,17 +186,11 @@ TEST_F(BloomTest, MatchesReferenceForEveryGuardAndLevel0Height) {
         const CpuImage input = random_hdr(c.w, c.h, c.w * 7 + c.h);
         const CpuImage gpu = run_bloom(bloom, input, kF32, kF32);
         ASSERT_TRUE(all_finite(gpu)) << "unwritten (poisoned) texels remain";
-        const auto ref = reference::bloom(input, config);
-        double diff = 0.0, norm = 0.0;
-        for (size_t i = 0; i < gpu.rgba.size(); ++i) {
-          if (i % 4 == 3) continue;
-          const double want = ref.rgba[i] - input.rgba[i], got = double(gpu.rgba[i]) - input.rgba[i];
-          diff += (got - want) * (got - want);
-          norm += want * want;
-        }
+        double norm = 0.0;
+        const double err = added_light_rel_l2(gpu, reference::bloom(input, config), input, norm);
         EXPECT_GT(norm, 0.0);
-        EXPECT_LT(std::sqrt(diff / norm), 1e-3) << bloom_filter_name(filter) << " guard " << firefly_guard_name(guard)
-                                                << " " << c.w << "x" << c.h << " level0_height " << c.level0_height;
+        EXPECT_LT(err, 1e-3) << bloom_filter_name(filter) << " guard " << firefly_guard_name(guard) << " " << c.w << "x"
+                             << c.h << " level0_height " << c.level0_height;
       }
     }
   }
@@ -227,18 +235,12 @@ TEST_F(BloomTest, SmoothBoxesFirstStepMatchesReference) {
         ctx->run_once([&](VkCommandBuffer cmd) { bloom.record(cmd, in.state, out.state); });
         const CpuImage gpu = detail::download(*ctx, out.state);
         ASSERT_TRUE(all_finite(gpu)) << "unwritten (poisoned) texels remain";
-        const auto ref = reference::bloom(input, config);
-        double diff = 0.0, norm = 0.0;
-        for (size_t i = 0; i < gpu.rgba.size(); ++i) {
-          if (i % 4 == 3) continue;
-          const double want = ref.rgba[i] - input.rgba[i], got = double(gpu.rgba[i]) - input.rgba[i];
-          diff += (got - want) * (got - want);
-          norm += want * want;
-        }
+        double norm = 0.0;
+        const double err = added_light_rel_l2(gpu, reference::bloom(input, config), input, norm);
         EXPECT_GT(norm, 0.0);
         const detail::Workgroup2D g = detail::choose_workgroup_2d(*ctx);
-        EXPECT_LT(std::sqrt(diff / norm), 1e-3) << bloom_filter_name(filter) << " " << size.width << "x" << size.height
-                                                << " workgroup " << g.x << "x" << g.y;
+        EXPECT_LT(err, 1e-3) << bloom_filter_name(filter) << " " << size.width << "x" << size.height << " workgroup "
+                             << g.x << "x" << g.y;
       }
     }
     if (ctx != &context()) {  // the fixture checks the program's context
