@@ -40,7 +40,6 @@ same code on the CPU for a smoke test; its times mean nothing).
 import argparse
 import json
 import math
-import statistics
 import sys
 
 try:
@@ -49,6 +48,8 @@ try:
 except ImportError:  # no torch, no failure (as the other peers)
     print("object_cull_torch.py: PyTorch is not installed; no peer numbers", file=sys.stderr)
     sys.exit(0)
+
+from peer_timing import timed_eager, timed_graph  # noqa: E402 (after the torch guard)
 
 WIDTH, HEIGHT = 1920, 1080
 FOV_Y, NEAR, FAR = 1.0, 0.1, 100.0
@@ -200,50 +201,6 @@ class SphereCull:
         self.state.copy_(state)
 
 
-def timed_graph(fn, reps, dev):
-    stream = torch.cuda.Stream()
-    stream.wait_stream(torch.cuda.current_stream())
-    with torch.cuda.stream(stream):
-        for _ in range(3):  # warm up before capture
-            fn()
-    torch.cuda.current_stream().wait_stream(stream)
-    graph = torch.cuda.CUDAGraph()
-    with torch.cuda.graph(graph):
-        fn()
-    times = []
-    for _ in range(reps):
-        start, end = torch.cuda.Event(enable_timing=True), torch.cuda.Event(enable_timing=True)
-        start.record()
-        graph.replay()
-        end.record()
-        torch.cuda.synchronize()
-        times.append(start.elapsed_time(end))
-    return statistics.median(times)
-
-
-def timed_eager(fn, reps, dev):
-    for _ in range(3):
-        fn()
-    if dev.type != "cuda":
-        import time
-        times = []
-        for _ in range(reps):
-            t = time.perf_counter()
-            fn()
-            times.append((time.perf_counter() - t) * 1e3)
-        return statistics.median(times)
-    torch.cuda.synchronize()
-    times = []
-    for _ in range(reps):
-        start, end = torch.cuda.Event(enable_timing=True), torch.cuda.Event(enable_timing=True)
-        start.record()
-        fn()
-        end.record()
-        torch.cuda.synchronize()
-        times.append(start.elapsed_time(end))
-    return statistics.median(times)
-
-
 def brute_hidden(objects, depth, count):
     """Brute force for the first `count` spheres in float64: frustum planes without margins, near
     crossing visible, else the exact projected rectangle read at every pixel of the depth image."""
@@ -304,9 +261,9 @@ def main():
                    ("sphere+hiz, nonzero, eager", cull.run_nonzero, False)]
         for label, fn, graph in methods:
             if graph and dev.type == "cuda":
-                ms = timed_graph(fn, args.reps, dev)
+                ms = timed_graph(fn, args.reps)
             else:
-                ms = timed_eager(fn, args.reps, dev)
+                ms = timed_eager(fn, args.reps, dev.type == "cuda")
             fn()  # the outputs of one more run, for the shares and the check
             state = cull.state.long().cpu()
             count = int(cull.count)

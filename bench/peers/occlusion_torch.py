@@ -18,7 +18,6 @@ Exits with status 0 and a message when PyTorch or CUDA is not available.
 """
 import argparse
 import json
-import statistics
 import sys
 
 try:
@@ -28,42 +27,7 @@ except ImportError:  # the guard the lead asked for: no torch, no failure
     print("occlusion_torch.py: PyTorch is not installed; no peer numbers", file=sys.stderr)
     sys.exit(0)
 
-
-def timed_graph(fn, reps):
-    """Median milliseconds of replays of `fn` captured in a CUDA graph."""
-    stream = torch.cuda.Stream()
-    stream.wait_stream(torch.cuda.current_stream())
-    with torch.cuda.stream(stream):
-        for _ in range(3):  # warm up before capture
-            fn()
-    torch.cuda.current_stream().wait_stream(stream)
-    graph = torch.cuda.CUDAGraph()
-    with torch.cuda.graph(graph):
-        fn()
-    times = []
-    for _ in range(reps):
-        start, end = torch.cuda.Event(enable_timing=True), torch.cuda.Event(enable_timing=True)
-        start.record()
-        graph.replay()
-        end.record()
-        torch.cuda.synchronize()
-        times.append(start.elapsed_time(end))
-    return statistics.median(times)
-
-
-def timed_eager(fn, reps):
-    for _ in range(3):
-        fn()
-    torch.cuda.synchronize()
-    times = []
-    for _ in range(reps):
-        start, end = torch.cuda.Event(enable_timing=True), torch.cuda.Event(enable_timing=True)
-        start.record()
-        fn()
-        end.record()
-        torch.cuda.synchronize()
-        times.append(start.elapsed_time(end))
-    return statistics.median(times)
+from peer_timing import timed_eager, timed_graph  # noqa: E402 (after the torch guard)
 
 
 def hiz_pyramid(depth):
