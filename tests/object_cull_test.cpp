@@ -678,6 +678,85 @@ TEST_F(ObjectCullTest, ManyTilesCompactInObjectOrder) {
   }
 }
 
+// Bounds near the ends of the fp32 range, in front of a background the Hi-Z test must see (an
+// occluder covers only the image's top-left corner): boxes whose min + max or max - min exceeds
+// FLT_MAX though every corner's view-space coordinate is far below it (a view that scales world
+// units by 0.01), and spheres so far away (w from 1e10 to 1e20) that the squares and fourth powers
+// in their tangent-slope bounds leave the fp32 range. Each keeps the reference's state; none
+// reads NaN bounds and is culled by the texel the NaN happens to pick.
+TEST_F(ObjectCullTest, ExtremeBoundsKeepTheReferenceState) {
+  const uint32_t W = 160, H = 96;
+  for (bool reversed : {false, true}) {
+    for (int scene = 0; scene < 2; ++scene) {
+      reference::ObjectCamera cam;
+      std::fill(cam.view, cam.view + 16, 0.0f);
+      const float scale = scene == 0 ? 0.01f : 1.0f;
+      cam.view[0] = cam.view[5] = cam.view[10] = scale;
+      cam.view[15] = 1.0f;
+      if (scene == 0) cam.view[12] = -2.5e36f;  // boxes around world x = 2.5e38 face the camera
+      cam.reversed_z = reversed;
+      reference::perspective(1.0, double(W) / H, 0.25, 0.0, reversed, true, cam.proj);
+      // Background (infinitely far) everywhere but a near occluder on the top-left 40 x 24 pixels.
+      const double s = cam.proj[11];
+      const float near_depth = static_cast<float>(double(cam.proj[10]) * s + cam.proj[14] / 1.0);
+      reference::DepthImage depth{W, H, std::vector<float>(size_t(W) * H, reversed ? 0.0f : 1.0f)};
+      for (uint32_t y = 0; y < 24; ++y)
+        for (uint32_t x = 0; x < 40; ++x) depth.depth[size_t(y) * W + x] = near_depth;
+      std::vector<GlintCullObject> objs;
+      auto box = [&](float x0, float x1, float z0, float z1) {
+        GlintCullObject o{};
+        o.kind = GLINT_OBJECT_BOX;
+        const float mn[3] = {x0, -100.0f, z0}, mx[3] = {x1, 100.0f, z1};
+        std::copy(mn, mn + 3, o.sphere_or_min);
+        std::copy(mx, mx + 3, o.box_max);
+        objs.push_back(o);
+      };
+      auto sphere = [&](float x, float y, float w, float r) {
+        GlintCullObject o{};
+        o.kind = GLINT_OBJECT_SPHERE;
+        const float v[4] = {x, y, -w, r};  // view = world here (w = -z)
+        std::copy(v, v + 4, o.sphere_or_min);
+        objs.push_back(o);
+      };
+      if (scene == 0) {
+        // View x in [-5.5e36, 5e35] (max - min = 6e38) and [-5e35, 5e35] (min + max = 5e38), both
+        // at w in [5, 10] (world z in [-1000, -500]).
+        box(-3e38f, 3e38f, -1000.0f, -500.0f);
+        box(2e38f, 3e38f, -1000.0f, -500.0f);
+      } else {
+        for (float w : {1e10f, 1e12f, 1e15f, 1e20f, 1e30f}) {
+          sphere(0.0f, 0.0f, w, w * 0.01f);
+          sphere(0.1f * w, -0.05f * w, w, w * 1e-3f);
+        }
+      }
+      const uint32_t n = uint32_t(objs.size());
+      GpuScene g(depth, reversed, objs);
+      ObjectCullConfig cc;
+      cc.max_objects = n;
+      cc.capacity = n;
+      cc.reversed_z = reversed;
+      ObjectCuller culler(context(), cc);
+      Outputs out(n, 0);
+      g.visibility.poison();
+      context().run_once([&](VkCommandBuffer cmd) {
+        g.hiz.record(cmd, g.depth_image.state);
+        culler.record(cmd, g.hiz, g.depth_image.state, frame_of(cam, n), g.buffers, out.out);
+        out.host(cmd);
+        to_host(cmd, g.buffers.visibility);
+      });
+      const std::string what =
+          std::string(reversed ? "reversed" : "standard") + (scene == 0 ? " huge boxes" : " far spheres");
+      const auto gpu = g.states(n);
+      const auto pyramid = reference::hiz_pyramid(depth, reversed, g.hiz.levels());
+      for (uint32_t i = 0; i < n; ++i) {
+        const auto v = reference::judge_object(objs[i], cam, depth, pyramid);
+        ASSERT_EQ(v.brute, GLINT_OBJECT_STATE_VISIBLE) << what << ": object " << i << " must be in view";
+      }
+      expect_states(gpu, objs, cam, depth, pyramid, what);
+    }
+  }
+}
+
 // Bad input throws glint::Error naming the problem, before anything is recorded.
 TEST_F(ObjectCullTest, ErrorsBeforeRecording) {
   SceneSpec s;

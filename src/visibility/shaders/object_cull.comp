@@ -144,6 +144,15 @@ vec2 box_margin(vec2 c, vec2 e0, vec2 e1, vec2 e2, float r, float s, float o, ve
 // radius r in one axis plane (w > r), widened by their fp32 error (Mara & McGuire 2013, section 3;
 // the form of zeux/niagara that divides without cancellation in the numerator's sign).
 vec2 sphere_slopes(float c, float w, float r) {
+  // The slopes are ratios: c, w and r scaled by one power of two (exact) give the same ones. A
+  // bound beyond 2^60 is scaled by 2^-100 first, so that the squares below stay in the fp32 range
+  // (c, w < 2^128 become < 2^28; w > r, and r is at least kEps w, stays normal).
+  if (max(abs(c), w) > 1152921504606846976.0) {  // 2^60
+    const float k = 7.888609052210118e-31;         // 2^-100
+    c *= k;
+    w *= k;
+    r *= k;
+  }
   const float t = sqrt(max(c * c + (w - r) * (w + r), 0.0));  // length of the tangent
   // Two reciprocals instead of three divisions: the smaller denominator t w - r |c| (> 0) is the
   // one whose reciprocal is larger. Each reciprocal and product adds a few units in the last place,
@@ -151,7 +160,9 @@ vec2 sphere_slopes(float c, float w, float r) {
   const float tc = t * c, rw = r * w, tw = t * w, rc = r * c;
   const float i_lo = 1.0 / (tw + rc), i_hi = 1.0 / (tw - rc);
   const float i_den = max(i_lo, i_hi);
-  const float err = kEps * (t * abs(c) + rw) * (tw + r * abs(c)) * (i_den * i_den);
+  // Each factor divided by the denominator on its own: the product of the two numerators (about
+  // w^4) and i_den^2 (about w^-4) leave the fp32 range from w = 2^32 on (0 x Inf, a NaN bound).
+  const float err = kEps * ((t * abs(c) + rw) * i_den) * ((tw + r * abs(c)) * i_den);
   return vec2((tc - rw) * i_lo - err, (tc + rw) * i_hi + err);
 }
 
@@ -270,7 +281,13 @@ uint test_object(vec4 w0, vec4 w1, bool frustum_only, out bool invalid, out vec4
     // c + (+-e0) + (+-e1) + (+-e2). The centre's and half extents' roundings and the sums' are a
     // few units in the last place of the terms r bounds (64 of them): each computed corner is within
     // r of the exact one, as the eight transformed corners were.
-    const vec3 mid = (a + b) * 0.5, half_ext = (b - a) * 0.5;
+    // Halved before the sum: (a + b) or (b - a) exceeds FLT_MAX for coordinates above 2^127 (the
+    // corners can still be far below it, as under a view that scales by 0.01), and the NaN the
+    // infinite half axis makes (Inf x 0) would reach the Hi-Z test. Halving is exact (normal
+    // values), and the halves' sum or difference is at most FLT_MAX. `precise`: not reassociated
+    // back into the overflowing form (SPIR-V NoContraction).
+    precise const vec3 mid = a * 0.5 + b * 0.5;
+    precise const vec3 half_ext = b * 0.5 - a * 0.5;
     float unused;
     const vec3 c = to_view(mid, unused);
     const vec3 e0 = vec3(pc.view_x[0], pc.view_y[0], pc.view_w[0]) * half_ext.x;
