@@ -11,6 +11,7 @@
 
 namespace glint {
 
+using detail::check_enum;
 using detail::check_range;
 using detail::concat;
 
@@ -21,24 +22,13 @@ void BloomConfig::validate() const {
   check_range("BloomConfig::iterations", iterations, 1, 8);
   check_range("BloomConfig::radius", radius, 0.25, 4.0);
   check_range("BloomConfig::max_brightness", max_brightness, 1e-3, 8000.0);
-  const auto f = static_cast<uint32_t>(filter);
-  if (f > GLINT_BLOOM_GAUSS9) {
-    throw Error(ErrorCode::invalid_argument,
-                concat("BloomConfig::filter = ", f, " is not a BloomFilter: accepted cod13, dual, gauss9"));
-  }
+  check_enum("BloomConfig::filter", filter, GLINT_BLOOM_GAUSS9 + 1, "BloomFilter", "cod13, dual, gauss9");
   if (level0_height != 0 && (level0_height < 8 || level0_height > 16384)) {
     throw Error(ErrorCode::invalid_argument,
                 concat("BloomConfig::level0_height = ", level0_height, " is out of range: accepted 0 or 8 to 16384"));
   }
-  const auto g = static_cast<uint32_t>(firefly_guard);
-  if (g > static_cast<uint32_t>(FireflyGuard::karis_smooth)) {
-    throw Error(ErrorCode::invalid_argument, concat("BloomConfig::firefly_guard = ", g,
-                                                    " is not a FireflyGuard: accepted off, karis, karis_smooth"));
-  }
-  const auto p = static_cast<uint32_t>(precision);
-  if (p > 1)
-    throw Error(ErrorCode::invalid_argument,
-                concat("BloomConfig::precision = ", p, " is not a Precision: accepted fp16, fp32"));
+  check_enum("BloomConfig::firefly_guard", firefly_guard, 3, "FireflyGuard", "off, karis, karis_smooth");
+  check_enum("BloomConfig::precision", precision, 2, "Precision", "fp16, fp32");
 }
 
 const char* bloom_filter_name(BloomFilter filter) {

@@ -17,11 +17,7 @@ void BlurPyramidConfig::validate() const {
   const char* names[3] = {"BlurPyramidConfig::sigma_texels[0]", "BlurPyramidConfig::sigma_texels[1]",
                           "BlurPyramidConfig::sigma_texels[2]"};
   for (int k = 0; k < 3; ++k) check_range(names[k], sigma_texels[k], 0.3, 4.0);
-  const auto p = static_cast<uint32_t>(precision);
-  if (p > 1) {
-    throw Error(ErrorCode::invalid_argument,
-                concat("BlurPyramidConfig::precision = ", p, " is not a Precision: accepted fp16, fp32"));
-  }
+  detail::check_enum("BlurPyramidConfig::precision", precision, 2, "Precision", "fp16, fp32");
 }
 
 struct BlurPyramid::Impl {

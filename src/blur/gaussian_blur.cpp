@@ -55,17 +55,8 @@ const char* to_string(BlurMethod method) { return blur_method_name(method); }
 void GaussianBlurConfig::validate() const {
   check_range("GaussianBlurConfig::sigma_px", sigma_px, 0.5, 64.0);
   check_range("GaussianBlurConfig::max_relative_error", max_relative_error, 1e-4, 1.0);
-  const auto m = static_cast<uint32_t>(method);
-  if (m > static_cast<uint32_t>(BlurMethod::dual)) {
-    throw Error(ErrorCode::invalid_argument,
-                concat("GaussianBlurConfig::method = ", m,
-                       " is not a BlurMethod: accepted automatic, separable, pyramid, dual"));
-  }
-  const auto p = static_cast<uint32_t>(precision);
-  if (p > 1) {
-    throw Error(ErrorCode::invalid_argument,
-                concat("GaussianBlurConfig::precision = ", p, " is not a Precision: accepted fp16, fp32"));
-  }
+  detail::check_enum("GaussianBlurConfig::method", method, 4, "BlurMethod", "automatic, separable, pyramid, dual");
+  detail::check_enum("GaussianBlurConfig::precision", precision, 2, "Precision", "fp16, fp32");
   const double costs[4] = {cost_model.us_per_dispatch, cost_model.us_per_byte, cost_model.us_per_shared_tap,
                            cost_model.us_per_fetch_tap};
   const char* cost_names[4] = {"us_per_dispatch", "us_per_byte", "us_per_shared_tap", "us_per_fetch_tap"};

@@ -33,6 +33,16 @@ inline void check_range(const char* name, double value, double lo, double hi) {
   }
 }
 
+/// Throws Error(invalid_argument) "NAME = V is not a TYPE: accepted ACCEPTED" unless the enum value
+/// `value` is below `count` (a config's enum field, cast from any integer by the caller).
+template <typename E>
+void check_enum(const char* name, E value, uint32_t count, const char* type, const char* accepted) {
+  const auto v = static_cast<uint32_t>(value);
+  if (v >= count) {
+    throw Error(ErrorCode::invalid_argument, concat(name, " = ", v, " is not a ", type, ": accepted ", accepted));
+  }
+}
+
 /// "VK_FORMAT_B10G11R11_UFLOAT_PACK32", ...: every VkFormat by its enumerant name (a value unknown to
 /// the headers as "VkFormat <number>"), so that every refusal names the format it refused.
 std::string format_name(VkFormat format);

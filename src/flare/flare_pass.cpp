@@ -33,10 +33,7 @@ void FlarePassConfig::validate() const {
                        " is not accepted: VK_FORMAT_D32_SFLOAT or VK_FORMAT_R32_SFLOAT"));
   }
   if (max_size_px != 0.0f) detail::check_range("FlarePassConfig::max_size_px", max_size_px, 1.0, 65536.0);
-  if (draw != FlareDrawPath::raster && draw != FlareDrawPath::compute) {
-    throw Error(ErrorCode::invalid_argument, concat("FlarePassConfig::draw = ", static_cast<uint32_t>(draw),
-                                                    " is not a FlareDrawPath: accepted raster, compute"));
-  }
+  detail::check_enum("FlarePassConfig::draw", draw, 2, "FlareDrawPath", "raster, compute");
   cull.validate();
 }
 
