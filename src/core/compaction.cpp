@@ -42,7 +42,7 @@ Compaction::Compaction(const Context& context, const Desc& desc) {
   d.bindings = {B};
   d.push_constant_bytes = sizeof(GlintCompactPush);
   d.workgroup = {scan_threads_, 1};
-  scan_tiles_ = ComputePipeline(context, d);
+  if (!desc.scan_tiles_only) scan_tiles_ = ComputePipeline(context, d);  // else the user's scan is level 1
   d.kernel_id = desc.scan_kernel;
   d.bindings.assign(1 + desc.scan_outputs, B);
   scan_ = ComputePipeline(context, d);
@@ -56,12 +56,6 @@ Compaction::Compaction(const Context& context, const Desc& desc) {
   groups_state_.buffer = groups_.buffer();
   groups_state_.size = groups_.size();
   groups_state_.usage = usage;
-}
-
-void Compaction::grid(uint32_t count, uint32_t& gx, uint32_t& gy) const {
-  const uint32_t g = std::max(1u, (count + kGroup - 1) / kGroup);
-  gx = std::min(g, max_groups_x_);
-  gy = (g + gx - 1) / gx;
 }
 
 void Compaction::record_clear_once(VkCommandBuffer cmd, Barriers& b) {

@@ -50,9 +50,6 @@ class Compaction {
   Buffer& groups() { return groups_state_; }
   /// Groups per tile of the scan (the scan workgroup's size, from the device).
   uint32_t tile_groups() const { return scan_threads_; }
-  /// 64-item workgroups covering `count` items as a 2D grid of at most maxComputeWorkGroupCount[0]
-  /// per row (the user's test and the scatter).
-  void grid(uint32_t count, uint32_t& gx, uint32_t& gy) const;
 
   /// Zeroes the header's counters the first time (the top-level scan resets them after every run).
   void record_clear_once(VkCommandBuffer cmd, Barriers& b);
