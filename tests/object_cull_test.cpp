@@ -157,6 +157,15 @@ std::vector<GlintCullObject> make_objects(std::mt19937& rng, const TestCamera& c
   return out;
 }
 
+// A culler's config for up to `objects` objects, with as many list slots.
+ObjectCullConfig config_for(uint32_t objects, bool reversed = false) {
+  ObjectCullConfig cc;
+  cc.max_objects = objects;
+  cc.capacity = objects;
+  cc.reversed_z = reversed;
+  return cc;
+}
+
 // A random scene of `s` from `seed`: camera, depth image and objects, drawn in that order.
 struct RandomScene {
   TestCamera cam;
@@ -297,10 +306,7 @@ TEST_F(ObjectCullTest, RandomScenesMatchReference) {
         const auto depth = make_depth_image(rng, cam, s);
         const auto objs = make_objects(rng, cam, s);
         GpuScene g(depth, reversed, objs, cap);
-        ObjectCullConfig cc;
-        cc.max_objects = s.objects;
-        cc.capacity = s.objects;
-        cc.reversed_z = reversed;
+        ObjectCullConfig cc = config_for(s.objects, reversed);
         cc.objects_per_group = 32;
         ObjectCuller culler(context(), cc);
         Outputs out(cc.capacity, 0);
@@ -384,10 +390,7 @@ TEST_F(ObjectCullTest, EveryTestKernelMatchesReference) {
       std::stable_partition(objs.begin(), objs.end(),
                             [](const GlintCullObject& o) { return o.kind != GLINT_OBJECT_BOX; });
     GpuScene g(depth, reversed, objs);
-    ObjectCullConfig cc;
-    cc.max_objects = s.objects;
-    cc.capacity = s.objects;
-    cc.reversed_z = reversed;
+    ObjectCullConfig cc = config_for(s.objects, reversed);
     ObjectCuller culler(context(), cc);
     const auto pyramid = reference::hiz_pyramid(depth, reversed, g.hiz.levels());
     const ObjectCullFrame frame = frame_of(cam.cam, s.objects);
@@ -445,10 +448,7 @@ TEST_F(ObjectCullTest, TwoPhaseMovingCameraMissesNothing) {
     std::mt19937 rng(77 + reversed);
     TestCamera cam = make_camera(rng, s);
     const auto objs = make_objects(rng, cam, s);
-    ObjectCullConfig cc;
-    cc.max_objects = s.objects;
-    cc.capacity = s.objects;
-    cc.reversed_z = reversed;
+    ObjectCullConfig cc = config_for(s.objects, reversed);
     ObjectCuller culler(context(), cc);
     Outputs early(cc.capacity, 0), late(cc.capacity, 0), single(cc.capacity, 0);
     auto depth = make_depth_image(rng, cam, s);
@@ -599,9 +599,7 @@ TEST_F(ObjectCullTest, NoObjectsWritesEmptyArguments) {
   s.objects = 300;
   const auto [cam, depth, objs] = random_scene(s, 77);
   GpuScene g(depth, false, objs);
-  ObjectCullConfig cc;
-  cc.max_objects = s.objects;
-  cc.capacity = s.objects;
+  ObjectCullConfig cc = config_for(s.objects);
   ObjectCuller culler(context(), cc);
   for (uint32_t count : {0u, s.objects, 0u}) {
     Outputs out(cc.capacity, 0);
@@ -642,9 +640,7 @@ TEST_F(ObjectCullTest, ManyTilesCompactInObjectOrder) {
   for (uint32_t i = 0; i < most; ++i) objs[i] = base[(i * 2654435761u) % base.size()];
   GpuScene g(depth, false, objs);
   for (uint32_t count : {most, 131072u, 131073u, 4109u}) {
-    ObjectCullConfig cc;
-    cc.max_objects = most;
-    cc.capacity = most;
+    ObjectCullConfig cc = config_for(most);
     ObjectCuller culler(context(), cc);
     Outputs out(most, 0);
     const ObjectCullFrame frame = frame_of(cam.cam, count);
@@ -731,10 +727,7 @@ TEST_F(ObjectCullTest, ExtremeBoundsKeepTheReferenceState) {
       }
       const uint32_t n = uint32_t(objs.size());
       GpuScene g(depth, reversed, objs);
-      ObjectCullConfig cc;
-      cc.max_objects = n;
-      cc.capacity = n;
-      cc.reversed_z = reversed;
+      ObjectCullConfig cc = config_for(n, reversed);
       ObjectCuller culler(context(), cc);
       Outputs out(n, 0);
       g.visibility.poison();
@@ -763,9 +756,7 @@ TEST_F(ObjectCullTest, ErrorsBeforeRecording) {
   s.objects = 64;
   const auto [cam, depth, objs] = random_scene(s, 3);
   GpuScene g(depth, false, objs);
-  ObjectCullConfig cc;
-  cc.max_objects = 64;
-  cc.capacity = 64;
+  ObjectCullConfig cc = config_for(64);
   ObjectCuller culler(context(), cc);
   Outputs out(64, 0);
   auto expect_throw = [&](const std::string& needle, const std::function<void(VkCommandBuffer)>& f) {
