@@ -627,10 +627,13 @@ TEST_F(ObjectCullTest, NoObjectsWritesEmptyArguments) {
   }
 }
 
-// The two-level scan over many tiles (a tile is up to 1024 groups of 64 objects, 64 groups on CPU
-// devices): the list holds exactly the objects the cull left VISIBLE, in increasing index, with
-// the count and statistics (every state's count) to match, for counts that end inside a group, on
-// a tile boundary and one past it. The objects repeat a random scene's, so every tile has visible and hidden ones.
+// The tile scan and the scatter over many tiles (a tile is up to 1024 groups of 64 objects, 64
+// groups on CPU devices), with both scan kernels (the subgroup one where the device has it, and the
+// shared-memory one the shared-atomic test kernels run with): the list holds exactly the objects
+// the cull left VISIBLE, in increasing index, with the count and statistics (every state's count)
+// to match, for counts that end inside a group, on a tile boundary and one past it. One culler
+// runs every count in turn, so anything left from a larger cull would show. The objects repeat a
+// random scene's, so every tile has visible and hidden ones.
 TEST_F(ObjectCullTest, ManyTilesCompactInObjectOrder) {
   SceneSpec s;
   s.objects = 4096;
@@ -639,38 +642,41 @@ TEST_F(ObjectCullTest, ManyTilesCompactInObjectOrder) {
   std::vector<GlintCullObject> objs(most);
   for (uint32_t i = 0; i < most; ++i) objs[i] = base[(i * 2654435761u) % base.size()];
   GpuScene g(depth, false, objs);
-  for (uint32_t count : {most, 131072u, 131073u, 4109u}) {
-    ObjectCullConfig cc = config_for(most);
-    ObjectCuller culler(context(), cc);
-    Outputs out(most, 0);
-    const ObjectCullFrame frame = frame_of(cam.cam, count);
-    g.visibility.poison();
-    context().run_once([&](VkCommandBuffer cmd) {
-      g.hiz.record(cmd, g.depth_image.state);
-      culler.record(cmd, g.hiz, g.depth_image.state, frame, g.buffers, out.out);
-      out.host(cmd);
-      to_host(cmd, g.buffers.visibility);
-    });
-    const auto states = g.states(count);
-    std::vector<uint32_t> expected;
-    uint32_t counts[4] = {};
-    for (uint32_t i = 0; i < count; ++i) {
-      if (states[i] == GLINT_OBJECT_STATE_VISIBLE) expected.push_back(i);
-      ASSERT_LE(states[i], 3u) << i;
-      counts[states[i]]++;
+  ObjectCuller culler(context(), config_for(most));
+  for (const auto kernel : {detail::ObjectCullKernel::current, detail::ObjectCullKernel::shared_atomics}) {
+    detail::object_cull_select_kernel(culler, kernel);
+    for (uint32_t count : {most, 131072u, 131073u, 4109u}) {
+      SCOPED_TRACE(kernel == detail::ObjectCullKernel::current ? "current kernels" : "shared-atomic kernels");
+      Outputs out(most, 0);
+      const ObjectCullFrame frame = frame_of(cam.cam, count);
+      g.visibility.poison();
+      context().run_once([&](VkCommandBuffer cmd) {
+        g.hiz.record(cmd, g.depth_image.state);
+        culler.record(cmd, g.hiz, g.depth_image.state, frame, g.buffers, out.out);
+        out.host(cmd);
+        to_host(cmd, g.buffers.visibility);
+      });
+      const auto states = g.states(count);
+      std::vector<uint32_t> expected;
+      uint32_t counts[4] = {};
+      for (uint32_t i = 0; i < count; ++i) {
+        if (states[i] == GLINT_OBJECT_STATE_VISIBLE) expected.push_back(i);
+        ASSERT_LE(states[i], 3u) << i;
+        counts[states[i]]++;
+      }
+      // The statistics sum every tile's counts (the tile scan adds the groups' counts).
+      EXPECT_EQ(out.st().visible, counts[GLINT_OBJECT_STATE_VISIBLE]) << count;
+      EXPECT_EQ(out.st().occluded, counts[GLINT_OBJECT_STATE_OCCLUDED]) << count;
+      EXPECT_EQ(out.st().frustum_culled, counts[GLINT_OBJECT_STATE_FRUSTUM]) << count;
+      EXPECT_EQ(counts[GLINT_OBJECT_STATE_NONE], 0u) << count;
+      ASSERT_GT(expected.size(), count / 100) << count;
+      ASSERT_LT(expected.size(), count) << count;
+      EXPECT_EQ(out.args().draw_count, expected.size()) << count;
+      EXPECT_EQ(out.st().emitted, expected.size()) << count;
+      EXPECT_EQ(out.st().total, count);
+      const auto list = out.words(expected.size());
+      EXPECT_TRUE(list == expected) << count << ": the list is not the visible objects in order";
     }
-    // The statistics sum every tile's groups (the tile scan adds the groups' counts).
-    EXPECT_EQ(out.st().visible, counts[GLINT_OBJECT_STATE_VISIBLE]) << count;
-    EXPECT_EQ(out.st().occluded, counts[GLINT_OBJECT_STATE_OCCLUDED]) << count;
-    EXPECT_EQ(out.st().frustum_culled, counts[GLINT_OBJECT_STATE_FRUSTUM]) << count;
-    EXPECT_EQ(counts[GLINT_OBJECT_STATE_NONE], 0u) << count;
-    ASSERT_GT(expected.size(), count / 100) << count;
-    ASSERT_LT(expected.size(), count) << count;
-    EXPECT_EQ(out.args().draw_count, expected.size()) << count;
-    EXPECT_EQ(out.st().emitted, expected.size()) << count;
-    EXPECT_EQ(out.st().total, count);
-    const auto list = out.words(expected.size());
-    EXPECT_TRUE(list == expected) << count << ": the list is not the visible objects in order";
   }
 }
 

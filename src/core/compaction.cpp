@@ -27,7 +27,6 @@ Compaction::Compaction(const Context& context, const Desc& desc) {
   }
   if (desc.scatter_groups < 1) throw Error(ErrorCode::invalid_argument, "Compaction: scatter_groups must be >= 1");
   scatter_groups_ = desc.scatter_groups;
-  scan_tiles_only_ = desc.scan_tiles_only;
   VkPhysicalDeviceProperties props;
   vkGetPhysicalDeviceProperties(context.physical_device(), &props);
   max_groups_x_ = props.limits.maxComputeWorkGroupCount[0];
@@ -42,10 +41,12 @@ Compaction::Compaction(const Context& context, const Desc& desc) {
   d.bindings = {B};
   d.push_constant_bytes = sizeof(GlintCompactPush);
   d.workgroup = {scan_threads_, 1};
-  if (!desc.scan_tiles_only) scan_tiles_ = ComputePipeline(context, d);  // else the user's scan is level 1
-  d.kernel_id = desc.scan_kernel;
-  d.bindings.assign(1 + desc.scan_outputs, B);
-  scan_ = ComputePipeline(context, d);
+  if (!desc.scan_kernel.empty()) {
+    scan_tiles_ = ComputePipeline(context, d);
+    d.kernel_id = desc.scan_kernel;
+    d.bindings.assign(1 + desc.scan_outputs, B);
+    scan_ = ComputePipeline(context, d);
+  }
   d.kernel_id = desc.scatter_kernel;
   d.bindings.assign(1 + desc.scatter_inputs + desc.scatter_outputs, B);
   d.workgroup = {kGroup, 1};
@@ -75,14 +76,7 @@ void Compaction::record_scan(VkCommandBuffer cmd, Barriers& b, GlintCompactPush 
   push.tile_groups = scan_threads_;
   const uint32_t group_count = (push.count + kGroup - 1) / kGroup;
   const uint32_t tiles = (group_count + scan_threads_ - 1) / scan_threads_;
-  if (scan_tiles_only_) {  // one workgroup per tile
-    if (tiles == 0) return;
-    b.use(groups_state_, kCompute, kRead | kWrite);
-    for (Buffer* o : outputs) b.use(*o, kCompute, kWrite);
-    b.flush(cmd);
-    scan_.dispatch(cmd, top, push, tiles * scan_threads_, 1);
-    return;
-  }
+  if (!scan_) throw Error(ErrorCode::invalid_argument, "Compaction::record_scan: no scan kernel was given");
   // 1. Tiles of scan_threads groups in parallel: slots within each tile, tile totals.
   if (group_count > 0) {
     b.use(groups_state_, kCompute, kRead | kWrite);

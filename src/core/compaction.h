@@ -2,9 +2,9 @@
 // docs/OCCLUSION.md "The shared compaction core"): the user's test kernel sets one bit per emitted item in
 // its 64-item group's mask of the group buffer this owns; record_scan() runs the two-level scan
 // (compact_scan_tiles.comp, then the user's top-level scan, which writes the user's indirect
-// arguments and statistics and resets the header's counters; or, with Desc::scan_tiles_only, the
-// user's own tile scan alone); record_scatter() runs the user's scatter, which puts every emitted
-// item's record into its slot in item order, clamped to the capacity.
+// arguments and statistics and resets the header's counters); record_scatter() runs the user's
+// scatter, which puts every emitted item's record into its slot in item order, clamped to the
+// capacity. A user with no top-level scan kernel (the object cull) records its own tile scan.
 #pragma once
 
 #include <glint/glint.h>
@@ -26,13 +26,11 @@ class Compaction {
   struct Desc {
     uint32_t max_items = 1;  //!< items of the largest run (a group buffer of ceil(max_items / 64) groups)
     /// The user's top-level scan (compact_top_scan of compact.glsl, then its outputs): binding 0
-    /// the group buffer, then `scan_outputs` storage buffers it writes.
+    /// the group buffer, then `scan_outputs` storage buffers it writes. Empty: no scan pipeline is
+    /// made (the user dispatches its own tile scan, one workgroup of tile_groups() invocations per
+    /// tile, and its scatter adds the totals of the tiles before each item's tile itself).
     std::string scan_kernel;
     uint32_t scan_outputs = 2;
-    /// The user's scan kernel is the first level only, one workgroup per tile (compact_tile_scan or
-    /// compact_tile_scan_counts), in place of compact_scan_tiles.comp and the top-level dispatch:
-    /// the user's scatter then adds the totals of the tiles before each item's tile itself.
-    bool scan_tiles_only = false;
     /// The scatter: one workgroup of 64 invocations per `scatter_groups` consecutive groups (a 2D
     /// grid, groups_x per row; at least one workgroup, also for no items); binding 0 the group
     /// buffer, then `scatter_inputs` storage buffers it reads and `scatter_outputs` it writes.
@@ -66,7 +64,6 @@ class Compaction {
   uint32_t max_groups_x_ = 65535;
   uint32_t scan_threads_ = 1;
   uint32_t scatter_groups_ = 1;
-  bool scan_tiles_only_ = false;
   ComputePipeline scan_tiles_, scan_, scatter_;
   OwnedBuffer groups_;
   Buffer groups_state_;

@@ -16,5 +16,6 @@ set(GLINT_EFFECT_KERNELS
   "shaders/object_cull|phase1_subgroup|GLINT_OBJECT_PHASE1=1+GLINT_OBJECT_SUBGROUP=1"
   "shaders/object_cull_v1|main|"
   "shaders/object_cull_scan|main|"
+  "shaders/object_cull_scan|main_subgroup|GLINT_OBJECT_SUBGROUP=1"
   "shaders/object_cull_scatter|main|"
 )

@@ -186,9 +186,11 @@ struct ObjectCuller::Impl {
   uint32_t test_threads = kGroup;
   detail::ObjectCullKernel kernel = detail::ObjectCullKernel::current;
   // The ordered compaction of the emitted objects (core/compaction.h): its group buffer holds the
-  // test's masks and packed counts; object_cull_scan.comp scans each tile, object_cull_scatter.comp
-  // writes the payloads, the arguments and the statistics.
+  // test's masks and packed counts; object_cull_scan.comp (`scan`, its subgroup variant where the
+  // device supports it; `scan_atomic` with the shared-atomic test kernels) scans each tile,
+  // object_cull_scatter.comp writes the payloads, the arguments and the statistics.
   detail::Compaction compact;
+  detail::ComputePipeline scan, scan_atomic;
   detail::OwnedBuffer dummy;
   Buffer dummy_state;
   // Each tile's counts of the four states (object_cull_scan.comp writes them every cull, the
@@ -304,13 +306,15 @@ ObjectCuller::ObjectCuller(const Context& context, const ObjectCullConfig& confi
   m.phase1 = detail::ComputePipeline(context, d);
   detail::Compaction::Desc cd;
   cd.max_items = config.max_objects;
-  cd.scan_kernel = "object_cull_scan_main";  // tiles only: slots, totals, counts
-  cd.scan_outputs = 1;                       // (the tile counts)
-  cd.scan_tiles_only = true;
   cd.scatter_kernel = "object_cull_scatter_main";  // reads payloads and tile counts; writes the
   cd.scatter_inputs = 2;                           // list, the arguments and the statistics
   cd.scatter_outputs = 3;
-  m.compact = detail::Compaction(context, cd);
+  m.compact = detail::Compaction(context, cd);  // no top-level scan: this records its tile scan
+  d.kernel_id = m.subgroup ? "object_cull_scan_main_subgroup" : "object_cull_scan_main";
+  d.bindings = {B, B};
+  d.push_constant_bytes = sizeof(GlintObjectCompactPush);
+  d.workgroup = {m.compact.tile_groups(), 1};
+  m.scan = detail::ComputePipeline(context, d);
   const uint64_t tiles = (groups + m.compact.tile_groups() - 1) / m.compact.tile_groups();
   m.tile_counts =
       detail::OwnedBuffer(context, std::max<uint64_t>(1, tiles) * 16, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, false);
@@ -392,8 +396,16 @@ void ObjectCuller::Impl::run(VkCommandBuffer cmd, HiZPyramid* hiz, Image* depth,
   GlintCompactPush cp;
   static_assert(sizeof(cp) == sizeof(op));
   std::memcpy(&cp, &op, sizeof(cp));
-  // 2. Scan: each tile's slots, total and counts.
-  compact.record_scan(cmd, b, cp, {&tile_counts_state});
+  // 2. Scan: each tile's slots, total and counts (one workgroup per tile).
+  const uint32_t tile_groups = compact.tile_groups();
+  const uint32_t tiles = ((count + kGroup - 1) / kGroup + tile_groups - 1) / tile_groups;
+  if (tiles > 0) {
+    b.use(groups_state, kCompute, kRead | kWrite);
+    b.use(tile_counts_state, kCompute, kWrite);
+    b.flush(cmd);
+    op.tile_groups = tile_groups;
+    (atomic ? scan_atomic : scan).dispatch(cmd, {groups_state, tile_counts_state}, op, tiles * tile_groups, 1);
+  }
   if (profiler) profiler->mark(cmd, "object cull scan");
   // 3. Scatter: payloads in object order (each workgroup adds the earlier tiles' totals); the
   //    arguments and statistics.
@@ -467,6 +479,11 @@ void object_cull_select_kernel(ObjectCuller& culler, ObjectCullKernel kernel) {
     d.kernel_id = "object_cull_phase1";
     d.bindings = {B, B, B};
     m.phase1_atomic = ComputePipeline(*m.context, d);
+    d.kernel_id = "object_cull_scan_main";
+    d.bindings = {B, B};
+    d.push_constant_bytes = sizeof(GlintObjectCompactPush);
+    d.workgroup = {m.compact.tile_groups(), 1};
+    m.scan_atomic = ComputePipeline(*m.context, d);
   }
   m.kernel = kernel;
 }
