@@ -34,10 +34,12 @@
 //    tile scans it, the last tile the tile totals) was measured slower on the H100
 //    (docs/OCCLUSION.md, "Cost"): every workgroup then pays a device-scope barrier and an atomic
 //    before it retires.
-// 7. A workgroup is 256 objects (four groups of 64). When it holds both kinds, it sorts them
+// 7. A workgroup is 128 objects (two groups of 64; 256 on CPU devices). When it holds both kinds, it sorts them
 //    through shared memory (spheres from the first slot, boxes from the last) before the test, so
 //    a subgroup runs one kind's code; the results go back to object order for the writes. A
-//    workgroup of one kind tests its objects where they are.
+//    workgroup of one kind tests its objects where they are. 256-object workgroups were slower on
+//    the H100 (fewer invocations fit its registers), 64-object ones slower on mixed scenes (a
+//    subgroup more often holds both kinds): docs/OCCLUSION.md, "Cost".
 // GLINT_OBJECT_PHASE1 builds the phase-1 variant, which binds no image (the depth image may be a
 // render target while phase 1 runs).
 // Cost (docs/OCCLUSION.md, "Cost"): one wave of latency-bound invocations, so the kernel keeps
@@ -79,8 +81,8 @@ layout(std430, binding = BINDING_VISIBILITY) buffer Visibility { uint visibility
 #include "compact.glsl"
 layout(push_constant) uniform Push { GlintObjectCullPush pc; };
 
-// A workgroup is kGroups groups of 64 objects (the host picks 256 invocations where the device
-// allows, else fewer, a multiple of 64).
+// A workgroup is kGroups groups of 64 objects (the host picks 128 invocations, which every
+// Vulkan device allows; 256 on CPU devices).
 const uint kThreads = gl_WorkGroupSize.x;
 const uint kGroups = (kThreads + GLINT_OBJECT_GROUP - 1u) / GLINT_OBJECT_GROUP;  // kThreads is a multiple of 64
 const uint kNotTested = 0x80000000u;
