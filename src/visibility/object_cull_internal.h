@@ -18,6 +18,10 @@ enum class ObjectCullKernel : uint32_t {
   /// object_cull_v1.comp (the same test before the cost work of docs/OCCLUSION.md "Cost") for the
   /// single-phase record(); phase 1 and 2 run `current`. glint_bench times it against `current`.
   previous,
+  /// `current`, with the subgroup tile scan forced onto the serial path it takes where a subgroup's
+  /// invocations are not consecutive (object_cull_scan.comp): the tests reach that path on any
+  /// device with the subgroup variants (elsewhere this is `current`).
+  serial_scan,
 };
 
 /// Selects the kernel `culler` records from now on.

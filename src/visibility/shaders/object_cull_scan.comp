@@ -1,10 +1,11 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #ifdef GLINT_OBJECT_SUBGROUP
-// The variant the host picks where the device's subgroups support arithmetic in compute
-// (VkPhysicalDeviceSubgroupProperties), as for object_cull.comp.
+// The variant the host picks where the device's subgroups support arithmetic and ballots in
+// compute (VkPhysicalDeviceSubgroupProperties), as for object_cull.comp.
 #extension GL_KHR_shader_subgroup_basic : require
 #extension GL_KHR_shader_subgroup_arithmetic : require
+#extension GL_KHR_shader_subgroup_ballot : require
 #endif
 // The object cull's scan of the test's masks (the ordered compaction, compact.glsl): workgroup k
 // scans tile k (each group's slot within the tile into its z, the tile's total into its first
@@ -16,6 +17,8 @@
 // the subgroups' totals: two barriers, where the shared-memory scan of compact.glsl takes two per
 // doubling (ten for a tile of 1024 groups) and its counts contend for shared atomics. The scan
 // dispatch is short and one workgroup's latency is much of it (docs/OCCLUSION.md, "Cost").
+// GLINT_OBJECT_SCAN_SERIAL builds the variant that takes the serial path (for subgroups that do
+// not hold consecutive invocations) on every device, so that the tests reach it.
 layout(local_size_x_id = 0, local_size_y_id = 1) in;
 
 #define COMPACT_GROUPS_BINDING 0
@@ -30,12 +33,14 @@ layout(std430, binding = 1) writeonly buffer TileCounts { uvec4 tile_counts[]; }
 layout(push_constant) uniform Push { GlintObjectCompactPush pc; };
 
 #ifdef GLINT_OBJECT_SUBGROUP
-// Per subgroup (at most one per invocation, for any subgroup size): its emitted objects, then its
-// exclusive offset in the tile; its counts as 16-bit halves (frustum | occluded << 16, visible |
-// invalid << 16: at most 128 invocations x 64 objects each, below 2^16).
+// Each invocation's group count (then, on the serial path, its exclusive prefix), and per
+// subgroup (at most one per invocation, for any subgroup size) its total with kOutOfOrder, then its
+// exclusive offset in the tile.
+shared uint s_n[GLINT_COMPACT_SCAN_MAX_THREADS];
 shared uint s_sub[GLINT_COMPACT_SCAN_MAX_THREADS];
-shared uvec2 s_sub_counts[GLINT_COMPACT_SCAN_MAX_THREADS];
-shared uint s_tile_total;
+shared uint s_counts[4];
+shared uint s_tile_total, s_serial;
+const uint kOutOfOrder = 0x80000000u;  // the subgroup's invocations are not consecutive in t order
 
 void main() {
   const uint threads = gl_WorkGroupSize.x * gl_WorkGroupSize.y;
@@ -48,40 +53,60 @@ void main() {
     n = uint(bitCount(v.x) + bitCount(v.y));
     packed = v.z;  // the test's four counts, a byte each (compact_pack_counts)
   }
+  if (t < 4u) s_counts[t] = 0u;
+  s_n[t] = n;
+  // The prefix within a subgroup is in t order only where the subgroup holds consecutive
+  // invocations in order; Vulkan does not promise that mapping (it holds on the devices of
+  // docs/DEVICES.md), so each subgroup checks it, and a tile with a subgroup out of order is
+  // scanned serially below.
+  const bool in_order =
+      subgroupBallotBitCount(subgroupBallot(t != gl_SubgroupID * gl_SubgroupSize + gl_SubgroupInvocationID)) == 0u;
   const uint incl = subgroupInclusiveAdd(n);
   const uint sub_total = subgroupAdd(n);
-  const uvec2 sub_counts = subgroupAdd(uvec2((packed & 0xffu) | (((packed >> 8u) & 0xffu) << 16u),
-                                             ((packed >> 16u) & 0xffu) | ((packed >> 24u) << 16u)));
-  if (subgroupElect()) {
-    s_sub[gl_SubgroupID] = sub_total;
-    s_sub_counts[gl_SubgroupID] = sub_counts;
-  }
+  const uvec4 sub_counts = subgroupAdd(uvec4(packed & 0xffu, (packed >> 8u) & 0xffu, (packed >> 16u) & 0xffu, packed >> 24u));
+#ifdef GLINT_OBJECT_SCAN_SERIAL
+  const bool out_of_order = true;  // the test variant: the serial path on any device
+#else
+  const bool out_of_order = !in_order;
+#endif
+  if (subgroupElect()) s_sub[gl_SubgroupID] = sub_total | (out_of_order ? kOutOfOrder : 0u);
   barrier();
-  // Subgroup 0: the subgroups' exclusive offsets (in chunks of its size, with a running carry),
-  // the tile's total and its counts.
+  if (subgroupElect()) {  // integer sums: the same in any order
+    for (uint f = 0u; f < 4u; ++f) {
+      if (sub_counts[f] != 0u) atomicAdd(s_counts[f], sub_counts[f]);
+    }
+  }
+  // Subgroup 0: the subgroups' exclusive offsets (in chunks of its size, with a running carry) and
+  // the tile's total; where a subgroup is out of order, one invocation scans the groups in t order.
   if (gl_SubgroupID == 0u) {
     uint carry = 0u;
-    uvec4 c = uvec4(0u);
+    bool serial = false;
     for (uint base = 0u; base < gl_NumSubgroups; base += gl_SubgroupSize) {
       const uint k = base + gl_SubgroupInvocationID;
-      const uint x = k < gl_NumSubgroups ? s_sub[k] : 0u;
+      const uint w = k < gl_NumSubgroups ? s_sub[k] : 0u;
+      serial = serial || subgroupBallotBitCount(subgroupBallot((w & kOutOfOrder) != 0u)) != 0u;
+      const uint x = w & ~kOutOfOrder;
       const uint before = subgroupExclusiveAdd(x);
-      if (k < gl_NumSubgroups) {
-        const uvec2 h = s_sub_counts[k];
-        c += uvec4(h.x & 0xffffu, h.x >> 16u, h.y & 0xffffu, h.y >> 16u);
-        s_sub[k] = carry + before;
-      }
+      if (k < gl_NumSubgroups) s_sub[k] = carry + before;
       carry += subgroupAdd(x);
     }
-    c = subgroupAdd(c);
     if (subgroupElect()) {
+      if (serial) {
+        uint run = 0u;
+        for (uint k = 0u; k < threads; ++k) {
+          const uint x = s_n[k];
+          s_n[k] = run;
+          run += x;
+        }
+      }
       s_tile_total = carry;
-      tile_counts[gl_WorkGroupID.x] = c;
+      s_serial = serial ? 1u : 0u;
     }
   }
   barrier();
-  if (g < group_count) groups[g].z = s_sub[gl_SubgroupID] + incl - n;
+  if (g < group_count) groups[g].z = s_serial != 0u ? s_n[t] : s_sub[gl_SubgroupID] + incl - n;
   if (t == 0u) groups[g].w = s_tile_total;  // g is the tile's first group
+  if (t < 4u) tile_counts[gl_WorkGroupID.x][t] = s_counts[t];
 }
 #else
 void main() {
