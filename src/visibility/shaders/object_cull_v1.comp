@@ -92,11 +92,21 @@ vec2 plane_margin(float c, float w, float r, float s, float o, vec2 len) {
 // radius r in one axis plane (w > r), widened by their fp32 error (Mara & McGuire 2013, section 3;
 // the form of zeux/niagara that divides without cancellation in the numerator's sign).
 vec2 sphere_slopes(float c, float w, float r) {
+  // Beyond 2^60 the bound is scaled by 2^-100 (exact; the slopes are ratios), so that the squares
+  // below stay in the fp32 range, as in object_cull.comp.
+  if (max(abs(c), w) > 1152921504606846976.0) {  // 2^60
+    const float k = 7.888609052210118e-31;         // 2^-100
+    c *= k;
+    w *= k;
+    r *= k;
+  }
   const float t = sqrt(max(c * c + (w - r) * (w + r), 0.0));  // length of the tangent
   const float lo = (t * c - r * w) / (t * w + r * c);
   const float hi = (t * c + r * w) / (t * w - r * c);
   const float den = t * w - r * abs(c);                        // the smaller denominator, > 0
-  const float err = kEps * (t * abs(c) + r * w) * (t * w + r * abs(c)) / (den * den);
+  // Each factor divided by den on its own: their product (about w^4) and den^2 leave the fp32
+  // range from w = 2^32 on (a NaN or zero bound).
+  const float err = kEps * ((t * abs(c) + r * w) / den) * ((t * w + r * abs(c)) / den);
   return vec2(lo - err, hi + err);
 }
 
