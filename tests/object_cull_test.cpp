@@ -629,8 +629,10 @@ TEST_F(ObjectCullTest, NoObjectsWritesEmptyArguments) {
 
 // The tile scan and the scatter over many tiles (a tile is up to 1024 groups of 64 objects, 64
 // groups on CPU devices), with every scan kernel (the subgroup one where the device has it, the
-// same forced onto the serial path it takes where a subgroup's invocations are out of order, and
-// the shared-memory one the shared-atomic test kernels run with): the list holds exactly the objects
+// same forced onto the serial path it takes where a subgroup's invocations are out of order, the
+// same as a device would run it that launches subgroup 0 with inactive invocations (half of them
+// sit out; half of the subgroups report themselves out of order), and the shared-memory one the
+// shared-atomic test kernels run with): the list holds exactly the objects
 // the cull left VISIBLE, in increasing index, with the count and statistics (every state's count)
 // to match, for counts that end inside a group, on a tile boundary and one past it. One culler
 // runs every count in turn, so anything left from a larger cull would show. The objects repeat a
@@ -645,14 +647,17 @@ TEST_F(ObjectCullTest, ManyTilesCompactInObjectOrder) {
   GpuScene g(depth, false, objs);
   ObjectCuller culler(context(), config_for(most));
   using detail::ObjectCullKernel;
-  for (const auto kernel :
-       {ObjectCullKernel::current, ObjectCullKernel::shared_atomics, ObjectCullKernel::serial_scan}) {
-    if (kernel == ObjectCullKernel::serial_scan && !detail::object_cull_has_subgroup_variant(culler)) continue;
+  for (const auto kernel : {ObjectCullKernel::current, ObjectCullKernel::shared_atomics, ObjectCullKernel::serial_scan,
+                            ObjectCullKernel::partial_scan}) {
+    if ((kernel == ObjectCullKernel::serial_scan || kernel == ObjectCullKernel::partial_scan) &&
+        !detail::object_cull_has_subgroup_variant(culler))
+      continue;
     detail::object_cull_select_kernel(culler, kernel);
     for (uint32_t count : {most, 131072u, 131073u, 4109u}) {
       SCOPED_TRACE(kernel == ObjectCullKernel::current          ? "current kernels"
                    : kernel == ObjectCullKernel::shared_atomics ? "shared-atomic kernels"
-                                                                : "subgroup scan on its serial path");
+                   : kernel == ObjectCullKernel::serial_scan    ? "subgroup scan on its serial path"
+                                                                : "subgroup scan with a partial subgroup 0");
       Outputs out(most, 0);
       const ObjectCullFrame frame = frame_of(cam.cam, count);
       g.visibility.poison();

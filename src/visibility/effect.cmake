@@ -18,5 +18,6 @@ set(GLINT_EFFECT_KERNELS
   "shaders/object_cull_scan|main|"
   "shaders/object_cull_scan|main_subgroup|GLINT_OBJECT_SUBGROUP=1"
   "shaders/object_cull_scan|main_serial|GLINT_OBJECT_SUBGROUP=1+GLINT_OBJECT_SCAN_SERIAL=1"
+  "shaders/object_cull_scan|main_partial|GLINT_OBJECT_SUBGROUP=1+GLINT_OBJECT_SCAN_PARTIAL=1"
   "shaders/object_cull_scatter|main|"
 )

@@ -192,7 +192,7 @@ struct ObjectCuller::Impl {
   // device supports it; `scan_atomic` with the shared-atomic test kernels) scans each tile,
   // object_cull_scatter.comp writes the payloads, the arguments and the statistics.
   detail::Compaction compact;
-  detail::ComputePipeline scan, scan_atomic, scan_serial;
+  detail::ComputePipeline scan, scan_atomic, scan_serial, scan_partial;
   detail::OwnedBuffer dummy;
   Buffer dummy_state;
   // Each tile's counts of the four states (object_cull_scan.comp writes them every cull, the
@@ -352,6 +352,7 @@ void ObjectCuller::Impl::run(VkCommandBuffer cmd, HiZPyramid* hiz, Image* depth,
   using detail::ObjectCullKernel;
   const bool atomic = kernel == ObjectCullKernel::shared_atomics;
   const bool serial = kernel == ObjectCullKernel::serial_scan && scan_serial;
+  const bool partial = kernel == ObjectCullKernel::partial_scan && scan_partial;
   const bool v1 = kernel == ObjectCullKernel::previous && mode == GLINT_OBJECT_MODE_SINGLE;
   // The test's descriptors: depth and Hi-Z (not in phase 1), objects, visibility, group records.
   detail::Bindings test;
@@ -411,9 +412,10 @@ void ObjectCuller::Impl::run(VkCommandBuffer cmd, HiZPyramid* hiz, Image* depth,
     b.use(tile_counts_state, kCompute, kWrite);
     b.flush(cmd);
     op.tile_groups = tile_groups;
-    (atomic   ? scan_atomic
-     : serial ? scan_serial
-              : scan)
+    (atomic    ? scan_atomic
+     : serial  ? scan_serial
+     : partial ? scan_partial
+               : scan)
         .dispatch(cmd, {groups_state, tile_counts_state}, op, tiles * tile_groups, 1);
   }
   if (profiler) profiler->mark(cmd, "object cull scan");
@@ -501,6 +503,13 @@ void object_cull_select_kernel(ObjectCuller& culler, ObjectCullKernel kernel) {
     d.push_constant_bytes = sizeof(GlintObjectCompactPush);
     d.workgroup = {m.compact.tile_groups(), 1};
     m.scan_serial = ComputePipeline(*m.context, d);
+  }
+  if (kernel == ObjectCullKernel::partial_scan && m.subgroup && !m.scan_partial) {
+    d.kernel_id = "object_cull_scan_main_partial";
+    d.bindings = {B, B};
+    d.push_constant_bytes = sizeof(GlintObjectCompactPush);
+    d.workgroup = {m.compact.tile_groups(), 1};
+    m.scan_partial = ComputePipeline(*m.context, d);
   }
   m.kernel = kernel;
 }

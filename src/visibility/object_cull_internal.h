@@ -22,6 +22,12 @@ enum class ObjectCullKernel : uint32_t {
   /// invocations are not consecutive (object_cull_scan.comp): the tests reach that path on any
   /// device with the subgroup variants (elsewhere this is `current`).
   serial_scan,
+  /// `current`, with the subgroup tile scan as a device may run it that launches subgroup 0 with
+  /// inactive invocations (its odd ones sit out the scan of the subgroups' totals) and whose
+  /// subgroups of odd index hold invocations out of order (object_cull_scan.comp): the tests reach
+  /// that case on any device with the subgroup variants and subgroups of 2 or more invocations
+  /// (elsewhere this is `current`).
+  partial_scan,
 };
 
 /// Selects the kernel `culler` records from now on.

@@ -19,6 +19,9 @@
 // dispatch is short and one workgroup's latency is much of it (docs/OCCLUSION.md, "Cost").
 // GLINT_OBJECT_SCAN_SERIAL builds the variant that takes the serial path (for subgroups that do
 // not hold consecutive invocations) on every device, so that the tests reach it.
+// GLINT_OBJECT_SCAN_PARTIAL builds the test variant in which subgroup 0's odd invocations sit out
+// the scan of the subgroups' totals, as the inactive invocations of a partial subgroup would, and
+// the subgroups of odd index report themselves out of order.
 layout(local_size_x_id = 0, local_size_y_id = 1) in;
 
 #define COMPACT_GROUPS_BINDING 0
@@ -66,6 +69,8 @@ void main() {
   const uvec4 sub_counts = subgroupAdd(uvec4(packed & 0xffu, (packed >> 8u) & 0xffu, (packed >> 16u) & 0xffu, packed >> 24u));
 #ifdef GLINT_OBJECT_SCAN_SERIAL
   const bool out_of_order = true;  // the test variant: the serial path on any device
+#elif defined(GLINT_OBJECT_SCAN_PARTIAL)
+  const bool out_of_order = !in_order || (gl_SubgroupID & 1u) != 0u;  // the test variant
 #else
   const bool out_of_order = !in_order;
 #endif
@@ -76,13 +81,27 @@ void main() {
       if (sub_counts[f] != 0u) atomicAdd(s_counts[f], sub_counts[f]);
     }
   }
-  // Subgroup 0: the subgroups' exclusive offsets (in chunks of its size, with a running carry) and
-  // the tile's total; where a subgroup is out of order, one invocation scans the groups in t order.
-  if (gl_SubgroupID == 0u) {
+  // Subgroup 0: the subgroups' exclusive offsets (in chunks of as many subgroups as it has active
+  // invocations, with a running carry) and the tile's total; where a subgroup is out of order, one
+  // invocation scans the groups in t order. Chunk entry k is the invocation's rank among the active
+  // ones, not gl_SubgroupInvocationID: where the workgroup's x size is not a multiple of the
+  // subgroup size, Vulkan lets a subgroup (subgroup 0 too) launch with inactive invocations at any
+  // index (Vulkan 1.3, built-in SubgroupLocalInvocationId), and indexing by gl_SubgroupInvocationID
+  // would skip the subgroups of the inactive indices: their totals, offsets and out-of-order flags.
+  // The exclusive add runs over the active invocations in gl_SubgroupInvocationID order, the
+  // order of the ranks.
+#ifdef GLINT_OBJECT_SCAN_PARTIAL
+  const bool lead = gl_SubgroupID == 0u && (gl_SubgroupInvocationID & 1u) == 0u;  // the test variant
+#else
+  const bool lead = gl_SubgroupID == 0u;
+#endif
+  if (lead) {
+    const uvec4 on = subgroupBallot(true);
+    const uint lanes = subgroupBallotBitCount(on), rank = subgroupBallotExclusiveBitCount(on);
     uint carry = 0u;
     bool serial = false;
-    for (uint base = 0u; base < gl_NumSubgroups; base += gl_SubgroupSize) {
-      const uint k = base + gl_SubgroupInvocationID;
+    for (uint base = 0u; base < gl_NumSubgroups; base += lanes) {
+      const uint k = base + rank;
       const uint w = k < gl_NumSubgroups ? s_sub[k] : 0u;
       serial = serial || subgroupBallotBitCount(subgroupBallot((w & kOutOfOrder) != 0u)) != 0u;
       const uint x = w & ~kOutOfOrder;
