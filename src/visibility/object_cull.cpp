@@ -246,6 +246,17 @@ struct ObjectCuller::Impl {
       throw Error(ErrorCode::missing_usage, concat(where, ": depth image lacks VK_IMAGE_USAGE_SAMPLED_BIT usage"));
   }
 
+  // A tile-scan pipeline (object_cull_scan.comp variant `kernel_id`): group buffer and tile counts,
+  // one workgroup of compact.tile_groups() invocations per tile.
+  detail::ComputePipeline make_scan(const char* kernel_id) const {
+    detail::PipelineDesc d;
+    d.kernel_id = kernel_id;
+    d.bindings = {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER};
+    d.push_constant_bytes = sizeof(GlintObjectCompactPush);
+    d.workgroup = {compact.tile_groups(), 1};
+    return detail::ComputePipeline(*context, d);
+  }
+
   void run(VkCommandBuffer cmd, HiZPyramid* hiz, Image* depth, uint32_t mode, GlintObjectCullPush push, uint32_t count,
            ObjectCullBuffers& in, ObjectCullOutputs& out, Profiler* profiler);
 };
@@ -316,11 +327,7 @@ ObjectCuller::ObjectCuller(const Context& context, const ObjectCullConfig& confi
   cd.scatter_inputs = 2;                           // list, the arguments and the statistics
   cd.scatter_outputs = 3;
   m.compact = detail::Compaction(context, cd);  // no top-level scan: this records its tile scan
-  d.kernel_id = m.subgroup ? "object_cull_scan_main_subgroup" : "object_cull_scan_main";
-  d.bindings = {B, B};
-  d.push_constant_bytes = sizeof(GlintObjectCompactPush);
-  d.workgroup = {m.compact.tile_groups(), 1};
-  m.scan = detail::ComputePipeline(context, d);
+  m.scan = m.make_scan(m.subgroup ? "object_cull_scan_main_subgroup" : "object_cull_scan_main");
   const uint64_t tiles = (groups + m.compact.tile_groups() - 1) / m.compact.tile_groups();
   m.tile_counts =
       detail::OwnedBuffer(context, std::max<uint64_t>(1, tiles) * 16, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, false);
@@ -491,26 +498,12 @@ void object_cull_select_kernel(ObjectCuller& culler, ObjectCullKernel kernel) {
     d.kernel_id = "object_cull_phase1";
     d.bindings = {B, B, B};
     m.phase1_atomic = ComputePipeline(*m.context, d);
-    d.kernel_id = "object_cull_scan_main";
-    d.bindings = {B, B};
-    d.push_constant_bytes = sizeof(GlintObjectCompactPush);
-    d.workgroup = {m.compact.tile_groups(), 1};
-    m.scan_atomic = ComputePipeline(*m.context, d);
+    m.scan_atomic = m.make_scan("object_cull_scan_main");
   }
-  if (kernel == ObjectCullKernel::serial_scan && m.subgroup && !m.scan_serial) {
-    d.kernel_id = "object_cull_scan_main_serial";
-    d.bindings = {B, B};
-    d.push_constant_bytes = sizeof(GlintObjectCompactPush);
-    d.workgroup = {m.compact.tile_groups(), 1};
-    m.scan_serial = ComputePipeline(*m.context, d);
-  }
-  if (kernel == ObjectCullKernel::partial_scan && m.subgroup && !m.scan_partial) {
-    d.kernel_id = "object_cull_scan_main_partial";
-    d.bindings = {B, B};
-    d.push_constant_bytes = sizeof(GlintObjectCompactPush);
-    d.workgroup = {m.compact.tile_groups(), 1};
-    m.scan_partial = ComputePipeline(*m.context, d);
-  }
+  if (kernel == ObjectCullKernel::serial_scan && m.subgroup && !m.scan_serial)
+    m.scan_serial = m.make_scan("object_cull_scan_main_serial");
+  if (kernel == ObjectCullKernel::partial_scan && m.subgroup && !m.scan_partial)
+    m.scan_partial = m.make_scan("object_cull_scan_main_partial");
   m.kernel = kernel;
 }
 
