@@ -188,11 +188,12 @@ struct ObjectCuller::Impl {
   uint32_t test_threads = kGroup;
   detail::ObjectCullKernel kernel = detail::ObjectCullKernel::current;
   // The ordered compaction of the emitted objects (core/compaction.h): its group buffer holds the
-  // test's masks and packed counts; object_cull_scan.comp (`scan`, its subgroup variant where the
-  // device supports it; `scan_atomic` with the shared-atomic test kernels) scans each tile,
-  // object_cull_scatter.comp writes the payloads, the arguments and the statistics.
+  // test's masks and packed counts; object_cull_scan.comp scans each tile (`scan`: its subgroup
+  // variant where the device supports it; `scan_hook`: the variant a test kernel selected by
+  // detail::object_cull_select_kernel runs with, when it is not `scan`), object_cull_scatter.comp
+  // writes the payloads, the arguments and the statistics.
   detail::Compaction compact;
-  detail::ComputePipeline scan, scan_atomic, scan_serial, scan_partial;
+  detail::ComputePipeline scan, scan_hook;
   detail::OwnedBuffer dummy;
   Buffer dummy_state;
   // Each tile's counts of the four states (object_cull_scan.comp writes them every cull, the
@@ -358,8 +359,6 @@ void ObjectCuller::Impl::run(VkCommandBuffer cmd, HiZPyramid* hiz, Image* depth,
   const bool images = mode != GLINT_OBJECT_MODE_PHASE1;
   using detail::ObjectCullKernel;
   const bool atomic = kernel == ObjectCullKernel::shared_atomics;
-  const bool serial = kernel == ObjectCullKernel::serial_scan && scan_serial;
-  const bool partial = kernel == ObjectCullKernel::partial_scan && scan_partial;
   const bool v1 = kernel == ObjectCullKernel::previous && mode == GLINT_OBJECT_MODE_SINGLE;
   // The test's descriptors: depth and Hi-Z (not in phase 1), objects, visibility, group records.
   detail::Bindings test;
@@ -419,11 +418,7 @@ void ObjectCuller::Impl::run(VkCommandBuffer cmd, HiZPyramid* hiz, Image* depth,
     b.use(tile_counts_state, kCompute, kWrite);
     b.flush(cmd);
     op.tile_groups = tile_groups;
-    (atomic    ? scan_atomic
-     : serial  ? scan_serial
-     : partial ? scan_partial
-               : scan)
-        .dispatch(cmd, {groups_state, tile_counts_state}, op, tiles * tile_groups, 1);
+    (scan_hook ? scan_hook : scan).dispatch(cmd, {groups_state, tile_counts_state}, op, tiles * tile_groups, 1);
   }
   if (profiler) profiler->mark(cmd, "object cull scan");
   // 3. Scatter: payloads in object order (each workgroup adds the earlier tiles' totals); the
@@ -498,12 +493,15 @@ void object_cull_select_kernel(ObjectCuller& culler, ObjectCullKernel kernel) {
     d.kernel_id = "object_cull_phase1";
     d.bindings = {B, B, B};
     m.phase1_atomic = ComputePipeline(*m.context, d);
-    m.scan_atomic = m.make_scan("object_cull_scan_main");
   }
-  if (kernel == ObjectCullKernel::serial_scan && m.subgroup && !m.scan_serial)
-    m.scan_serial = m.make_scan("object_cull_scan_main_serial");
-  if (kernel == ObjectCullKernel::partial_scan && m.subgroup && !m.scan_partial)
-    m.scan_partial = m.make_scan("object_cull_scan_main_partial");
+  // The tile scan the selection runs with: the shared-memory one with the shared-atomic kernels,
+  // the subgroup one forced onto its serial or partial-subgroup path for those hooks (where the
+  // device has the subgroup variants), else `scan`.
+  const char* hook = kernel == ObjectCullKernel::shared_atomics               ? "object_cull_scan_main"
+                     : kernel == ObjectCullKernel::serial_scan && m.subgroup  ? "object_cull_scan_main_serial"
+                     : kernel == ObjectCullKernel::partial_scan && m.subgroup ? "object_cull_scan_main_partial"
+                                                                              : nullptr;
+  m.scan_hook = hook ? m.make_scan(hook) : ComputePipeline{};
   m.kernel = kernel;
 }
 

@@ -30,7 +30,8 @@ enum class ObjectCullKernel : uint32_t {
   partial_scan,
 };
 
-/// Selects the kernel `culler` records from now on.
+/// Selects the kernel `culler` records from now on. Call it while no recorded cull of `culler` is
+/// pending: it may replace the tile-scan pipeline a pending command buffer uses.
 void object_cull_select_kernel(ObjectCuller& culler, ObjectCullKernel kernel);
 /// Whether `culler` runs the subgroup variants in ObjectCullKernel::current (the device supports them).
 bool object_cull_has_subgroup_variant(const ObjectCuller& culler);

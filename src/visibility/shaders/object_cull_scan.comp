@@ -67,13 +67,15 @@ void main() {
   const uint incl = subgroupInclusiveAdd(n);
   const uint sub_total = subgroupAdd(n);
   const uvec4 sub_counts = subgroupAdd(uvec4(packed & 0xffu, (packed >> 8u) & 0xffu, (packed >> 16u) & 0xffu, packed >> 24u));
-#ifdef GLINT_OBJECT_SCAN_SERIAL
-  const bool out_of_order = true;  // the test variant: the serial path on any device
+  // The test variants report subgroups out of order that are not: every one, or those of odd index.
+#if defined(GLINT_OBJECT_SCAN_SERIAL)
+  const bool forced = true;
 #elif defined(GLINT_OBJECT_SCAN_PARTIAL)
-  const bool out_of_order = !in_order || (gl_SubgroupID & 1u) != 0u;  // the test variant
+  const bool forced = (gl_SubgroupID & 1u) != 0u;
 #else
-  const bool out_of_order = !in_order;
+  const bool forced = false;
 #endif
+  const bool out_of_order = !in_order || forced;
   if (subgroupElect()) s_sub[gl_SubgroupID] = sub_total | (out_of_order ? kOutOfOrder : 0u);
   barrier();
   if (subgroupElect()) {  // integer sums: the same in any order
