@@ -182,6 +182,33 @@ TEST(BlurPlan, AutoTakesTheCheapestPlanWithinTheBound) {
   EXPECT_THROW(plan_auto(2.0, 0, 64, 1e-2), std::invalid_argument);
 }
 
+// RGBA16F levels and output (what GaussianBlur stores by default): where the last level's two fp16
+// shared copies would take the pyramid over the bound, the plan keeps them in fp32 and counts two
+// roundings fewer (docs/BLUR.md "Error model"); where the fp16 copies meet it, it keeps them.
+TEST(BlurPlan, PyramidKeepsFp32SharedCopiesOnlyWhereTheBoundNeedsThem) {
+  Storage half;
+  half.level_unit = half.output_unit = store_unit(10);
+  half.level_half = half.output_half = true;
+  const double two_copies = 2.0 * std::ldexp(1.0, -10);
+  const Plan tight = plan_method(Method::pyramid, 64.0, 3840, 2160, 1e-2, half);
+  EXPECT_TRUE(tight.fp32_shared);
+  EXPECT_LE(tight.expected_relative_l2, 1e-2);
+  // The fp16 copies would add two units, times 1 + the modelled error, to the same plan: over.
+  EXPECT_GT(tight.expected_relative_l2 + two_copies, 1e-2) << "the fp16 copies would have met the bound";
+  // A loose bound keeps the fp16 copies.
+  EXPECT_FALSE(plan_method(Method::pyramid, 64.0, 3840, 2160, 0.5, half).fp32_shared);
+  // Twice the shared bytes at the last level: its taps counted twice (docs/BLUR.md "Cost model").
+  const double last = double(tight.padding.padded_width >> tight.levels) * (tight.padding.padded_height >> tight.levels);
+  EXPECT_DOUBLE_EQ(tight.work.shared_taps, 2.0 * last * 2.0 * (2.0 * tight.radius + 1.0));
+  // fp32 levels have no fp16 copies to drop.
+  Storage full;
+  EXPECT_FALSE(plan_method(Method::pyramid, 64.0, 3840, 2160, 1e-2, full).fp32_shared);
+  // sigma 16 meets the default bound with the fp16 copies, and auto takes the pyramid at both.
+  EXPECT_FALSE(plan_method(Method::pyramid, 16.0, 3840, 2160, 1e-2, half).fp32_shared);
+  EXPECT_EQ(plan_auto(64.0, 3840, 2160, 1e-2, half).method, Method::pyramid);
+  EXPECT_EQ(plan_auto(16.0, 3840, 2160, 1e-2, half).method, Method::pyramid);
+}
+
 // docs/BLUR.md "Borders": the padded chain is an exact 2:1 chain (sizes multiples of 2^k, pads
 // multiples of 2^k) that extends the input by at least the reach of every level on both sides,
 // and no further than needed by one level-k block.

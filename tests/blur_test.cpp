@@ -455,6 +455,25 @@ TEST_F(BlurTest, WholeImageErrorIsWithinTheExpectedErrorForEveryMethodAndSigma) 
   }
 }
 
+// RGBA16F at sigma 64 and the default bound: the pyramid keeps its last level's shared copies in
+// fp32 to meet the bound (blur_plan::Plan::fp32_shared). The output matches the float64
+// reference of the same plan and the exact Gaussian within the expected error it reports.
+TEST_F(BlurTest, PyramidWithFp32SharedCopiesMeetsItsBound) {
+  const CpuImage input = as_stored(natural_like(301, 203, 31), kF16);
+  GaussianBlurConfig config;
+  config.method = BlurMethod::pyramid;
+  config.sigma_px = 64.0f;
+  config.precision = Precision::fp16;
+  GaussianBlur blur(context(), config);
+  const CpuImage out = run_gauss(blur, input, kF16);
+  ASSERT_TRUE(all_finite(out)) << "unwritten or non-finite texels";
+  EXPECT_EQ(blur.choice().method, BlurMethod::pyramid);
+  EXPECT_LE(blur.choice().expected_relative_error, config.max_relative_error);
+  EXPECT_LT(reference::rgba_relative_l2(out, reference_of(blur, input)), kTolFp16);
+  EXPECT_LE(reference::rgba_relative_l2(out, reference::exact_gaussian(input, 64.0)),
+            blur.choice().expected_relative_error);
+}
+
 // The cost model auto ranks by is the device's: measured once per Context (the same constants
 // on a second call), or the config's when one is passed in, which then decides the choice.
 TEST_F(BlurTest, AutoRanksByTheDevicesCostModel) {

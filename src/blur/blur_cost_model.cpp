@@ -40,7 +40,8 @@ Work separable_work(uint32_t radius, uint32_t width, uint32_t height, bool linea
 // Pyramid on the padded chain: D reads four bilinear texels (16 taps) per output at levels 1..k
 // (level k's D is fused into the blur's load, whose taps come from shared memory); the B-spline up
 // reads 16 texels per output. The first D reads the padded extent of the input (clamped reads).
-Work pyramid_work(uint32_t levels, uint32_t level_radius, uint32_t width, uint32_t height, const Padding& padding) {
+Work pyramid_work(uint32_t levels, uint32_t level_radius, uint32_t width, uint32_t height, const Padding& padding,
+                  bool fp32_shared) {
   Work w;
   w.dispatches = levels + 1.0;
   w.bytes = kBytesPerTexel * (texels(padding.padded_width, padding.padded_height) + texels(width, height));
@@ -51,7 +52,7 @@ Work pyramid_work(uint32_t levels, uint32_t level_radius, uint32_t width, uint32
     lh = half_size(lh);
     w.bytes += 2.0 * kBytesPerTexel * texels(lw, lh);  // written once, read once
     w.fetch_taps += 16.0 * texels(lw, lh);
-    if (j == levels) w.shared_taps += texels(lw, lh) * 2.0 * (2.0 * level_radius + 1.0);
+    if (j == levels) w.shared_taps += texels(lw, lh) * 2.0 * (2.0 * level_radius + 1.0) * (fp32_shared ? 2.0 : 1.0);
   }
   return w;
 }

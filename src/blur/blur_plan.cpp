@@ -82,10 +82,18 @@ Plan plan_pyramid(double sigma_px, uint32_t width, uint32_t height, double max_r
     const double level_var = discrete_variance(level_sigma, kGaussTruncation);
     p.effective_sigma_px = std::sqrt(pyramid_axis_variance(1u << k, k, level_var));
     p.expected_relative_l2 = error;
-    if (storage) p.expected_relative_l2 += rounding_bound(p, *storage);
+    if (storage) {
+      p.expected_relative_l2 += rounding_bound(p, *storage);
+      // fp16 levels: where the last level's two fp16 shared copies would break the bound, keep them
+      // in fp32 (the level is at most a quarter of the input's texels; its shared bytes double).
+      if (storage->level_half && p.expected_relative_l2 > max_relative_l2) {
+        p.fp32_shared = true;
+        p.expected_relative_l2 = error + rounding_bound(p, *storage);
+      }
+    }
     const double error_total = p.expected_relative_l2;
     p.padding = padding_of(p, width, height);
-    p.work = pyramid_work(k, p.radius, width, height, p.padding);
+    p.work = pyramid_work(k, p.radius, width, height, p.padding, p.fp32_shared);
     p.cost = model.estimate_us(p.work);
     const bool meets = in_range && error_total <= max_relative_l2;
     if (!have || meets || (!best_meets && in_range && (!best_in_range || error < best.expected_relative_l2)) ||

@@ -89,6 +89,10 @@ struct Plan {
   uint32_t levels = 0;              //!< pyramid / dual: k
   double level_sigma = 0;           //!< pyramid: sigma_k in texels of level k (taps at kGaussTruncation)
   double dual_offset = 1;           //!< dual: o
+  /// pyramid: the last level's fused blur keeps its shared copies in fp32 although the levels are
+  /// RGBA16F (two fp16 roundings fewer; twice the shared bytes): chosen only when the fp16 copies
+  /// would miss the bound and these meet it.
+  bool fp32_shared = false;
   double effective_sigma_px = 0;    //!< sigma of the method's impulse response (input pixels)
   double expected_relative_l2 = 0;  //!< modelled error against the exact Gaussian (docs/BLUR.md)
   Padding padding;                  //!< pyramid / dual: the padded chain (padding_of())

@@ -40,7 +40,10 @@ double dual_model_error(double sigma, uint32_t levels, double o);
 // blur_cost_model.cpp: what each method's dispatches do (level sizes from `padding` where the
 // chain is padded).
 Work separable_work(uint32_t radius, uint32_t width, uint32_t height, bool linear);
-Work pyramid_work(uint32_t levels, uint32_t level_radius, uint32_t width, uint32_t height, const Padding& padding);
+// fp32_shared: the last level's shared copies are fp32, each tap twice the shared bytes of an fp16
+// one (counted twice).
+Work pyramid_work(uint32_t levels, uint32_t level_radius, uint32_t width, uint32_t height, const Padding& padding,
+                  bool fp32_shared = false);
 Work dual_work(uint32_t levels, uint32_t width, uint32_t height, const Padding& padding);
 
 // blur_border.cpp: the padding of a pyramid (levels, level radius) or dual (levels, offset) chain.

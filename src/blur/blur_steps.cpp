@@ -167,14 +167,15 @@ VkExtent2D half_extent(VkExtent2D e) { return {blur_plan::half_size(e.width), bl
 // `binomial` picks the pyramid method's downsample over the area average (docs/BLUR.md).
 Step fused_step(StepProgram& prog, const DeviceInfo& info, int src, int dst, VkExtent2D src_size, VkExtent2D dst_size,
                 VkFormat dst_format, double sigma, double truncation, bool binomial, uint32_t flags, float max_value,
-                std::string label) {
+                std::string label, bool fp32_shared) {
   const std::vector<double> w = blur_plan::gaussian_half_taps(sigma, truncation);
   const uint32_t radius = static_cast<uint32_t>(w.size()) - 1;
   if (radius > kFusedMaxRadius)
     throw Error(ErrorCode::invalid_argument, concat("blur sigma ", sigma, " needs radius ", radius,
                                                     "; the fused kernel takes at most ", kFusedMaxRadius));
-  // Where the result is stored as fp16, the shared copies may be too (half the shared traffic).
-  const bool half_shared = dst_format == VK_FORMAT_R16G16B16A16_SFLOAT;
+  // Where the result is stored as fp16, the shared copies may be too (half the shared traffic),
+  // unless the plan's error bound needs them in fp32 (blur_plan::Plan::fp32_shared).
+  const bool half_shared = dst_format == VK_FORMAT_R16G16B16A16_SFLOAT && !fp32_shared;
   const FusedShape shape = fused_shape(info, radius, half_shared);
   // The source read, fixed per pipeline so each variant compiles only its own path.
   const bool same = src_size.width == dst_size.width && src_size.height == dst_size.height;

@@ -106,10 +106,11 @@ BlurPush make_push(VkExtent2D src, VkExtent2D dst, uint32_t flags, float max_val
 VkExtent2D half_extent(VkExtent2D e);
 
 // A fused level-blur step B(src -> dst, sigma) (docs/BLUR.md); sigma 0 is the area downsample alone.
-// `binomial` picks the pyramid method's downsample over the area average (docs/BLUR.md).
+// `binomial` picks the pyramid method's downsample over the area average (docs/BLUR.md). The
+// shared copies are fp16 where dst_format is RGBA16F, unless `fp32_shared`.
 Step fused_step(StepProgram& prog, const DeviceInfo& info, int src, int dst, VkExtent2D src_size, VkExtent2D dst_size,
                 VkFormat dst_format, double sigma, double truncation, bool binomial, uint32_t flags, float max_value,
-                std::string label);
+                std::string label, bool fp32_shared = false);
 
 // A plain per-texel step (upsample, dual down/up) with 2D workgroups.
 Step simple_step(StepProgram& prog, const char* kernel, int src, int dst, VkExtent2D src_size, VkExtent2D dst_size,

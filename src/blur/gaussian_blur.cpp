@@ -288,7 +288,8 @@ struct GaussianBlur::Impl {
         const bool last = j == choice.levels;
         Step s = fused_step(prog, info, src, dst, prev, e, lf, last ? choice.level_sigma : 0.0,
                             blur_plan::kGaussTruncation, true, src == kInput ? sanitize : 0u, max_value,
-                            concat("gauss pyramid level ", j, last ? " (blur)" : " (down)"));
+                            concat("gauss pyramid level ", j, last ? " (blur)" : " (down)"),
+                            last && plan_made.fp32_shared);
         if (src == kInput) read_padded_input(s, size, pad);
         prog.steps.push_back(std::move(s));
         src = dst;
