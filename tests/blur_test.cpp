@@ -259,6 +259,26 @@ TEST_F(BlurTest, EveryMethodMatchesItsReferenceOnRandomInput) {
   }
 }
 
+// The caller's NaN becomes 0 and +-Inf the largest finite value of the chain (docs/BLUR.md
+// "Notation") in whichever step reads the input first: the fused, line and linear kernels, the
+// pyramid's binomial downsample and the dual's first level. Not the linear-sampling variant, whose
+// hardware filter blends texels before the shader sees them (GaussianBlurConfig::linear_sampling).
+TEST_F(BlurTest, EveryMethodSanitizesNanAndInfinity) {
+  CpuImage input = random_hdr(83, 57, 23);
+  input.at(3, 4)[0] = std::nanf("");
+  input.at(40, 20)[1] = INFINITY;
+  input.at(80, 50)[2] = -INFINITY;
+  input.at(0, 56)[3] = std::nanf("");
+  for (const MethodCase& c : kMethodCases) {
+    if (c.linear) continue;
+    SCOPED_TRACE(describe(c));
+    GaussianBlur blur(context(), config_of(c, Precision::fp16));
+    const CpuImage out = run_gauss(blur, input, kF16);
+    ASSERT_TRUE(all_finite(out)) << "a non-finite input texel reached the output";
+    EXPECT_LT(reference::rgba_relative_l2(out, reference_of(blur, input)), kTolFp16);
+  }
+}
+
 TEST_F(BlurTest, OddAndDegenerateSizes) {
   const std::pair<uint32_t, uint32_t> sizes[] = {{1, 1}, {1, 29}, {29, 1}, {7, 3}, {4097, 3}};
   for (const MethodCase& c : kMethodCases) {

@@ -141,7 +141,11 @@ struct GaussianBlurConfig {
   float max_relative_error = 1e-2f;           //!< automatic and pyramid: bound on the modelled relative L2
                                               //!< error against the exact Gaussian (1e-4 to 1)
   bool linear_sampling = false;               //!< separable only: two passes that pair taps into bilinear
-                                              //!< fetches through the sampler (9 taps in 5 fetches)
+                                              //!< fetches through the sampler (9 taps in 5 fetches). The
+                                              //!< sampler filters before any shader code sees a texel, so
+                                              //!< this variant does not sanitize: the input must be finite
+                                              //!< and within the output format's range (NaN and Inf reach
+                                              //!< the output; every other method maps them, docs/BLUR.md)
   Precision precision = Precision::fp16;      //!< intermediate images
   /// automatic: the device's cost constants; all zero = measured (see BlurCostModel). Each is
   /// finite and >= 0, and all are zero or all > 0.

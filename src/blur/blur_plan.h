@@ -84,11 +84,11 @@ CostModel fit_cost_model(const std::vector<Work>& work, const std::vector<double
 /// The parameters of one method for one sigma (input pixels) at one image size.
 struct Plan {
   Method method = Method::separable;
-  double sigma_px = 0;              //!< requested sigma
-  uint32_t radius = 0;              //!< separable: taps radius at full resolution; pyramid: of level k
-  uint32_t levels = 0;              //!< pyramid / dual: k
-  double level_sigma = 0;           //!< pyramid: sigma_k in texels of level k (taps at kGaussTruncation)
-  double dual_offset = 1;           //!< dual: o
+  double sigma_px = 0;     //!< requested sigma
+  uint32_t radius = 0;     //!< separable: taps radius at full resolution; pyramid: of level k
+  uint32_t levels = 0;     //!< pyramid / dual: k
+  double level_sigma = 0;  //!< pyramid: sigma_k in texels of level k (taps at kGaussTruncation)
+  double dual_offset = 1;  //!< dual: o
   /// pyramid: the last level's fused blur keeps its shared copies in fp32 although the levels are
   /// RGBA16F (two fp16 roundings fewer; twice the shared bytes): chosen only when the fp16 copies
   /// would miss the bound and these meet it.

@@ -192,9 +192,77 @@ Step fused_step(StepProgram& prog, const DeviceInfo& info, int src, int dst, VkE
   s.push = make_push(src_size, dst_size, flags, max_value);
   for (uint32_t t = 0; t <= radius; ++t) s.push.weights[t] = static_cast<float>(w[t]);
   s.invocations_x = dst_size.width;
+  s.rows = shape.rows;
   s.invocations_y = (dst_size.height + shape.rows - 1) / shape.rows;
   s.label = std::move(label);
   return s;
+}
+
+namespace {
+
+// The first shape of `gpu` (of `cpu` on CPU devices) whose invocations and shared memory
+// (`shared_bytes(tile width, tile height)`) fit the device; the list's last shape must fit every
+// device (64 invocations, a few KiB).
+template <typename Bytes>
+FusedShape first_fitting(const DeviceInfo& info, std::initializer_list<FusedShape> gpu,
+                         std::initializer_list<FusedShape> cpu, Bytes shared_bytes) {
+  const std::initializer_list<FusedShape>& list = info.type == VK_PHYSICAL_DEVICE_TYPE_CPU ? cpu : gpu;
+  for (const FusedShape& s : list) {
+    if (s.workgroup.x * s.workgroup.y <= info.max_workgroup_invocations &&
+        shared_bytes(s.workgroup.x, s.workgroup.y * s.rows) <= info.max_shared_memory_bytes) {
+      return s;
+    }
+  }
+  return *(list.end() - 1);
+}
+
+// A step of a tiled kernel that takes only the source and destination (and the rows constant).
+Step tiled_step(StepProgram& prog, const char* kernel, FusedShape shape, int src, int dst, VkExtent2D src_size,
+                VkExtent2D dst_size, VkFormat dst_format, uint32_t flags, float max_value, std::string label) {
+  Step s;
+  s.pipeline = &prog.pipeline(kernel, dst_format, shape.workgroup, {shape.rows},
+                              {VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
+  s.src = src;
+  s.dst = dst;
+  s.push = make_push(src_size, dst_size, flags, max_value);
+  s.rows = shape.rows;
+  s.invocations_x = dst_size.width;
+  s.invocations_y = (dst_size.height + shape.rows - 1) / shape.rows;
+  s.label = std::move(label);
+  return s;
+}
+
+}  // namespace
+
+Step upsample_step(StepProgram& prog, const DeviceInfo& info, int src, int dst, VkExtent2D src_size,
+                   VkExtent2D dst_size, VkFormat dst_format, float max_value, std::string label) {
+  // The kernel's shared footprint holds a tile's source texels at a magnification of 2 or more.
+  if (2 * src_size.width > dst_size.width || 2 * src_size.height > dst_size.height) {
+    throw Error(ErrorCode::invalid_argument, concat("upsample_step: ", src_size.width, "x", src_size.height, " -> ",
+                                                    dst_size.width, "x", dst_size.height, " magnifies less than 2x"));
+  }
+  // Output tiles of 64x16 on GPUs (wide rows: coalesced writes, a footprint of 36x12 level
+  // texels); CPU devices (lavapipe) get 16x8, as their other 2D kernels. Shared memory: the
+  // footprint (TW / 2 + 4) x (TH / 2 + 4) and the horizontal pass (TH / 2 + 4) x TW, 16 bytes each.
+  const FusedShape shape =
+      first_fitting(info, {{{64, 4}, 4}, {{32, 4}, 2}, {{16, 8}, 1}, {{8, 8}, 1}}, {{{16, 8}, 1}, {{8, 8}, 1}},
+                    [](uint32_t tw, uint32_t th) { return 16 * (th / 2 + 4) * (tw / 2 + 4 + tw); });
+  return tiled_step(prog, "blur_upsample", shape, src, dst, src_size, dst_size, dst_format, 0u, max_value,
+                    std::move(label));
+}
+
+Step down_step(StepProgram& prog, const DeviceInfo& info, int src, int dst, VkExtent2D src_size, VkExtent2D dst_size,
+               VkFormat dst_format, uint32_t flags, float max_value, std::string label) {
+  if (src_size.width != 2 * dst_size.width || src_size.height != 2 * dst_size.height) {
+    throw Error(ErrorCode::invalid_argument, concat("down_step: ", src_size.width, "x", src_size.height, " -> ",
+                                                    dst_size.width, "x", dst_size.height, " is not an exact 2:1 step"));
+  }
+  // Output tiles of 32x8 on GPUs (a source block of 66x18), 16x8 on CPU devices. Shared memory:
+  // the block (2 TW + 2) x (2 TH + 2) and its rows summed along x, (2 TH + 2) x TW, 16 bytes each.
+  const FusedShape shape = first_fitting(info, {{{32, 8}, 1}, {{16, 8}, 1}, {{8, 8}, 1}}, {{{16, 8}, 1}, {{8, 8}, 1}},
+                                         [](uint32_t tw, uint32_t th) { return 16 * (2 * th + 2) * (3 * tw + 2); });
+  return tiled_step(prog, "blur_down", shape, src, dst, src_size, dst_size, dst_format, flags, max_value,
+                    std::move(label));
 }
 
 Step simple_step(StepProgram& prog, const char* kernel, int src, int dst, VkExtent2D src_size, VkExtent2D dst_size,

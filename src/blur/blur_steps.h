@@ -62,6 +62,7 @@ struct Step {
   BlurPush push{};
   uint32_t invocations_x = 0;  // dispatch covers these (the pipeline divides by its workgroup)
   uint32_t invocations_y = 0;
+  uint32_t rows = 1;                          // output rows per invocation: invocations_y = ceil(rows of output / this)
   bool sampler = false;                       // binding 0 is a combined image sampler
   const detail::OwnedBuffer* taps = nullptr;  // binding 2
   std::string label;
@@ -113,6 +114,14 @@ Step fused_step(StepProgram& prog, const DeviceInfo& info, int src, int dst, VkE
                 std::string label, bool fp32_shared = false);
 
 // A plain per-texel step (upsample, dual down/up) with 2D workgroups.
+// The pyramid's B-spline upsample (src/blur/shaders/blur_upsample.comp) from `src` to `dst`: its
+// tile shape from the device (the largest whose shared footprint and invocations fit).
+Step upsample_step(StepProgram& prog, const DeviceInfo& info, int src, int dst, VkExtent2D src_size,
+                   VkExtent2D dst_size, VkFormat dst_format, float max_value, std::string label);
+// The pyramid's binomial downsample (src/blur/shaders/blur_down.comp) of an exact 2:1 step from
+// `src` to `dst`: its tile shape from the device, as upsample_step's.
+Step down_step(StepProgram& prog, const DeviceInfo& info, int src, int dst, VkExtent2D src_size, VkExtent2D dst_size,
+               VkFormat dst_format, uint32_t flags, float max_value, std::string label);
 Step simple_step(StepProgram& prog, const char* kernel, int src, int dst, VkExtent2D src_size, VkExtent2D dst_size,
                  VkFormat dst_format, uint32_t flags, float max_value, std::string label,
                  std::vector<VkDescriptorType> bindings = {VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE,

@@ -118,7 +118,7 @@ void write_padded_output(Step& s, VkExtent2D output, const blur_plan::Padding& p
   s.push.dst_origin_x = static_cast<int32_t>(pad.pad_x);
   s.push.dst_origin_y = static_cast<int32_t>(pad.pad_y);
   s.invocations_x = output.width;
-  s.invocations_y = output.height;
+  s.invocations_y = (output.height + s.rows - 1) / s.rows;
 }
 
 }  // namespace
@@ -252,7 +252,8 @@ struct GaussianBlur::Impl {
         s.push.tap_count = static_cast<uint32_t>(taps.size() / 2 - 1);
         prog.steps.push_back(std::move(s));
       }
-      // The sampler cannot sanitize: NaN or Inf in the input reach the output (documented).
+      // The sampler cannot sanitize: NaN or Inf in the input reach the output
+      // (GaussianBlurConfig::linear_sampling, docs/BLUR.md "Notation").
     } else if (choice.method == BlurMethod::separable && choice.radius <= kFusedMaxRadius) {
       prog.steps.push_back(fused_step(prog, info, kInput, kOutput, size, size, out_format, config.sigma_px,
                                       blur_plan::kGaussTruncation, false, sanitize, max_value,
@@ -286,17 +287,19 @@ struct GaussianBlur::Impl {
         const VkExtent2D e = half_extent(prev);
         const int dst = add(e);
         const bool last = j == choice.levels;
-        Step s = fused_step(prog, info, src, dst, prev, e, lf, last ? choice.level_sigma : 0.0,
-                            blur_plan::kGaussTruncation, true, src == kInput ? sanitize : 0u, max_value,
-                            concat("gauss pyramid level ", j, last ? " (blur)" : " (down)"),
-                            last && plan_made.fp32_shared);
+        const uint32_t flags = src == kInput ? sanitize : 0u;
+        // The last level fuses D with its blur; the others are D alone (src/blur/shaders/blur_down.comp).
+        Step s =
+            last ? fused_step(prog, info, src, dst, prev, e, lf, choice.level_sigma, blur_plan::kGaussTruncation, true,
+                              flags, max_value, concat("gauss pyramid level ", j, " (blur)"), plan_made.fp32_shared)
+                 : down_step(prog, info, src, dst, prev, e, lf, flags, max_value,
+                             concat("gauss pyramid level ", j, " (down)"));
         if (src == kInput) read_padded_input(s, size, pad);
         prog.steps.push_back(std::move(s));
         src = dst;
         prev = e;
       }
-      Step up = simple_step(prog, "blur_upsample", src, kOutput, prev, padded, out_format, 0u, max_value,
-                            "gauss pyramid upsample");
+      Step up = upsample_step(prog, info, src, kOutput, prev, padded, out_format, max_value, "gauss pyramid upsample");
       write_padded_output(up, size, pad);
       prog.steps.push_back(std::move(up));
     } else {  // dual, on the padded extent as the pyramid

@@ -1,0 +1,56 @@
+#version 460
+#extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_samplerless_texture_functions : require
+// The pyramid method's binomial downsample D (docs/BLUR.md, "pyramid") on an exact 2:1 step of
+// the padded chain: [1 3 3 1] / 8 along each axis, destination texel x reading source texels
+// 2x - 1 .. 2x + 2 (relative to the chain's origins). Equal in exact arithmetic to the mean of the
+// four bilinear reads at map(x) +- 0.375 r that blur.glsl's binomial_sample() takes, whose
+// fractions are 1/4 and 3/4 on this step.
+// binomial_sample() fetches 16 texels per output, and neighbouring outputs share half of them on
+// each axis: every source texel is fetched (and sanitized) four times. Here a workgroup loads its
+// tile's source block once into shared memory, sums it along x into shared rows, then along y:
+// H100, 3840x2160 input, the first level: 93 to 125 us with binomial_sample() (docs/PERF.md).
+// The last level of a pyramid (D fused with the level blur) stays in blur_level.comp.
+layout(local_size_x_id = 0, local_size_y_id = 1) in;
+layout(constant_id = 2) const int ROWS = 1;  // output rows per invocation: tile = (WG.x, WG.y * ROWS)
+
+layout(binding = 0) uniform texture2D src;
+#include "dst_image.glsl"
+DST_LAYOUT(1) uniform writeonly image2D dst;
+
+#include "blur_params.h"
+layout(push_constant) uniform Push { BlurPush p; };
+#include "blur.glsl"
+
+const int TW = int(gl_WorkGroupSize.x);
+const int TH = int(gl_WorkGroupSize.y) * ROWS;
+const int GROUP_SIZE = int(gl_WorkGroupSize.x) * int(gl_WorkGroupSize.y);
+const int IW = 2 * TW + 2;  // the tile's source block
+const int IH = 2 * TH + 2;
+shared vec4 s_src[IH * IW];  // the block, row-major (clamped and sanitized as src_texel() reads)
+shared vec4 s_row[IH * TW];  // block row j summed along x for output column x, at j * TW + x
+
+void main() {
+  const ivec2 size = ivec2(p.dst_width, p.dst_height);
+  const ivec2 tile = ivec2(gl_WorkGroupID.xy) * ivec2(TW, TH);
+  const int lx = int(gl_LocalInvocationID.x), ly = int(gl_LocalInvocationID.y);
+  // Source texel of tap 0 of the tile's first output: 2 x - 1 in the virtual (padded) grids.
+  const ivec2 i0 = 2 * (tile + ivec2(p.dst_origin_x, p.dst_origin_y)) - 1 - ivec2(p.src_origin_x, p.src_origin_y);
+  for (int i = int(gl_LocalInvocationIndex); i < IW * IH; i += GROUP_SIZE) {
+    const int j = i / IW;
+    s_src[i] = src_texel(i0 + ivec2(i - j * IW, j));
+  }
+  barrier();
+  for (int j = ly; j < IH; j += int(gl_WorkGroupSize.y)) {
+    const int b = j * IW + 2 * lx;
+    s_row[j * TW + lx] = (s_src[b] + s_src[b + 3]) * 0.125 + (s_src[b + 1] + s_src[b + 2]) * 0.375;
+  }
+  barrier();
+  for (int r = 0; r < ROWS; ++r) {
+    const int y = ly * ROWS + r;
+    const int b = 2 * y * TW + lx;
+    const vec4 v = (s_row[b] + s_row[b + 3 * TW]) * 0.125 + (s_row[b + TW] + s_row[b + 2 * TW]) * 0.375;
+    const ivec2 xy = tile + ivec2(lx, y);
+    if (all(lessThan(xy, size))) imageStore(dst, xy, v);
+  }
+}
