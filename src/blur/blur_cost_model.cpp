@@ -37,11 +37,11 @@ Work separable_work(uint32_t radius, uint32_t width, uint32_t height, bool linea
   return w;
 }
 
-// Pyramid on the padded chain: at levels 1..k-1, D alone (shaders/blur_down.comp) fetches each
+// Pyramid on the padded chain: at levels 2..k-1, D alone (shaders/blur_down.comp) fetches each
 // texel of a tile's source block once (66 x 18 for 32 x 8 outputs, 4.6 per output) and sums it
 // through shared memory (4 taps along x for each of the block's 18 rows, 4 along y: 13 per
-// output); level k's D is fused into the blur's load, 16 fetched taps per output, and the blur's
-// taps come from shared memory. The B-spline up
+// output); level 1's D (from the input) and level k's (fused into the blur's load) fetch 16 taps
+// per output, and the blur's taps come from shared memory. The B-spline up
 // is separable through shared memory: 4 vertical taps per output and about 4 horizontal ones (a
 // footprint row serves the tile's rows; shaders/blur_upsample.comp), 8 shared taps. The first D
 // reads the padded extent of the input (clamped reads).
@@ -56,13 +56,13 @@ Work pyramid_work(uint32_t levels, uint32_t level_radius, uint32_t width, uint32
     lw = half_size(lw);
     lh = half_size(lh);
     w.bytes += 2.0 * kBytesPerTexel * texels(lw, lh);  // written once, read once
-    if (j < levels) {
+    if (j > 1 && j < levels) {
       w.fetch_taps += (66.0 * 18.0 / 256.0) * texels(lw, lh);
       w.shared_taps += 13.0 * texels(lw, lh);
       continue;
     }
     w.fetch_taps += 16.0 * texels(lw, lh);
-    w.shared_taps += texels(lw, lh) * 2.0 * (2.0 * level_radius + 1.0) * (fp32_shared ? 2.0 : 1.0);
+    if (j == levels) w.shared_taps += texels(lw, lh) * 2.0 * (2.0 * level_radius + 1.0) * (fp32_shared ? 2.0 : 1.0);
   }
   return w;
 }

@@ -220,7 +220,9 @@ FusedShape first_fitting(const DeviceInfo& info, std::initializer_list<FusedShap
 Step tiled_step(StepProgram& prog, const char* kernel, FusedShape shape, int src, int dst, VkExtent2D src_size,
                 VkExtent2D dst_size, VkFormat dst_format, uint32_t flags, float max_value, std::string label) {
   Step s;
-  s.pipeline = &prog.pipeline(kernel, dst_format, shape.workgroup, {shape.rows},
+  // Constant 3: prefetch the load step on GPUs only (as fused_step's).
+  const uint32_t prefetch = prog.context->info().type == VK_PHYSICAL_DEVICE_TYPE_CPU ? 0u : 1u;
+  s.pipeline = &prog.pipeline(kernel, dst_format, shape.workgroup, {shape.rows, prefetch},
                               {VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
   s.src = src;
   s.dst = dst;

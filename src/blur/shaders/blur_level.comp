@@ -39,6 +39,16 @@ const int LOAD_W = TILE_W + 2 * RADIUS;
 const int LOAD_H = TILE_H + 2 * RADIUS;
 const int GROUP_SIZE = int(gl_WorkGroupSize.x) * int(gl_WorkGroupSize.y);
 const int LOADS = (LOAD_W * LOAD_H + GROUP_SIZE - 1) / GROUP_SIZE;  // source texels per invocation
+// Loads issued together by the prefetching load step: all of them where a load is one fetch (MODE
+// 0) or 4 (exact 2:1 area: 139 registers on the H100, but batches of two loads took the 3-level
+// BlurPyramid from 124.8 to 144.5 us at 59 registers); one at a time where a load is up to 16
+// (binomial, any-ratio area), which otherwise kept all their texels in registers (255 on the
+// H100; the pyramid's sigma-4 level blur 253 -> 223 us at 94). The pyramid's first downsample
+// alone (RADIUS 0, 4 loads an invocation) keeps them all in flight: it reads the caller's input
+// from memory, and at 128 registers took 93 us at 3840x2160 (sigma 16), which blur_down.comp's
+// one fetch per texel did not beat (147 us); the later levels, read from cache, go there.
+const int BATCH = MODE <= 1 || RADIUS == 0 ? LOADS : 1;
+const int BATCHES = (LOADS + BATCH - 1) / BATCH;
 const int RUN = 4;                        // horizontal outputs per invocation (TILE_W is a multiple)
 const int H_RUNS = TILE_W / RUN;
 const int H_WINDOW = RUN + 2 * RADIUS;
@@ -92,14 +102,16 @@ void main() {
   // 3840x2160: 9 taps 244 -> 178 us; the 3-level pyramid, which reads 4 texels per loaded one,
   // 147 us without this and 124 us with it).
   if (PREFETCH) {
-    vec4 fetched[LOADS];
-    [[unroll]] for (int n = 0; n < LOADS; ++n) {
-      int i = min(local + n * GROUP_SIZE, LOAD_W * LOAD_H - 1);
-      fetched[n] = load_source(clamp(tile - RADIUS + ivec2(i % LOAD_W, i / LOAD_W), ivec2(0), dst_size - 1));
-    }
-    [[unroll]] for (int n = 0; n < LOADS; ++n) {
-      int i = local + n * GROUP_SIZE;
-      if (i < LOAD_W * LOAD_H) put_src((i / LOAD_W) * LOAD_S + i % LOAD_W, fetched[n]);
+    [[dont_unroll]] for (int b = 0; b < BATCHES; ++b) {
+      vec4 fetched[BATCH];
+      [[unroll]] for (int n = 0; n < BATCH; ++n) {
+        int i = min(local + (b * BATCH + n) * GROUP_SIZE, LOAD_W * LOAD_H - 1);
+        fetched[n] = load_source(clamp(tile - RADIUS + ivec2(i % LOAD_W, i / LOAD_W), ivec2(0), dst_size - 1));
+      }
+      [[unroll]] for (int n = 0; n < BATCH; ++n) {
+        int i = local + (b * BATCH + n) * GROUP_SIZE;
+        if (i < LOAD_W * LOAD_H) put_src((i / LOAD_W) * LOAD_S + i % LOAD_W, fetched[n]);
+      }
     }
   } else {
     [[dont_unroll]] for (int i = local; i < LOAD_W * LOAD_H; i += GROUP_SIZE) {

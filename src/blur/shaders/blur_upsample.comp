@@ -1,6 +1,7 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_samplerless_texture_functions : require
+#extension GL_EXT_control_flow_attributes : require
 // The pyramid method's last step (docs/BLUR.md, "pyramid"): the blurred level brought to full
 // resolution at the same normalized coordinate by a uniform cubic B-spline (4x4 texels, exact
 // fp32 weights). Unlike bilinear magnification it leaves no kinks at level texel centres (C2),
@@ -17,6 +18,9 @@
 // H100, 3840x2160 RGBA16F output: 159 us with 16 fetches per output (docs/PERF.md).
 layout(local_size_x_id = 0, local_size_y_id = 1) in;
 layout(constant_id = 2) const int ROWS = 1;  // output rows per invocation: tile = (WG.x, WG.y * ROWS)
+// Every fetch of the load step issued before the first shared store (GPUs), or a plain loop (CPU
+// devices), as blur_down.comp.
+layout(constant_id = 3) const bool PREFETCH = true;
 
 layout(binding = 0) uniform texture2D src;
 #include "dst_image.glsl"
@@ -34,7 +38,8 @@ const int GROUP_SIZE = int(gl_WorkGroupSize.x) * int(gl_WorkGroupSize.y);
 // from floor - 1 on.
 const int FW = TW / 2 + 4;
 const int FH = TH / 2 + 4;
-shared vec4 s_src[FH * FW];  // the footprint, row-major
+const int LOADS = (FW * FH + GROUP_SIZE - 1) / GROUP_SIZE;  // most footprint texels per invocation
+shared vec4 s_src[FH * FW];                                 // the footprint, row-major
 shared vec4 s_row[FH * TW];  // step 2: footprint row j, output column x at j * TW + x
 
 void main() {
@@ -47,9 +52,21 @@ void main() {
   const ivec2 f0 = ivec2(floor(source_position(tile))) - 1;
   const ivec2 fs = ivec2(floor(source_position(last))) + 3 - f0;  // <= (FW, FH)
   // 1. The footprint, clamped to the level as the direct form's fetches are.
-  for (int i = int(gl_LocalInvocationIndex); i < fs.x * fs.y; i += GROUP_SIZE) {
-    const int j = i / fs.x;
-    s_src[j * FW + (i - j * fs.x)] = src_texel(f0 + ivec2(i - j * fs.x, j));
+  const int local = int(gl_LocalInvocationIndex), count = fs.x * fs.y;
+  if (PREFETCH) {
+    vec4 fetched[LOADS];
+    [[unroll]] for (int n = 0; n < LOADS; ++n) {
+      const int i = min(local + n * GROUP_SIZE, count - 1);
+      fetched[n] = src_texel(f0 + ivec2(i % fs.x, i / fs.x));
+    }
+    [[unroll]] for (int n = 0; n < LOADS; ++n) {
+      const int i = local + n * GROUP_SIZE;
+      if (i < count) s_src[(i / fs.x) * FW + i % fs.x] = fetched[n];
+    }
+  } else {
+    [[dont_unroll]] for (int i = local; i < count; i += GROUP_SIZE) {
+      s_src[(i / fs.x) * FW + i % fs.x] = src_texel(f0 + ivec2(i % fs.x, i / fs.x));
+    }
   }
   barrier();
   // 2. Column tile.x + lx of every footprint row. A column beyond the image (not written) reads
