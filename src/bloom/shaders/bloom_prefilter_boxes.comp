@@ -22,9 +22,10 @@
 //
 // A workgroup of W x H invocations makes a tile of W x 2H outputs (two rows per invocation), which
 // halves the apron re-read per output against a W x H tile. Shared memory holds one fp32 value per
-// channel (no unused alpha) of the (2W + 14) x (4H + 14) window of P, reused in place for the
-// horizontal results and then the box means (each pass computes into registers, then a barrier,
-// then stores): 25 KiB at 16 x 8 against the 44 KiB of the general kernel's two vec4 windows.
+// channel (no unused alpha) of the (2W + 14) x (4H + 14) window of P, then of the box means, and of
+// the horizontal results: 44 KiB at 16 x 8. Reusing the window in place for the horizontal results
+// too (25 KiB) needed them staged in registers across a barrier: 182 registers on the H100, two
+// workgroups an SM (docs/PERF.md).
 layout(local_size_x_id = 0, local_size_y_id = 1) in;
 
 layout(binding = 0) uniform texture2D scene;
@@ -63,9 +64,14 @@ const float kEdge[12] = float[](1.0 / 1024.0, 10.0 / 1024.0, 45.0 / 1024.0, 120.
                                 252.0 / 1024.0, 210.0 / 1024.0, 120.0 / 1024.0, 45.0 / 1024.0, 10.0 / 1024.0,
                                 1.0 / 1024.0, 0.0);
 
+// The window of P (step 1), then the box means (step 3, stride kCornersW); the horizontal results
+// (step 2, stride kCornersW).
 shared float s_r[kWindowW * kWindowH];
 shared float s_g[kWindowW * kWindowH];
 shared float s_b[kWindowW * kWindowH];
+shared float t_r[kRowValues];
+shared float t_g[kRowValues];
+shared float t_b[kRowValues];
 
 vec3 shared_at(uint i) { return vec3(s_r[i], s_g[i], s_b[i]); }
 void shared_put(uint i, vec3 v) {
@@ -73,6 +79,7 @@ void shared_put(uint i, vec3 v) {
   s_g[i] = v.g;
   s_b[i] = v.b;
 }
+vec3 row_at(uint i) { return vec3(t_r[i], t_g[i], t_b[i]); }
 
 // One axis of a corner's box: corner `i` (absolute, in source texels) of an axis of `n` texels.
 // Its taps are window entries first + k, k = 0..11, with weights w[k]: the 12-tap binomial at
@@ -98,7 +105,11 @@ vec3 row_value(uint n, int x0, int w) {
 }
 void put_row(uint n, vec3 v) {
   uint q = gl_LocalInvocationIndex + n * kGroupSize;
-  if (q < kRowValues) shared_put(q, v);
+  if (q < kRowValues) {
+    t_r[q] = v.r;
+    t_g[q] = v.g;
+    t_b[q] = v.b;
+  }
 }
 
 // Step 3's value n: the vertical 12-tap sum at one corner whose two indices have the same parity;
@@ -111,7 +122,7 @@ vec3 box_value(uint n, int y0, int h) {
   bool edge = at_edge(j, h);
   uint first = uint(int(cy) + edge_shift(j, h)) * kCornersW + cx;
   vec3 sum = vec3(0.0);
-  [[unroll]] for (uint k = 0u; k < 12u; ++k) sum += (edge ? kEdge[k] : kInner[k]) * shared_at(first + k * kCornersW);
+  [[unroll]] for (uint k = 0u; k < 12u; ++k) sum += (edge ? kEdge[k] : kInner[k]) * row_at(first + k * kCornersW);
   return sum;
 }
 void put_box(uint n, vec3 v) {
@@ -152,34 +163,20 @@ void main() {
   barrier();
 
   // 2. Horizontal: every window row at every corner column, stored with row stride kCornersW.
-  // Results stay in registers until every invocation has read the window (it is reused in place).
   // CPU devices run the same loops without unrolling (PREFETCH, as above).
-  vec3 rows[kRowsPerInvocation];
   if (PREFETCH) {
-    [[unroll]] for (uint n = 0u; n < kRowsPerInvocation; ++n) rows[n] = row_value(n, corner0.x, src_size.x);
+    [[unroll]] for (uint n = 0u; n < kRowsPerInvocation; ++n) put_row(n, row_value(n, corner0.x, src_size.x));
   } else {
-    [[dont_unroll]] for (uint n = 0u; n < kRowsPerInvocation; ++n) rows[n] = row_value(n, corner0.x, src_size.x);
-  }
-  barrier();
-  if (PREFETCH) {
-    [[unroll]] for (uint n = 0u; n < kRowsPerInvocation; ++n) put_row(n, rows[n]);
-  } else {
-    [[dont_unroll]] for (uint n = 0u; n < kRowsPerInvocation; ++n) put_row(n, rows[n]);
+    [[dont_unroll]] for (uint n = 0u; n < kRowsPerInvocation; ++n) put_row(n, row_value(n, corner0.x, src_size.x));
   }
   barrier();
 
-  // 3. Vertical, at the corners the taps read, stored at their place in the kCornersW x kCornersH grid.
-  vec3 boxes[kBoxesPerInvocation];
+  // 3. Vertical, at the corners the taps read, stored at their place in the kCornersW x kCornersH
+  // grid over the window (read no more).
   if (PREFETCH) {
-    [[unroll]] for (uint n = 0u; n < kBoxesPerInvocation; ++n) boxes[n] = box_value(n, corner0.y, src_size.y);
+    [[unroll]] for (uint n = 0u; n < kBoxesPerInvocation; ++n) put_box(n, box_value(n, corner0.y, src_size.y));
   } else {
-    [[dont_unroll]] for (uint n = 0u; n < kBoxesPerInvocation; ++n) boxes[n] = box_value(n, corner0.y, src_size.y);
-  }
-  barrier();
-  if (PREFETCH) {
-    [[unroll]] for (uint n = 0u; n < kBoxesPerInvocation; ++n) put_box(n, boxes[n]);
-  } else {
-    [[dont_unroll]] for (uint n = 0u; n < kBoxesPerInvocation; ++n) put_box(n, boxes[n]);
+    [[dont_unroll]] for (uint n = 0u; n < kBoxesPerInvocation; ++n) put_box(n, box_value(n, corner0.y, src_size.y));
   }
   barrier();
 
