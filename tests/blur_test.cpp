@@ -215,7 +215,7 @@ const MethodCase kMethodCases[] = {
     {BlurMethod::separable, false, 6.0f},  // two line passes, radius 18
     {BlurMethod::separable, true, 1.2f},   // linear sampling, 5 fetches
     {BlurMethod::separable, true, 4.0f},  {BlurMethod::pyramid, false, 4.0f}, {BlurMethod::pyramid, false, 9.0f},
-    {BlurMethod::pyramid, false, 20.0f},  // 3 levels: level 2 by the separable binomial (blur_down.comp)
+    {BlurMethod::pyramid, false, 20.0f},  // 3 levels: levels 1 and 2 by the separable binomial (blur_down.comp)
     {BlurMethod::dual, false, 3.0f},      {BlurMethod::dual, false, 8.0f},
 };
 

@@ -288,14 +288,11 @@ struct GaussianBlur::Impl {
         const int dst = add(e);
         const bool last = j == choice.levels;
         const uint32_t flags = src == kInput ? sanitize : 0u;
-        // The last level fuses D with its blur; the first reads the caller's input with the fused
-        // kernel's binomial (every fetch in flight: faster on the H100 from memory, 93 against 147
-        // us at 3840x2160); the others are D alone from cache (src/blur/shaders/blur_down.comp).
+        // The last level fuses D with its blur; the others are D alone (src/blur/shaders/blur_down.comp).
         const std::string label = concat("gauss pyramid level ", j, last ? " (blur)" : " (down)");
-        Step s = last || j == 1 ? fused_step(prog, info, src, dst, prev, e, lf, last ? choice.level_sigma : 0.0,
-                                             blur_plan::kGaussTruncation, true, flags, max_value, label,
-                                             last && plan_made.fp32_shared)
-                                : down_step(prog, info, src, dst, prev, e, lf, flags, max_value, label);
+        Step s = last ? fused_step(prog, info, src, dst, prev, e, lf, choice.level_sigma, blur_plan::kGaussTruncation,
+                                   true, flags, max_value, label, plan_made.fp32_shared)
+                      : down_step(prog, info, src, dst, prev, e, lf, flags, max_value, label);
         if (src == kInput) read_padded_input(s, size, pad);
         prog.steps.push_back(std::move(s));
         src = dst;

@@ -10,13 +10,15 @@
 // binomial_sample() fetches 16 texels per output, and neighbouring outputs share half of them on
 // each axis: every source texel is fetched (and sanitized) four times. Here a workgroup loads its
 // tile's source block once into shared memory, sums it along x into shared rows, then along y:
-// H100, 3840x2160, sigma 16: level 2 44 -> 35 us, sigma 64: levels 3 and 4 20 -> 14 and 12 -> 7 us.
-// The first level (read from memory, where the 16-fetch form with every fetch in flight measured
-// faster: 93 against 147 us) and the last (D fused with the level blur) stay in blur_level.comp.
+// The last level of a pyramid (D fused with the level blur) stays in blur_level.comp. H100,
+// 3840x2160, whole blur (glint_bench medians, same machine): sigma 16 283 -> 271 us and sigma 64
+// 321 -> 312 us against the 16-fetch form at the first level (with every fetch in flight, 128
+// registers), which the levels after it had also beaten (a single frame's stage times had shown
+// the first level the other way round, 93 against 147 us: not what the whole blur does).
 layout(local_size_x_id = 0, local_size_y_id = 1) in;
 layout(constant_id = 2) const int ROWS = 1;  // output rows per invocation: tile = (WG.x, WG.y * ROWS)
 // Every fetch of the load step issued before the first shared store (GPUs: their latencies
-// overlap; one at a time, the first level took 183 us instead of 147 on the H100 at 3840x2160), or
+// overlap; one at a time, the sigma-16 blur took 311 us instead of 271 on the H100 at 3840x2160), or
 // a plain loop (CPU devices, as blur_level.comp's PREFETCH).
 layout(constant_id = 3) const bool PREFETCH = true;
 

@@ -43,11 +43,8 @@ const int LOADS = (LOAD_W * LOAD_H + GROUP_SIZE - 1) / GROUP_SIZE;  // source te
 // 0) or 4 (exact 2:1 area: 139 registers on the H100, but batches of two loads took the 3-level
 // BlurPyramid from 124.8 to 144.5 us at 59 registers); one at a time where a load is up to 16
 // (binomial, any-ratio area), which otherwise kept all their texels in registers (255 on the
-// H100; the pyramid's sigma-4 level blur 253 -> 223 us at 94). The pyramid's first downsample
-// alone (RADIUS 0, 4 loads an invocation) keeps them all in flight: it reads the caller's input
-// from memory, and at 128 registers took 93 us at 3840x2160 (sigma 16), which blur_down.comp's
-// one fetch per texel did not beat (147 us); the later levels, read from cache, go there.
-const int BATCH = MODE <= 1 || RADIUS == 0 ? LOADS : 1;
+// H100; the pyramid's sigma-4 level blur 253 -> 223 us at 94).
+const int BATCH = MODE <= 1 ? LOADS : 1;
 const int BATCHES = (LOADS + BATCH - 1) / BATCH;
 const int RUN = 4;                        // horizontal outputs per invocation (TILE_W is a multiple)
 const int H_RUNS = TILE_W / RUN;
