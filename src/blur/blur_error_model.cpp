@@ -451,7 +451,8 @@ double rounding_bound(const Plan& plan, const Storage& st) {
           arith * 2.0 * (plan.radius + 2.0);
       break;
     case Method::pyramid:  // k levels, the fused kernel's copies at the last, the B-spline output
-      u = plan.levels * st.level_unit + (st.level_half && !plan.fp32_shared ? 2.0 * half : 0.0) + st.output_unit +
+      u = (plan.levels + (pyramid_splits_last(plan.levels) ? 1.0 : 0.0)) * st.level_unit +
+          (st.level_half && !plan.fp32_shared ? 2.0 * half : 0.0) + st.output_unit +
           arith * (16.0 * plan.levels + line_taps + 16.0);
       break;
     case Method::dual:  // k down, k - 1 up into levels, the last up into the output

@@ -100,6 +100,12 @@ struct Plan {
   double cost = 0;                  //!< estimated microseconds (CostModel::estimate_us(work))
 };
 
+/// Whether a pyramid of `levels` levels stores its last level twice: at one level the downsample
+/// of the input and the level blur run as two dispatches (the downsample alone through shared
+/// memory, then the same-size fused blur), which on the H100 beat the fused blur that downsamples
+/// the full-resolution input in its load; the intermediate is one more store (docs/BLUR.md).
+inline bool pyramid_splits_last(uint32_t levels) { return levels == 1; }
+
 /// The border padding of a pyramid (levels, radius) or dual (levels, dual_offset) plan on an input
 /// of width x height (zero pads, the input size, for separable). See Padding.
 Padding padding_of(const Plan& plan, uint32_t width, uint32_t height);

@@ -288,15 +288,26 @@ struct GaussianBlur::Impl {
         const int dst = add(e);
         const bool last = j == choice.levels;
         const uint32_t flags = src == kInput ? sanitize : 0u;
-        // The last level fuses D with its blur; the others are D alone (src/blur/shaders/blur_down.comp).
-        const std::string label = concat("gauss pyramid level ", j, last ? " (blur)" : " (down)");
-        Step s = last ? fused_step(prog, info, src, dst, prev, e, lf, choice.level_sigma, blur_plan::kGaussTruncation,
-                                   true, flags, max_value, label, plan_made.fp32_shared)
-                      : down_step(prog, info, src, dst, prev, e, lf, flags, max_value, label);
+        // The last level fuses D with its blur, unless the plan splits it (blur_plan::
+        // pyramid_splits_last: D from the full-resolution input, then the level's blur); the
+        // others are D alone (src/blur/shaders/blur_down.comp).
+        const bool split = last && blur_plan::pyramid_splits_last(choice.levels);
+        const std::string label = concat("gauss pyramid level ", j, last && !split ? " (blur)" : " (down)");
+        Step s = last && !split
+                     ? fused_step(prog, info, src, dst, prev, e, lf, choice.level_sigma, blur_plan::kGaussTruncation,
+                                  true, flags, max_value, label, plan_made.fp32_shared)
+                     : down_step(prog, info, src, dst, prev, e, lf, flags, max_value, label);
         if (src == kInput) read_padded_input(s, size, pad);
         prog.steps.push_back(std::move(s));
         src = dst;
         prev = e;
+        if (split) {
+          const int blurred = add(e);
+          prog.steps.push_back(fused_step(prog, info, src, blurred, e, e, lf, choice.level_sigma,
+                                          blur_plan::kGaussTruncation, false, 0u, max_value,
+                                          concat("gauss pyramid level ", j, " (blur)"), plan_made.fp32_shared));
+          src = blurred;
+        }
       }
       Step up = upsample_step(prog, info, src, kOutput, prev, padded, out_format, max_value, "gauss pyramid upsample");
       write_padded_output(up, size, pad);
