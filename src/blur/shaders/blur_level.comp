@@ -43,7 +43,8 @@ const int LOADS = (LOAD_W * LOAD_H + GROUP_SIZE - 1) / GROUP_SIZE;  // source te
 // 0) or 4 (exact 2:1 area: 139 registers on the H100, but batches of two loads took the 3-level
 // BlurPyramid from 124.8 to 144.5 us at 59 registers); one at a time where a load is up to 16
 // (binomial, any-ratio area), which otherwise kept all their texels in registers (255 on the
-// H100; the pyramid's sigma-4 level blur 253 -> 223 us at 94).
+// H100; the binomial level blur from a full-resolution input, before the pyramid's one-level
+// split, 253 -> 223 us at 94 in a single frame).
 const int BATCH = MODE <= 1 ? LOADS : 1;
 const int BATCHES = (LOADS + BATCH - 1) / BATCH;
 const int RUN = 4;                        // horizontal outputs per invocation (TILE_W is a multiple)
