@@ -41,6 +41,24 @@ void check_extent_named(const Context& context, VkExtent2D e, const char* where,
   }
 }
 
+// The first shape of `gpu` (of `cpu` on CPU devices) whose invocations and shared memory
+// (`shared_bytes(shape)`) fit the device (CONTRIBUTING.md, "Device limits"): larger tiles first.
+// Throws Error(no_device) naming `what` and the smallest shape's need when none fits.
+template <typename Bytes>
+FusedShape first_fitting(const DeviceInfo& info, std::initializer_list<FusedShape> gpu,
+                         std::initializer_list<FusedShape> cpu, Bytes shared_bytes, const std::string& what) {
+  const std::initializer_list<FusedShape>& list = info.type == VK_PHYSICAL_DEVICE_TYPE_CPU ? cpu : gpu;
+  for (const FusedShape& s : list) {
+    if (s.workgroup.x * s.workgroup.y <= info.max_workgroup_invocations &&
+        shared_bytes(s) <= info.max_shared_memory_bytes) {
+      return s;
+    }
+  }
+  throw Error(ErrorCode::no_device,
+              concat(what, " needs ", shared_bytes(*(list.end() - 1)), " bytes of shared memory; device '", info.name,
+                     "' has ", info.max_shared_memory_bytes));
+}
+
 }  // namespace
 
 VkFormat precision_format(Precision p) {
@@ -48,20 +66,11 @@ VkFormat precision_format(Precision p) {
 }
 
 FusedShape fused_shape(const DeviceInfo& info, uint32_t radius, bool half_shared) {
-  static const FusedShape gpu[] = {{{32, 8}, 4}, {{32, 8}, 2}, {{32, 8}, 1}, {{16, 8}, 2}, {{16, 8}, 1}, {{8, 8}, 1}};
-  static const FusedShape cpu[] = {{{16, 8}, 1}, {{8, 8}, 1}};  // widths are multiples of 4 (RUN)
-  const bool is_cpu = info.type == VK_PHYSICAL_DEVICE_TYPE_CPU;
-  const FusedShape* begin = is_cpu ? cpu : gpu;
-  const FusedShape* end = is_cpu ? cpu + 2 : gpu + 6;
-  for (const FusedShape* s = begin; s != end; ++s) {
-    if (s->workgroup.x * s->workgroup.y <= info.max_workgroup_invocations &&
-        fused_shared_bytes(*s, radius, half_shared) <= info.max_shared_memory_bytes) {
-      return *s;
-    }
-  }
-  throw Error(ErrorCode::no_device,
-              concat("blur radius ", radius, " needs ", fused_shared_bytes({{8, 8}, 1}, radius, half_shared),
-                     " bytes of shared memory; device '", info.name, "' has ", info.max_shared_memory_bytes));
+  // CPU widths are multiples of 4 (RUN).
+  return first_fitting(
+      info, {{{32, 8}, 4}, {{32, 8}, 2}, {{32, 8}, 1}, {{16, 8}, 2}, {{16, 8}, 1}, {{8, 8}, 1}},
+      {{{16, 8}, 1}, {{8, 8}, 1}}, [&](FusedShape s) { return fused_shared_bytes(s, radius, half_shared); },
+      concat("blur radius ", radius));
 }
 
 float max_value_for(VkFormat a, VkFormat b) {
@@ -200,22 +209,6 @@ Step fused_step(StepProgram& prog, const DeviceInfo& info, int src, int dst, VkE
 
 namespace {
 
-// The first shape of `gpu` (of `cpu` on CPU devices) whose invocations and shared memory
-// (`shared_bytes(tile width, tile height)`) fit the device; the list's last shape must fit every
-// device (64 invocations, a few KiB).
-template <typename Bytes>
-FusedShape first_fitting(const DeviceInfo& info, std::initializer_list<FusedShape> gpu,
-                         std::initializer_list<FusedShape> cpu, Bytes shared_bytes) {
-  const std::initializer_list<FusedShape>& list = info.type == VK_PHYSICAL_DEVICE_TYPE_CPU ? cpu : gpu;
-  for (const FusedShape& s : list) {
-    if (s.workgroup.x * s.workgroup.y <= info.max_workgroup_invocations &&
-        shared_bytes(s.workgroup.x, s.workgroup.y * s.rows) <= info.max_shared_memory_bytes) {
-      return s;
-    }
-  }
-  return *(list.end() - 1);
-}
-
 // A step of a tiled kernel that takes only the source and destination (and the rows constant).
 Step tiled_step(StepProgram& prog, const char* kernel, FusedShape shape, int src, int dst, VkExtent2D src_size,
                 VkExtent2D dst_size, VkFormat dst_format, uint32_t flags, float max_value, std::string label) {
@@ -246,9 +239,13 @@ Step upsample_step(StepProgram& prog, const DeviceInfo& info, int src, int dst, 
   // Output tiles of 64x16 on GPUs (wide rows: coalesced writes, a footprint of 36x12 level
   // texels); CPU devices (lavapipe) get 16x8, as their other 2D kernels. Shared memory: the
   // footprint (TW / 2 + 4) x (TH / 2 + 4) and the horizontal pass (TH / 2 + 4) x TW, 16 bytes each.
-  const FusedShape shape =
-      first_fitting(info, {{{64, 4}, 4}, {{32, 4}, 2}, {{16, 8}, 1}, {{8, 8}, 1}}, {{{16, 8}, 1}, {{8, 8}, 1}},
-                    [](uint32_t tw, uint32_t th) { return 16 * (th / 2 + 4) * (tw / 2 + 4 + tw); });
+  const FusedShape shape = first_fitting(
+      info, {{{64, 4}, 4}, {{32, 4}, 2}, {{16, 8}, 1}, {{8, 8}, 1}}, {{{16, 8}, 1}, {{8, 8}, 1}},
+      [](FusedShape s) {
+        const uint32_t tw = s.workgroup.x, th = s.workgroup.y * s.rows;
+        return 16 * (th / 2 + 4) * (tw / 2 + 4 + tw);
+      },
+      "the blur upsample");
   return tiled_step(prog, "blur_upsample", shape, src, dst, src_size, dst_size, dst_format, 0u, max_value,
                     std::move(label));
 }
@@ -261,8 +258,13 @@ Step down_step(StepProgram& prog, const DeviceInfo& info, int src, int dst, VkEx
   }
   // Output tiles of 32x8 on GPUs (a source block of 66x18), 16x8 on CPU devices. Shared memory:
   // the block (2 TW + 2) x (2 TH + 2) and its rows summed along x, (2 TH + 2) x TW, 16 bytes each.
-  const FusedShape shape = first_fitting(info, {{{32, 8}, 1}, {{16, 8}, 1}, {{8, 8}, 1}}, {{{16, 8}, 1}, {{8, 8}, 1}},
-                                         [](uint32_t tw, uint32_t th) { return 16 * (2 * th + 2) * (3 * tw + 2); });
+  const FusedShape shape = first_fitting(
+      info, {{{32, 8}, 1}, {{16, 8}, 1}, {{8, 8}, 1}}, {{{16, 8}, 1}, {{8, 8}, 1}},
+      [](FusedShape s) {
+        const uint32_t tw = s.workgroup.x, th = s.workgroup.y * s.rows;
+        return 16 * (2 * th + 2) * (3 * tw + 2);
+      },
+      "the blur downsample");
   return tiled_step(prog, "blur_down", shape, src, dst, src_size, dst_size, dst_format, flags, max_value,
                     std::move(label));
 }

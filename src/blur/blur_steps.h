@@ -113,7 +113,6 @@ Step fused_step(StepProgram& prog, const DeviceInfo& info, int src, int dst, VkE
                 VkFormat dst_format, double sigma, double truncation, bool binomial, uint32_t flags, float max_value,
                 std::string label, bool fp32_shared = false);
 
-// A plain per-texel step (upsample, dual down/up) with 2D workgroups.
 // The pyramid's B-spline upsample (src/blur/shaders/blur_upsample.comp) from `src` to `dst`: its
 // tile shape from the device (the largest whose shared footprint and invocations fit).
 Step upsample_step(StepProgram& prog, const DeviceInfo& info, int src, int dst, VkExtent2D src_size,
@@ -122,6 +121,7 @@ Step upsample_step(StepProgram& prog, const DeviceInfo& info, int src, int dst, 
 // `src` to `dst`: its tile shape from the device, as upsample_step's.
 Step down_step(StepProgram& prog, const DeviceInfo& info, int src, int dst, VkExtent2D src_size, VkExtent2D dst_size,
                VkFormat dst_format, uint32_t flags, float max_value, std::string label);
+// A plain per-texel step (dual down/up) with 2D workgroups.
 Step simple_step(StepProgram& prog, const char* kernel, int src, int dst, VkExtent2D src_size, VkExtent2D dst_size,
                  VkFormat dst_format, uint32_t flags, float max_value, std::string label,
                  std::vector<VkDescriptorType> bindings = {VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE,
