@@ -30,8 +30,9 @@ void BM_Bloom(benchmark::State& state) {
   const auto precision = static_cast<Precision>(state.range(3));
   const auto guard = static_cast<FireflyGuard>(state.range(4));
   const auto level0_height = static_cast<uint32_t>(state.range(5));
-  // fused: bit 0 the small levels in one dispatch, bit 1 the last upsample in the composite
-  // (src/bloom/bloom_internal.h, docs/BLOOM.md "Dispatches"); 3 is the default, 0 one dispatch per level.
+  // fused: bit 0 the small levels in one dispatch, bit 1 the last upsample in the composite, bit 2
+  // the tiled composite instead of the 2:1 one, bit 3 the tiled upsample steps instead of the 2:1
+  // ones (src/bloom/bloom_internal.h, docs/BLOOM.md "Dispatches"); 0 is the default.
   const auto fused = static_cast<uint32_t>(state.range(6));
   const Context& ctx = context();
   const VkFormat format = VK_FORMAT_R16G16B16A16_SFLOAT;
@@ -46,7 +47,7 @@ void BM_Bloom(benchmark::State& state) {
   config.firefly_guard = guard;
   config.level0_height = level0_height;
   Bloom bloom(ctx, config);
-  detail::BloomAccess::set_path(bloom, {(fused & 1u) != 0, (fused & 2u) != 0});
+  detail::BloomAccess::set_path(bloom, {(fused & 1u) != 0, (fused & 2u) != 0, (fused & 4u) == 0, (fused & 8u) == 0});
   bloom.prepare({width, height});
   Profiler profiler(ctx, kFramesPerIteration + 1);
 
@@ -101,9 +102,11 @@ void bloom_args(benchmark::internal::Benchmark* b) {
   // Defaults (karis_smooth, level0_height 0) per filter and cod13 with fp32 levels; then cod13 with
   // the per-box guard and none (what the smooth guard costs), and with level0_height 540. Each with
   // the fused dispatches (fused:3) and one dispatch per level (fused:0, the default); the default
-  // configuration also with each fusion alone (fused:1 small levels, fused:2 the last upsample).
+  // configuration also with each fusion alone (fused:1 small levels, fused:2 the last upsample)
+  // and with the tiled kernels where the 2:1 ones run (fused:4 the composite, 8 the upsample
+  // steps, 12 both).
   for (auto size : {std::pair{640, 480}, std::pair{1920, 1080}, std::pair{3840, 2160}}) {
-    for (int fused : {3, 0, 1, 2}) b->Args({size.first, size.second, 0, 0, 2, 0, fused});
+    for (int fused : {3, 0, 1, 2, 4, 8, 12}) b->Args({size.first, size.second, 0, 0, 2, 0, fused});
     for (int fused : {3, 0}) {
       for (int filter = 1; filter < 3; ++filter) b->Args({size.first, size.second, filter, 0, 2, 0, fused});
       b->Args({size.first, size.second, 0, 1, 2, 0, fused});

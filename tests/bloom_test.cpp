@@ -196,6 +196,38 @@ TEST_F(BloomTest, MatchesReferenceForEveryGuardAndLevel0Height) {
   }
 }
 
+// Where the output is exactly twice level 0 on both axes, cod13 and gauss9 composite through
+// bloom_composite_2x.comp (one invocation per 2x2 block, the upsample's weights formed per offset,
+// offsets -S .. S with S = floor(r + 1/4) + 1 taken from the radius at run time). Every radius
+// that changes S (0.25 to 4), set per frame on one effect (set_config makes no pipeline for a
+// radius), against the float64 reference on the light added: an even size whose blocks fill the
+// workgroups and one whose last row and column of workgroups are partial. fp32 levels and I/O: 1e-3
+// as above.
+TEST_F(BloomTest, TwoToOneCompositeMatchesReferenceAtEveryRadius) {
+  for (BloomFilter filter : {BloomFilter::cod13, BloomFilter::gauss9}) {
+    BloomConfig config;
+    config.filter = filter;
+    config.precision = Precision::fp32;
+    config.iterations = 3;
+    config.intensity = 1.0f;
+    Bloom bloom(context(), config);
+    for (VkExtent2D size : {VkExtent2D{96, 64}, VkExtent2D{100, 70}}) {
+      const CpuImage input = random_hdr(size.width, size.height, size.width + 3 * size.height);
+      for (float radius : {0.25f, 0.8f, 1.0f, 1.3f, 2.5f, 3.75f, 4.0f}) {
+        config.radius = radius;
+        bloom.set_config(config);
+        const CpuImage gpu = run_bloom(bloom, input, kF32, kF32);
+        ASSERT_TRUE(all_finite(gpu)) << "unwritten (poisoned) texels remain";
+        double norm = 0.0;
+        const double err = added_light_rel_l2(gpu, reference::bloom(input, config), input, norm);
+        EXPECT_GT(norm, 0.0);
+        EXPECT_LT(err, 1e-3) << bloom_filter_name(filter) << " " << size.width << "x" << size.height << " radius "
+                             << radius;
+      }
+    }
+  }
+}
+
 // The karis_smooth first step at an exact 2:1 reduction with cod13 and dual runs its own kernel
 // on GPUs and wherever ContextOptions::workgroup_2d is set (src/bloom/shaders/bloom_prefilter_boxes.comp:
 // the box means of the binomially filtered source as one 12-tap binomial pass per axis, a

@@ -120,14 +120,19 @@ struct Bloom::Impl {
 
   // Pipelines for the current shape (filter, precision); composite and copy per output format.
   detail::ComputePipeline prefilter_down, down, blur, up;
+  // bloom_up_2x for the separable filters (cod13, gauss9), run where level k is exactly twice
+  // level k+1 on both axes; else empty.
+  detail::ComputePipeline up_2x;
   // karis_smooth at an exact 2:1 first step with cod13 or dual (smooth_boxes_apply()); else empty.
   detail::ComputePipeline prefilter_boxes;
   // The small levels in one dispatch (path.fuse_small_levels); else empty.
   detail::ComputePipeline tail;
   // Composite and copy per output variant (core/formats.h, check_color_write()): rgba16f and
   // rgba32f are made with the others, r11f_g11f_b10f and noformat on first use. The composite is
-  // bloom_composite_up (path.fuse_last_up) or bloom_composite.
-  std::map<std::string, detail::ComputePipeline> composite, copy;
+  // bloom_composite_up (path.fuse_last_up) or bloom_composite; composite_2x holds
+  // bloom_composite_2x for the separable filters (cod13, gauss9), which record() runs where the
+  // output is exactly twice level 0 on both axes.
+  std::map<std::string, detail::ComputePipeline> composite, composite_2x, copy;
 
   // The pyramid of one input extent (and config generation). Kept per size in `cache` until no
   // submitted work can use it (core/size_cache.h), so one Bloom may be recorded at several sizes.
@@ -175,6 +180,9 @@ struct Bloom::Impl {
     blur = config.filter == BloomFilter::gauss9 ? detail::ComputePipeline(*context, desc("bloom_blur_" + lv, {S, W}))
                                                 : detail::ComputePipeline();
     up = detail::ComputePipeline(*context, desc("bloom_up_" + lv, {S, W}));
+    up_2x = path.up_2x && config.filter != BloomFilter::dual
+                ? detail::ComputePipeline(*context, desc("bloom_up_2x_" + lv, {S, W}))
+                : detail::ComputePipeline();
     if (path.fuse_small_levels) {
       detail::PipelineDesc d = desc("bloom_tail_" + lv, {S, W});
       d.push_constant_bytes = sizeof(BloomTailPush);
@@ -185,12 +193,19 @@ struct Bloom::Impl {
       tail = detail::ComputePipeline();
     }
     composite.clear();
+    composite_2x.clear();
     copy.clear();
     for (const char* v : {"rgba16f", "rgba32f"}) output_pipelines(v);
   }
 
-  // The composite and copy pipelines that write an output of kernel variant `v`.
-  std::pair<detail::ComputePipeline*, detail::ComputePipeline*> output_pipelines(const std::string& v) {
+  // The pipelines that write an output of kernel variant `v`: the composite, the 2:1 composite
+  // (null where it does not apply: dual, or the composite with the last upsample fused) and the copy.
+  struct OutputPipelines {
+    detail::ComputePipeline* composite;
+    detail::ComputePipeline* composite_2x;
+    detail::ComputePipeline* copy;
+  };
+  OutputPipelines output_pipelines(const std::string& v) {
     const auto S = VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE;
     const auto W = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
     auto c = composite.find(v);
@@ -199,9 +214,18 @@ struct Bloom::Impl {
           path.fuse_last_up ? desc("bloom_composite_up_" + v, {S, S, W, S}) : desc("bloom_composite_" + v, {S, S, W});
       c = composite.emplace(v, detail::ComputePipeline(*context, d)).first;
     }
+    detail::ComputePipeline* c2 = nullptr;
+    if (!path.fuse_last_up && path.composite_2x && config.filter != BloomFilter::dual) {
+      auto it = composite_2x.find(v);
+      if (it == composite_2x.end()) {
+        it = composite_2x.emplace(v, detail::ComputePipeline(*context, desc("bloom_composite_2x_" + v, {S, S, W})))
+                 .first;
+      }
+      c2 = &it->second;
+    }
     auto k = copy.find(v);
     if (k == copy.end()) k = copy.emplace(v, detail::ComputePipeline(*context, desc("image_copy_" + v, {S, W}))).first;
-    return {&c->second, &k->second};
+    return {&c->second, c2, &k->second};
   }
 
   // The pyramid for `size`, from the cache or made now; it becomes `cur`. Throws (before anything
@@ -316,7 +340,7 @@ void Bloom::Impl::record(VkCommandBuffer cmd, Image& input, Image& output, Profi
     // Nothing to add: the output is the input. In place that is no work at all.
     if (in_place) return;
     Pyramid& P = pyramid_for(input.extent, "Bloom::record");
-    const detail::ComputePipeline* copy_pipeline = output_pipelines(out_variant).second;
+    const detail::ComputePipeline* copy_pipeline = output_pipelines(out_variant).copy;
     cache.recorded(&P, cmd);
     detail::Barriers b;
     b.use(input, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, kSampled);
@@ -330,7 +354,7 @@ void Bloom::Impl::record(VkCommandBuffer cmd, Image& input, Image& output, Profi
     return;
   }
   Pyramid& P = pyramid_for(input.extent, "Bloom::record");
-  const detail::ComputePipeline* composite_pipeline = output_pipelines(out_variant).first;
+  const OutputPipelines out_pipelines = output_pipelines(out_variant);
   cache.recorded(&P, cmd);
   const std::vector<LevelSize>& chain = P.chain;
   const std::vector<LevelSize>& pre_chain = P.pre_chain;
@@ -426,8 +450,13 @@ void Bloom::Impl::record(VkCommandBuffer cmd, Image& input, Image& output, Profi
     b.use(levels[k + 1].state, G, kCompute, kSampled);
     b.use(levels[k].state, G, kCompute, kStorageRead | kStorageWrite);
     b.flush(cmd);
-    up.dispatch(cmd, {{levels[k + 1].state.view, G}, {levels[k].state.view, G}}, push(P, chain[k + 1], chain[k]),
-                chain[k].width, chain[k].height);
+    const detail::Bindings bindings{{levels[k + 1].state.view, G}, {levels[k].state.view, G}};
+    if (up_2x && chain[k].width == 2 * chain[k + 1].width && chain[k].height == 2 * chain[k + 1].height) {
+      // One invocation per 2x2 block of level k (bloom_up_2x.comp).
+      up_2x.dispatch(cmd, bindings, push(P, chain[k + 1], chain[k]), chain[k].width / 2, chain[k].height / 2);
+    } else {
+      up.dispatch(cmd, bindings, push(P, chain[k + 1], chain[k]), chain[k].width, chain[k].height);
+    }
   }
   if (profiler && have > up_to) profiler->mark(cmd, "bloom upsample");
 
@@ -446,7 +475,7 @@ void Bloom::Impl::record(VkCommandBuffer cmd, Image& input, Image& output, Profi
     b.use(scene, scene_layout, kCompute, kSampled);
     b.use(output, G, kCompute, in_place ? (kSampled | kStorageWrite) : kStorageWrite);
     b.flush(cmd);
-    composite_pipeline->dispatch(
+    out_pipelines.composite->dispatch(
         cmd, {{input.view, scene_layout}, {levels[0].state.view, G}, {output.view, G}, {next.view, G}}, cp, full.width,
         full.height);
   } else {
@@ -454,8 +483,13 @@ void Bloom::Impl::record(VkCommandBuffer cmd, Image& input, Image& output, Profi
     b.use(scene, scene_layout, kCompute, kSampled);
     b.use(output, G, kCompute, in_place ? (kSampled | kStorageWrite) : kStorageWrite);
     b.flush(cmd);
-    composite_pipeline->dispatch(cmd, {{input.view, scene_layout}, {levels[0].state.view, G}, {output.view, G}},
-                                 push(P, chain[0], full), full.width, full.height);
+    const detail::Bindings bindings{{input.view, scene_layout}, {levels[0].state.view, G}, {output.view, G}};
+    if (out_pipelines.composite_2x && full.width == 2 * chain[0].width && full.height == 2 * chain[0].height) {
+      // One invocation per 2x2 block of outputs (bloom_composite_2x.comp).
+      out_pipelines.composite_2x->dispatch(cmd, bindings, push(P, chain[0], full), full.width / 2, full.height / 2);
+    } else {
+      out_pipelines.composite->dispatch(cmd, bindings, push(P, chain[0], full), full.width, full.height);
+    }
   }
   if (profiler) profiler->mark(cmd, "bloom composite");
   if (in_place) input = output;

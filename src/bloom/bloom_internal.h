@@ -14,6 +14,11 @@ struct BloomPath {
   /// The composite evaluates A(0) = level 0 + Up(A(1)) itself (bloom_composite_up.comp) instead of
   /// an upsample dispatch writing A(0) over level 0.
   bool fuse_last_up = false;
+  /// Where an image is exactly twice the level it upsamples on both axes and the filter is
+  /// separable (cod13, gauss9), the composite (bloom_composite_2x.comp) and the upsample steps
+  /// (bloom_up_2x.comp) run one invocation per 2x2 block instead of the tiled kernels.
+  bool composite_2x = true;
+  bool up_2x = true;
 };
 
 struct BloomAccess {
