@@ -48,6 +48,17 @@ double added_light_error(const CpuImage& gpu, const CpuImage& input, const Bloom
   return norm > 0.0 ? err : std::numeric_limits<double>::infinity();
 }
 
+// The configuration the added-light comparisons use: `filter`, fp32 levels (fp32 arithmetic end
+// to end, so a 1e-3 bound), 3 iterations, intensity 1; the default guard.
+BloomConfig added_light_config(BloomFilter filter) {
+  BloomConfig config;
+  config.filter = filter;
+  config.precision = Precision::fp32;
+  config.iterations = 3;
+  config.intensity = 1.0f;
+  return config;
+}
+
 // Runs one bloom of `input` and reads the output back. The output starts poisoned with NaN.
 CpuImage run_bloom(Bloom& bloom, const CpuImage& input, VkFormat in_format, VkFormat out_format,
                    Profiler* profiler = nullptr) {
@@ -183,12 +194,8 @@ TEST_F(BloomTest, MatchesReferenceForEveryGuardAndLevel0Height) {
   const Case cases[] = {{97, 61, 0}, {200, 150, 40}, {61, 97, 30}, {40, 30, 24}, {17, 9, 8}, {33, 20, 64}};
   for (BloomFilter filter : kFilters) {
     for (FireflyGuard guard : {FireflyGuard::off, FireflyGuard::karis, FireflyGuard::karis_smooth}) {
-      BloomConfig config;
-      config.filter = filter;
+      BloomConfig config = added_light_config(filter);
       config.firefly_guard = guard;
-      config.precision = Precision::fp32;
-      config.iterations = 3;
-      config.intensity = 1.0f;
       Bloom bloom(context(), config);  // one effect: set_config re-makes only the pyramid
       for (const Case& c : cases) {
         config.level0_height = c.level0_height;
@@ -213,11 +220,7 @@ TEST_F(BloomTest, MatchesReferenceForEveryGuardAndLevel0Height) {
 // as above.
 TEST_F(BloomTest, TwoToOneUpsampleAndCompositeMatchReferenceAtEveryRadius) {
   for (BloomFilter filter : {BloomFilter::cod13, BloomFilter::gauss9}) {
-    BloomConfig config;
-    config.filter = filter;
-    config.precision = Precision::fp32;
-    config.iterations = 3;
-    config.intensity = 1.0f;
+    BloomConfig config = added_light_config(filter);
     Bloom bloom(context(), config);
     for (VkExtent2D size : {VkExtent2D{96, 64}, VkExtent2D{100, 70}}) {
       const CpuImage input = random_hdr(size.width, size.height, size.width + 3 * size.height);
@@ -254,11 +257,7 @@ TEST_F(BloomTest, SmoothBoxesFirstStepMatchesReference) {
   for (const auto& c : forced) contexts.push_back(c.get());
   for (const Context* ctx : contexts) {
     for (BloomFilter filter : {BloomFilter::cod13, BloomFilter::dual}) {
-      BloomConfig config;
-      config.filter = filter;
-      config.precision = Precision::fp32;
-      config.iterations = 3;
-      config.intensity = 1.0f;
+      const BloomConfig config = added_light_config(filter);
       ASSERT_EQ(config.firefly_guard, FireflyGuard::karis_smooth);
       Bloom bloom(*ctx, config);
       for (VkExtent2D size : sizes) {
