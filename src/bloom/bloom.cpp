@@ -70,10 +70,16 @@ bool smooth_boxes_kernel(const Context& context, const BloomConfig& config) {
   return config.firefly_guard == FireflyGuard::karis_smooth && config.filter != BloomFilter::gauss9 && gpu_kernels;
 }
 
+// Whether `big` is exactly twice `small` on both axes (an exact 2:1 step, which the box-means
+// first step and the 2:1 upsample and composite kernels need).
+bool exactly_twice(LevelSize big, LevelSize small) {
+  return big.width == 2 * small.width && big.height == 2 * small.height;
+}
+
 // Whether the first downsample runs that kernel: it needs an exact 2:1 step. Every other case
 // runs the general src/bloom/shaders/bloom_prefilter_smooth.comp.
 bool smooth_boxes_apply(const Context& context, const BloomConfig& config, VkExtent2D full, LevelSize first) {
-  return smooth_boxes_kernel(context, config) && full.width == 2 * first.width && full.height == 2 * first.height;
+  return smooth_boxes_kernel(context, config) && exactly_twice({full.width, full.height}, first);
 }
 
 // The device's preferred workgroup if its shared memory holds the tiles, else 8x8 (12 KiB).
@@ -451,7 +457,7 @@ void Bloom::Impl::record(VkCommandBuffer cmd, Image& input, Image& output, Profi
     b.use(levels[k].state, G, kCompute, kStorageRead | kStorageWrite);
     b.flush(cmd);
     const detail::Bindings bindings{{levels[k + 1].state.view, G}, {levels[k].state.view, G}};
-    if (up_2x && chain[k].width == 2 * chain[k + 1].width && chain[k].height == 2 * chain[k + 1].height) {
+    if (up_2x && exactly_twice(chain[k], chain[k + 1])) {
       // One invocation per 2x2 block of level k (bloom_up_2x.comp).
       up_2x.dispatch(cmd, bindings, push(P, chain[k + 1], chain[k]), chain[k].width / 2, chain[k].height / 2);
     } else {
@@ -484,7 +490,7 @@ void Bloom::Impl::record(VkCommandBuffer cmd, Image& input, Image& output, Profi
     b.use(output, G, kCompute, in_place ? (kSampled | kStorageWrite) : kStorageWrite);
     b.flush(cmd);
     const detail::Bindings bindings{{input.view, scene_layout}, {levels[0].state.view, G}, {output.view, G}};
-    if (out_pipelines.composite_2x && full.width == 2 * chain[0].width && full.height == 2 * chain[0].height) {
+    if (out_pipelines.composite_2x && exactly_twice(full, chain[0])) {
       // One invocation per 2x2 block of outputs (bloom_composite_2x.comp).
       out_pipelines.composite_2x->dispatch(cmd, bindings, push(P, chain[0], full), full.width / 2, full.height / 2);
     } else {

@@ -137,3 +137,14 @@ vec3 downsample(texture2D src, BloomSource s, ivec2 xy, ivec2 dst_size, bool kar
   add_box(sum, wsum, (g[4] + g[5] + g[7] + g[8]) * 0.25, 0.125, karis);
   return sum / wsum;
 }
+
+#ifdef OUTPUT_MAX
+// The composite's rule for one output texel (docs/BLOOM.md "Composite"): scene + scale * bloom on
+// RGB, the scene's alpha; a NaN scene channel counts as 0 and every channel is clamped to
+// +-OUTPUT_MAX (the output format's largest finite value, set per kernel variant), so the output
+// is finite even where the scene is not.
+vec4 composite_texel(vec4 scene, vec3 bloom, float scale) {
+  scene = mix(scene, vec4(0.0), isnan(scene));
+  return clamp(vec4(scene.rgb + scale * bloom, scene.a), vec4(-OUTPUT_MAX), vec4(OUTPUT_MAX));
+}
+#endif

@@ -24,7 +24,5 @@ void main() {
   vec4 s = texelFetch(scene, min(xy, size - 1), 0);  // issued first: its latency overlaps the tile work
   vec3 bloom = upsample_tiled(level0, ivec2(p.src_width, p.src_height), size, p.radius);
   if (any(greaterThanEqual(xy, size))) return;  // after the barriers inside upsample_tiled
-  s = mix(s, vec4(0.0), isnan(s));
-  vec4 o = vec4(s.rgb + p.composite_scale * bloom, s.a);
-  imageStore(result, xy, clamp(o, vec4(-OUTPUT_MAX), vec4(OUTPUT_MAX)));
+  imageStore(result, xy, composite_texel(s, bloom, p.composite_scale));
 }

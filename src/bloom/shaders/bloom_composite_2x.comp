@@ -5,8 +5,7 @@
 // The composite out = scene + intensity / N * Up(A0) (docs/BLOOM.md "Composite") where the output
 // is exactly twice level 0 on both axes and the filter is separable (cod13, gauss9): one
 // invocation per 2x2 block of outputs (bloom_up_2x.glsl), no shared memory and no barrier, so
-// that the kernel streams the scene like a copy. A NaN scene channel becomes 0 and the sum is
-// clamped to +-OUTPUT_MAX, as in bloom_composite.comp.
+// that the kernel streams the scene like a copy. Each output follows composite_texel() (bloom.glsl).
 layout(local_size_x_id = 0, local_size_y_id = 1) in;
 
 layout(binding = 0) uniform texture2D scene;
@@ -20,12 +19,6 @@ layout(push_constant) uniform Push { BloomPush p; };
 #include "bloom.glsl"
 #include "bloom_up_2x.glsl"
 
-void composite(ivec2 xy, vec4 s, vec3 bloom) {
-  s = mix(s, vec4(0.0), isnan(s));
-  const vec4 o = vec4(s.rgb + p.composite_scale * bloom, s.a);
-  imageStore(result, xy, clamp(o, vec4(-OUTPUT_MAX), vec4(OUTPUT_MAX)));
-}
-
 void main() {
   const ivec2 k = ivec2(gl_GlobalInvocationID.xy);  // the block's level-0 texel
   const ivec2 xy = 2 * k;                            // its first output
@@ -35,8 +28,8 @@ void main() {
   const vec4 s01 = texelFetch(scene, xy + ivec2(0, 1), 0), s11 = texelFetch(scene, xy + ivec2(1, 1), 0);
   vec3 a[4];
   up_2x_block(level0, ivec2(p.src_width, p.src_height), k, p.radius, a);
-  composite(xy, s00, a[0]);
-  composite(xy + ivec2(1, 0), s10, a[1]);
-  composite(xy + ivec2(0, 1), s01, a[2]);
-  composite(xy + ivec2(1, 1), s11, a[3]);
+  imageStore(result, xy, composite_texel(s00, a[0], p.composite_scale));
+  imageStore(result, xy + ivec2(1, 0), composite_texel(s10, a[1], p.composite_scale));
+  imageStore(result, xy + ivec2(0, 1), composite_texel(s01, a[2], p.composite_scale));
+  imageStore(result, xy + ivec2(1, 1), composite_texel(s11, a[3], p.composite_scale));
 }

@@ -129,7 +129,5 @@ void main() {
   }
   vec3 bloom = upsample_window(size0, size, p.radius, lo, win);
   if (any(greaterThanEqual(xy, size))) return;  // after the barriers inside upsample_window
-  s = mix(s, vec4(0.0), isnan(s));
-  vec4 o = vec4(s.rgb + p.composite_scale * bloom, s.a);
-  imageStore(result, xy, clamp(o, vec4(-OUTPUT_MAX), vec4(OUTPUT_MAX)));
+  imageStore(result, xy, composite_texel(s, bloom, p.composite_scale));
 }
