@@ -26,6 +26,11 @@
 // the horizontal results: 44 KiB at 16 x 8. Reusing the window in place for the horizontal results
 // too (25 KiB) needed them staged in registers across a barrier: 182 registers on the H100, two
 // workgroups an SM (docs/PERF.md).
+//
+// The horizontal pass is register-blocked: an invocation sums a run of kRun consecutive corner
+// columns of one window row from the kRun + 11 window values they share, read once (3 x 15 shared
+// reads for 4 sums instead of 3 x 48). Consecutive invocations take consecutive window rows, and
+// the window's row stride is odd, so the 32 lanes of a read hit 32 different banks.
 layout(local_size_x_id = 0, local_size_y_id = 1) in;
 
 layout(binding = 0) uniform texture2D scene;
@@ -47,8 +52,14 @@ const uint kWindowW = kCornersW + 2u * uint(kRadius) + 1u;
 const uint kWindowH = kCornersH + 2u * uint(kRadius) + 1u;
 const uint kGroupSize = gl_WorkGroupSize.x * gl_WorkGroupSize.y;
 const uint kLoads = (kWindowW * kWindowH + kGroupSize - 1u) / kGroupSize;
+// Row stride of the window in shared memory: odd, so that lanes reading one column of
+// consecutive rows fall in distinct banks.
+const uint kStride = kWindowW | 1u;
 const uint kRowValues = kCornersW * kWindowH;  // horizontal pass results
-const uint kRowsPerInvocation = (kRowValues + kGroupSize - 1u) / kGroupSize;
+// Step 2 in runs of kRun corner columns of one window row.
+const uint kRun = 4u;
+const uint kRunsPerRow = (kCornersW + kRun - 1u) / kRun;
+const uint kRuns = kRunsPerRow * kWindowH;
 // Corners with both indices of the same parity: rows of even index hold kTileW + 2 of them, odd
 // rows kTileW + 1; enumerated as kCornersH rows of kTileW + 2 slots, the last slot of odd rows unused.
 const uint kBoxSlots = kCornersH * (kTileW + 2u);
@@ -64,11 +75,12 @@ const float kEdge[12] = float[](1.0 / 1024.0, 10.0 / 1024.0, 45.0 / 1024.0, 120.
                                 252.0 / 1024.0, 210.0 / 1024.0, 120.0 / 1024.0, 45.0 / 1024.0, 10.0 / 1024.0,
                                 1.0 / 1024.0, 0.0);
 
-// The window of P (step 1), then the box means (step 3, stride kCornersW); the horizontal results
-// (step 2, stride kCornersW).
-shared float s_r[kWindowW * kWindowH];
-shared float s_g[kWindowW * kWindowH];
-shared float s_b[kWindowW * kWindowH];
+// The window of P (step 1, row stride kStride, plus the kRun entries the last run of the last row
+// reads past its end and never uses), then the box means (step 3, stride kCornersW); the
+// horizontal results (step 2, stride kCornersW).
+shared float s_r[kStride * kWindowH + kRun];
+shared float s_g[kStride * kWindowH + kRun];
+shared float s_b[kStride * kWindowH + kRun];
 shared float t_r[kRowValues];
 shared float t_g[kRowValues];
 shared float t_b[kRowValues];
@@ -91,24 +103,43 @@ bool at_edge(int i, int n) { return i < 0 || i > n - 2; }
 #define BOX_MEAN(i) shared_at(i)
 #include "bloom_boxes.glsl"
 
-// Step 2's value n of this invocation: the horizontal 12-tap sum at one (window row, corner
-// column); `x0` is the absolute corner of column 0, `w` the source width.
-vec3 row_value(uint n, int x0, int w) {
-  uint q = min(gl_LocalInvocationIndex + n * kGroupSize, kRowValues - 1u);
-  uint row = q / kCornersW, col = q % kCornersW;
+// Step 2 at one window row and corner column: the horizontal 12-tap sum, stored with row stride
+// kCornersW; `x0` is the absolute corner of column 0, `w` the source width.
+void put_row(uint row, uint col, vec3 v) {
+  const uint q = row * kCornersW + col;
+  t_r[q] = v.r;
+  t_g[q] = v.g;
+  t_b[q] = v.b;
+}
+vec3 row_value(uint row, uint col, int x0, int w) {
   int i = x0 + int(col);
   bool edge = at_edge(i, w);
-  uint first = row * kWindowW + uint(int(col) + edge_shift(i, w));
+  uint first = row * kStride + uint(int(col) + edge_shift(i, w));
   vec3 sum = vec3(0.0);
   [[unroll]] for (uint k = 0u; k < 12u; ++k) sum += (edge ? kEdge[k] : kInner[k]) * shared_at(first + k);
   return sum;
 }
-void put_row(uint n, vec3 v) {
-  uint q = gl_LocalInvocationIndex + n * kGroupSize;
-  if (q < kRowValues) {
-    t_r[q] = v.r;
-    t_g[q] = v.g;
-    t_b[q] = v.b;
+
+// Run q of step 2 (q < kRuns): corner columns kRun c .. kRun c + kRun - 1 of window row r, with
+// r = q mod kWindowH (consecutive invocations, consecutive rows). Where none of the columns is at
+// an image edge, the run's kRun + 11 window values are read once and each column sums its 12 with
+// the interior weights; else each column takes row_value().
+void row_run(uint q, int x0, int w) {
+  const uint row = q % kWindowH, col0 = (q / kWindowH) * kRun;
+  const int i0 = x0 + int(col0);
+  if (!at_edge(i0, w) && !at_edge(i0 + int(kRun) - 1, w)) {
+    const uint first = row * kStride + col0;
+    vec3 v[kRun + 11u];
+    [[unroll]] for (uint k = 0u; k < kRun + 11u; ++k) v[k] = shared_at(first + k);
+    [[unroll]] for (uint r = 0u; r < kRun; ++r) {
+      vec3 sum = vec3(0.0);
+      [[unroll]] for (uint k = 0u; k < 12u; ++k) sum += kInner[k] * v[r + k];
+      if (col0 + r < kCornersW) put_row(row, col0 + r, sum);
+    }
+  } else {
+    for (uint r = 0u; r < kRun; ++r) {
+      if (col0 + r < kCornersW) put_row(row, col0 + r, row_value(row, col0 + r, x0, w));
+    }
   }
 }
 
@@ -153,22 +184,19 @@ void main() {
     }
     [[unroll]] for (uint n = 0u; n < kLoads; ++n) {
       uint i = gl_LocalInvocationIndex + n * kGroupSize;
-      if (i < kWindowW * kWindowH) shared_put(i, fetched[n]);
+      if (i < kWindowW * kWindowH) shared_put((i / kWindowW) * kStride + i % kWindowW, fetched[n]);
     }
   } else {
     [[dont_unroll]] for (uint i = gl_LocalInvocationIndex; i < kWindowW * kWindowH; i += kGroupSize) {
-      shared_put(i, source_texel(scene, bright, window0 + ivec2(i % kWindowW, i / kWindowW)));
+      shared_put((i / kWindowW) * kStride + i % kWindowW,
+                 source_texel(scene, bright, window0 + ivec2(i % kWindowW, i / kWindowW)));
     }
   }
   barrier();
 
-  // 2. Horizontal: every window row at every corner column, stored with row stride kCornersW.
-  // CPU devices run the same loops without unrolling (PREFETCH, as above).
-  if (PREFETCH) {
-    [[unroll]] for (uint n = 0u; n < kRowsPerInvocation; ++n) put_row(n, row_value(n, corner0.x, src_size.x));
-  } else {
-    [[dont_unroll]] for (uint n = 0u; n < kRowsPerInvocation; ++n) put_row(n, row_value(n, corner0.x, src_size.x));
-  }
+  // 2. Horizontal: every window row at every corner column, stored with row stride kCornersW, in
+  // runs of kRun columns (row_run()).
+  [[dont_unroll]] for (uint q = gl_LocalInvocationIndex; q < kRuns; q += kGroupSize) row_run(q, corner0.x, src_size.x);
   barrier();
 
   // 3. Vertical, at the corners the taps read, stored at their place in the kCornersW x kCornersH
