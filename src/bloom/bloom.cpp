@@ -459,9 +459,8 @@ void Bloom::Impl::record(VkCommandBuffer cmd, Image& input, Image& output, Profi
     b.flush(cmd);
     const detail::Bindings bindings{{levels[k + 1].state.view, G}, {levels[k].state.view, G}};
     if (up_2x && exactly_twice(chain[k], chain[k + 1])) {
-      // One invocation per 2x2 group of 2x2 blocks of level k (bloom_up_2x.comp).
-      up_2x.dispatch(cmd, bindings, push(P, chain[k + 1], chain[k]), (chain[k + 1].width + 1) / 2,
-                     (chain[k + 1].height + 1) / 2);
+      // One invocation per 2x2 block of level k (bloom_up_2x.comp).
+      up_2x.dispatch(cmd, bindings, push(P, chain[k + 1], chain[k]), chain[k].width / 2, chain[k].height / 2);
     } else {
       up.dispatch(cmd, bindings, push(P, chain[k + 1], chain[k]), chain[k].width, chain[k].height);
     }
@@ -493,9 +492,8 @@ void Bloom::Impl::record(VkCommandBuffer cmd, Image& input, Image& output, Profi
     b.flush(cmd);
     const detail::Bindings bindings{{input.view, scene_layout}, {levels[0].state.view, G}, {output.view, G}};
     if (out_pipelines.composite_2x && exactly_twice(full, chain[0])) {
-      // One invocation per 2x2 group of 2x2 blocks of outputs (bloom_composite_2x.comp).
-      out_pipelines.composite_2x->dispatch(cmd, bindings, push(P, chain[0], full), (chain[0].width + 1) / 2,
-                                           (chain[0].height + 1) / 2);
+      // One invocation per 2x2 block of outputs (bloom_composite_2x.comp).
+      out_pipelines.composite_2x->dispatch(cmd, bindings, push(P, chain[0], full), full.width / 2, full.height / 2);
     } else {
       out_pipelines.composite->dispatch(cmd, bindings, push(P, chain[0], full), full.width, full.height);
     }

@@ -15,10 +15,6 @@
 // bloom_up_tiled.glsl's two passes (which form them from floor and fraction per tap), so the sums
 // agree up to fp32 rounding; texels past the edge are read clamped, as there. The radius is a
 // per-frame value (BloomConfig::radius; no pipeline per radius), so S is computed here.
-//
-// The kernels take 2x2 blocks per invocation (up_2x_quad(): 4x4 outputs): the blocks at k and
-// k + 1 share 2 S of their 2 S + 1 columns and rows, so an invocation reads (2 S + 2)^2 texels
-// for four blocks instead of 4 (2 S + 1)^2 (36 against 100 at the default radius).
 
 const int kUpMaxSpan = 5;  // S at the largest radius, 4
 const int kUpMaxTaps = 2 * kUpMaxSpan + 1;
@@ -70,52 +66,4 @@ void up_2x_block(texture2D small, ivec2 small_size, ivec2 k, float r, out vec3 a
     for (int oy = -span; oy <= span; ++oy) UP_2X_ROW(oy, kUpMaxSpan)
   }
 #undef UP_2X_ROW
-}
-
-// Up at the 4x4 outputs 2 k0 + (0..3, 0..3), the four blocks k0 + (bx, by):
-// a[(2 by + ey) * 4 + 2 bx + ex] is output 2 (k0 + (bx, by)) + (ex, ey). Rows and columns at offsets
-// -S .. S + 1 from k0; block 1 along an axis takes offset o - 1 of its own weights.
-void up_2x_quad(texture2D small, ivec2 small_size, ivec2 k0, float r, out vec3 a[16]) {
-  const int span = FILTER == GLINT_BLOOM_GAUSS9 ? 1 : min(kUpMaxSpan, int(floor(r + 0.25)) + 1);
-  float w0[kUpMaxTaps], w1[kUpMaxTaps];  // x weights of offset i - kUpMaxSpan
-  [[unroll]] for (int i = 0; i < kUpMaxTaps; ++i) {
-    w0[i] = up_weight(-0.25, i - kUpMaxSpan, r);
-    w1[i] = up_weight(0.25, i - kUpMaxSpan, r);
-  }
-  [[unroll]] for (int n = 0; n < 16; ++n) a[n] = vec3(0.0);
-  // One row at offset oy: the four x sums (block bx, output ex) h[2 bx + ex], added to both
-  // blocks' rows with their y weights (zero where |oy - by| > S, so no test is needed there).
-  // Columns at compile time for S = 1 and 2 as in up_2x_block().
-#define UP_2X_QUAD_ROW(oy, S)                                                                  \
-  {                                                                                            \
-    vec3 h[4] = vec3[4](vec3(0.0), vec3(0.0), vec3(0.0), vec3(0.0));                           \
-    [[unroll]] for (int i = kUpMaxSpan - (S); i <= kUpMaxSpan + (S) + 1; ++i) {                \
-      const int o = i - kUpMaxSpan;                                                            \
-      if (o < -span || o > span + 1) continue; /* uniform */                                   \
-      const vec3 t = fetch_clamped(small, k0 + ivec2(o, oy), small_size).rgb;                  \
-      if (i < kUpMaxTaps) {                                                                    \
-        h[0] += w0[i] * t;                                                                     \
-        h[1] += w1[i] * t;                                                                     \
-      }                                                                                        \
-      if (i >= 1) {                                                                            \
-        h[2] += w0[i - 1] * t;                                                                 \
-        h[3] += w1[i - 1] * t;                                                                 \
-      }                                                                                        \
-    }                                                                                          \
-    [[unroll]] for (int by = 0; by < 2; ++by) {                                                \
-      const float v0 = up_weight(-0.25, (oy) - by, r), v1 = up_weight(0.25, (oy) - by, r);     \
-      [[unroll]] for (int n = 0; n < 4; ++n) {                                                 \
-        a[(2 * by) * 4 + n] += v0 * h[n];                                                      \
-        a[(2 * by + 1) * 4 + n] += v1 * h[n];                                                  \
-      }                                                                                        \
-    }                                                                                          \
-  }
-  if (span == 1) {
-    [[unroll]] for (int oy = -1; oy <= 2; ++oy) UP_2X_QUAD_ROW(oy, 1)
-  } else if (span == 2) {
-    [[unroll]] for (int oy = -2; oy <= 3; ++oy) UP_2X_QUAD_ROW(oy, 2)
-  } else {
-    for (int oy = -span; oy <= span + 1; ++oy) UP_2X_QUAD_ROW(oy, kUpMaxSpan)
-  }
-#undef UP_2X_QUAD_ROW
 }
