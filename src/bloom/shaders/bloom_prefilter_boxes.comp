@@ -30,7 +30,8 @@
 // The horizontal pass is register-blocked: an invocation sums a run of kRun consecutive corner
 // columns of one window row from the kRun + 11 window values they share, read once (3 x 15 shared
 // reads for 4 sums instead of 3 x 48). Consecutive invocations take consecutive window rows, and
-// the window's row stride is odd, so the 32 lanes of a read hit 32 different banks.
+// the window's row stride is odd, so the lanes of a read that share a run of columns hit distinct
+// banks (only where a subgroup wraps to the next run can two meet).
 layout(local_size_x_id = 0, local_size_y_id = 1) in;
 
 layout(binding = 0) uniform texture2D scene;
