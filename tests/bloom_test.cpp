@@ -217,18 +217,31 @@ TEST_F(BloomTest, MatchesReferenceForEveryGuardAndLevel0Height) {
 // that changes S (0.25 to 4), set per frame on one effect (set_config makes no pipeline for a
 // radius), against the float64 reference on the light added: an even size whose blocks fill the
 // workgroups and one whose last row and column of workgroups are partial. fp32 levels and I/O: 1e-3
-// as above.
+// as above. Both store orders of those kernels (COPY_ORDER: through shared memory in copy order,
+// what GPUs run, and each block's own outputs, what CPU devices run) on this device, giving the
+// same bits (the same arithmetic per output).
 TEST_F(BloomTest, TwoToOneUpsampleAndCompositeMatchReferenceAtEveryRadius) {
+  using Order = detail::BloomPath::CopyOrder;
   for (BloomFilter filter : {BloomFilter::cod13, BloomFilter::gauss9}) {
     BloomConfig config = added_light_config(filter);
-    Bloom bloom(context(), config);
+    Bloom on(context(), config), off(context(), config);
+    detail::BloomPath path;
+    path.copy_order_2x = Order::on;
+    detail::BloomAccess::set_path(on, path);
+    path.copy_order_2x = Order::off;
+    detail::BloomAccess::set_path(off, path);
     for (VkExtent2D size : {VkExtent2D{96, 64}, VkExtent2D{100, 70}}) {
       const CpuImage input = random_hdr(size.width, size.height, size.width + 3 * size.height);
       for (float radius : {0.25f, 0.8f, 1.0f, 1.3f, 2.5f, 3.75f, 4.0f}) {
         config.radius = radius;
-        bloom.set_config(config);
-        EXPECT_LT(added_light_error(run_bloom(bloom, input, kF32, kF32), input, config), 1e-3)
-            << bloom_filter_name(filter) << " " << size.width << "x" << size.height << " radius " << radius;
+        on.set_config(config);
+        off.set_config(config);
+        const CpuImage a = run_bloom(on, input, kF32, kF32), b = run_bloom(off, input, kF32, kF32);
+        const std::string what = std::string(bloom_filter_name(filter)) + " " + std::to_string(size.width) + "x" +
+                                 std::to_string(size.height) + " radius " + std::to_string(radius);
+        EXPECT_LT(added_light_error(a, input, config), 1e-3) << what << ", copy order";
+        EXPECT_LT(added_light_error(b, input, config), 1e-3) << what << ", block order";
+        EXPECT_TRUE(a.rgba == b.rgba) << what << ": the two store orders differ";
       }
     }
   }

@@ -173,6 +173,18 @@ struct Bloom::Impl {
     return d;
   }
 
+  // desc() of the 2:1 upsample and composite kernels, with constant 4: their outputs stored in copy
+  // order through shared memory, on GPUs unless the path says otherwise
+  // (src/bloom/shaders/bloom_up_2x.glsl, COPY_ORDER).
+  detail::PipelineDesc desc_2x(const std::string& kernel, std::vector<VkDescriptorType> bindings) const {
+    detail::PipelineDesc d = desc(kernel, std::move(bindings));
+    using Order = detail::BloomPath::CopyOrder;
+    const bool on = path.copy_order_2x == Order::device ? context->info().type != VK_PHYSICAL_DEVICE_TYPE_CPU
+                                                         : path.copy_order_2x == Order::on;
+    d.specialization.push_back(on ? 1u : 0u);
+    return d;
+  }
+
   void make_pipelines() {
     const std::string lv = detail::format_variant(level_format());
     const auto S = VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE;
@@ -188,7 +200,7 @@ struct Bloom::Impl {
                                                 : detail::ComputePipeline();
     up = detail::ComputePipeline(*context, desc("bloom_up_" + lv, {S, W}));
     up_2x = path.up_2x && config.filter != BloomFilter::dual
-                ? detail::ComputePipeline(*context, desc("bloom_up_2x_" + lv, {S, W}))
+                ? detail::ComputePipeline(*context, desc_2x("bloom_up_2x_" + lv, {S, W}))
                 : detail::ComputePipeline();
     if (path.fuse_small_levels) {
       detail::PipelineDesc d = desc("bloom_tail_" + lv, {S, W});
@@ -225,7 +237,7 @@ struct Bloom::Impl {
     if (!path.fuse_last_up && path.composite_2x && config.filter != BloomFilter::dual) {
       auto it = composite_2x.find(v);
       if (it == composite_2x.end()) {
-        it = composite_2x.emplace(v, detail::ComputePipeline(*context, desc("bloom_composite_2x_" + v, {S, S, W})))
+        it = composite_2x.emplace(v, detail::ComputePipeline(*context, desc_2x("bloom_composite_2x_" + v, {S, S, W})))
                  .first;
       }
       c2 = &it->second;

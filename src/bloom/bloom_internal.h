@@ -19,6 +19,11 @@ struct BloomPath {
   /// (bloom_up_2x.comp) run one invocation per 2x2 block instead of the tiled kernels.
   bool composite_2x = true;
   bool up_2x = true;
+  /// Whether those 2:1 kernels store their blocks' outputs in copy order through shared memory
+  /// (src/bloom/shaders/bloom_up_2x.glsl, COPY_ORDER): as the device type decides (GPUs yes, CPU
+  /// devices no), or forced either way (tests reach both forms on any device).
+  enum class CopyOrder { device, on, off };
+  CopyOrder copy_order_2x = CopyOrder::device;
 };
 
 struct BloomAccess {

@@ -68,28 +68,41 @@ void up_2x_block(texture2D small, ivec2 small_size, ivec2 k, float r, out vec3 a
 #undef UP_2X_ROW
 }
 
-// The workgroup's blocks as one tile of 2W x 2H outputs (W x H the workgroup size) in shared
-// memory, so that the stores go out in the order of a copy: each invocation computes the four
-// outputs of its block (up_2x_block), puts them in the tile (up_2x_put), and after a barrier takes
-// the four outputs at (x + W i, y + H j) of the tile, i, j = 0, 1 (up_2x_at): consecutive
-// invocations then store consecutive texels of a row, where the blocks' own outputs lie 2 texels
-// apart. On the H100 the 2x2-block stores alone took 25 us at 1920x1080 against 14.7 us for a
-// whole copy (docs/PERF.md).
+// Where an invocation's four outputs go. COPY_ORDER (specialization constant 4, set by the host
+// on GPUs): the workgroup's blocks form one tile of 2W x 2H outputs (W x H the workgroup size) in
+// shared memory; each invocation computes the four outputs of its block (up_2x_block), and after
+// up_2x_exchange takes the four outputs at (x + W i, y + H j) of the tile, i, j = 0, 1, so that
+// consecutive invocations read and store consecutive texels of a row, in the order of a copy,
+// where a block's own outputs lie 2 texels apart. On the H100 the 2x2-block stores alone took
+// 25 us at 1920x1080 against 14.7 us for a whole copy (docs/PERF.md). CPU devices (lavapipe)
+// store their own block's outputs: there the exchange's barrier cost more than the order gained
+// (the composite step 39 -> 49 to 57 ms at 1920x1080).
+layout(constant_id = 4) const bool COPY_ORDER = true;
 const uint kUpTileW = 2u * gl_WorkGroupSize.x;
 shared vec3 s_up_tile[kUpTileW * 2u * gl_WorkGroupSize.y];
 
-void up_2x_put(vec3 a[4]) {
+// Output j (0..3) of the invocation whose block is k, in store order: its position in the image
+// and where its value will be in `a` after up_2x_exchange (tile_index).
+ivec2 up_2x_out(uint j, ivec2 k, out uint tile_index) {
+  if (!COPY_ORDER) {
+    tile_index = j;
+    return 2 * k + ivec2(j & 1u, j >> 1u);
+  }
+  const uvec2 o = gl_LocalInvocationID.xy + uvec2((j & 1u) * gl_WorkGroupSize.x, (j >> 1u) * gl_WorkGroupSize.y);
+  tile_index = o.y * kUpTileW + o.x;
+  return ivec2(2u * gl_WorkGroupID.xy * gl_WorkGroupSize.xy + o);
+}
+
+// The block's outputs a[0..3] (as up_2x_block wrote them) become the outputs of up_2x_out's order:
+// through the shared tile under COPY_ORDER (every invocation of the workgroup calls it), unchanged
+// otherwise.
+void up_2x_exchange(inout vec3 a[4], uint tile_index[4]) {
+  if (!COPY_ORDER) return;  // uniform: a specialization constant
   const uvec2 o = 2u * gl_LocalInvocationID.xy;
   s_up_tile[o.y * kUpTileW + o.x] = a[0];
   s_up_tile[o.y * kUpTileW + o.x + 1u] = a[1];
   s_up_tile[(o.y + 1u) * kUpTileW + o.x] = a[2];
   s_up_tile[(o.y + 1u) * kUpTileW + o.x + 1u] = a[3];
-}
-
-// Output j (0..3) of this invocation in store order: its position in the image and its value's
-// index in the tile.
-ivec2 up_2x_out(uint j, out uint tile_index) {
-  const uvec2 o = gl_LocalInvocationID.xy + uvec2((j & 1u) * gl_WorkGroupSize.x, (j >> 1u) * gl_WorkGroupSize.y);
-  tile_index = o.y * kUpTileW + o.x;
-  return ivec2(2u * gl_WorkGroupID.xy * gl_WorkGroupSize.xy + o);
+  barrier();
+  [[unroll]] for (uint j = 0u; j < 4u; ++j) a[j] = s_up_tile[tile_index[j]];
 }
