@@ -218,8 +218,10 @@ TEST_F(BloomTest, MatchesReferenceForEveryGuardAndLevel0Height) {
 // radius), against the float64 reference on the light added: an even size whose blocks fill the
 // workgroups and one whose last row and column of workgroups are partial. fp32 levels and I/O: 1e-3
 // as above. Both store orders of those kernels (COPY_ORDER: through shared memory in copy order,
-// what GPUs run, and each block's own outputs, what CPU devices run) on this device, giving the
-// same bits (the same arithmetic per output).
+// what GPUs run, and each block's own outputs, what CPU devices run) on this device, agreeing to
+// 2^-20 of each value: the same arithmetic per output, but the two specializations are compiled
+// apart, and SPIR-V lets a compiler contract a multiply-add into an FMA in one and not the other
+// (a texel placed wrongly differs by far more).
 TEST_F(BloomTest, TwoToOneUpsampleAndCompositeMatchReferenceAtEveryRadius) {
   using Order = detail::BloomPath::CopyOrder;
   for (BloomFilter filter : {BloomFilter::cod13, BloomFilter::gauss9}) {
@@ -241,7 +243,11 @@ TEST_F(BloomTest, TwoToOneUpsampleAndCompositeMatchReferenceAtEveryRadius) {
                                  std::to_string(size.height) + " radius " + std::to_string(radius);
         EXPECT_LT(added_light_error(a, input, config), 1e-3) << what << ", copy order";
         EXPECT_LT(added_light_error(b, input, config), 1e-3) << what << ", block order";
-        EXPECT_TRUE(a.rgba == b.rgba) << what << ": the two store orders differ";
+        ASSERT_EQ(a.rgba.size(), b.rgba.size());
+        size_t differ = 0;
+        for (size_t i = 0; i < a.rgba.size(); ++i)
+          differ += !(std::abs(a.rgba[i] - b.rgba[i]) <= 0x1p-20f * std::max(1.0f, std::abs(a.rgba[i])));
+        EXPECT_EQ(differ, 0u) << what << ": values where the two store orders differ";
       }
     }
   }

@@ -180,7 +180,7 @@ struct Bloom::Impl {
     detail::PipelineDesc d = desc(kernel, std::move(bindings));
     using Order = detail::BloomPath::CopyOrder;
     const bool on = path.copy_order_2x == Order::device ? context->info().type != VK_PHYSICAL_DEVICE_TYPE_CPU
-                                                         : path.copy_order_2x == Order::on;
+                                                        : path.copy_order_2x == Order::on;
     d.specialization.push_back(on ? 1u : 0u);
     return d;
   }
