@@ -1,6 +1,7 @@
 // Up (docs/BLOOM.md) at an exact 2:1 ratio for the separable filters (cod13's 3x3 tent of
-// bilinear taps, gauss9's one bilinear tap), one 2x2 block of outputs at a time, without shared
-// memory or barriers (bloom_composite_2x.comp, bloom_up_2x.comp). Requires bloom.glsl first.
+// bilinear taps, gauss9's one bilinear tap), one 2x2 block of outputs at a time, summed without
+// shared memory (bloom_composite_2x.comp, bloom_up_2x.comp); on GPUs the outputs then go through a
+// shared tile to be stored in copy order (up_2x_exchange, below). Requires bloom.glsl first.
 //
 // At 2:1, output x = 2k + e (e = 0, 1) sits at position k + c_e of the smaller image, with
 // c_0 = -0.25 and c_1 = +0.25 (map_position: (x + 0.5) / 2 - 0.5). A bilinear tap at position q
