@@ -44,7 +44,8 @@ constexpr VkAccessFlags2 kStorageRead = VK_ACCESS_2_SHADER_STORAGE_READ_BIT;
 // Shared memory the tiled kernels declare for a workgroup (src/bloom/shaders/bloom_down_tiled.glsl,
 // bloom_up_tiled.glsl, bloom_composite_up.comp and src/bloom/shaders/bloom_prefilter_smooth.comp: vec4 windows of the
 // source; src/bloom/shaders/bloom_prefilter_boxes.comp: three floats per texel of a window for a 2 g.y row tile,
-// at an odd row stride with 4 texels of slack, and of its horizontal results).
+// at an odd row stride with 4 texels of slack, and of its horizontal results; src/bloom/shaders/bloom_up_2x.glsl:
+// a vec3 per output of the workgroup's 2 g.x x 2 g.y tile, counted at 16 bytes).
 uint32_t bloom_shared_bytes(detail::Workgroup2D g) {
   const uint32_t down = ((2 * g.x + 4) * (2 * g.y + 4) + (2 * g.x + 3) * (2 * g.y + 3)) * 16;
   const uint32_t up = ((g.x + 10) * (g.y + 10) + g.x * (g.y + 10)) * 16;
@@ -54,7 +55,8 @@ uint32_t bloom_shared_bytes(detail::Workgroup2D g) {
   const uint32_t smooth = ((2 * g.x + 6 + apron) * (2 * g.y + 6 + apron) + (2 * g.y + 6 + apron) * (2 * g.x + 6)) * 16;
   // The window's row stride is odd: 2 g.x + 4 + apron is even, so one more.
   const uint32_t boxes = ((2 * g.x + 5 + apron + 2 * g.x + 3) * (4 * g.y + 4 + apron) + 4) * 12;
-  return std::max({down, composite_up, smooth, boxes});
+  const uint32_t two_to_one = 4 * g.x * g.y * 16;
+  return std::max({down, composite_up, smooth, boxes, two_to_one});
 }
 
 // Whether src/bloom/shaders/bloom_prefilter_boxes.comp can serve this configuration: the
