@@ -17,6 +17,7 @@
 #include "support/flare_scene.h"
 #include "support/gpu_test.h"
 #include "support/transfer.h"
+#include "visibility/hiz_internal.h"
 #include "visibility/shaders/light_cull_params.h"
 
 namespace glint::test {
@@ -95,6 +96,11 @@ struct HiZCase {
   uint32_t w, h;
 };
 
+// Both stream passes (levels 1-6 by blocks, as GPUs run it; levels 1-2 by texels, as CPU devices
+// do), each followed by the tile pass from its last level, on any device.
+const detail::HiZStream kStreams[] = {detail::HiZStream::blocks, detail::HiZStream::texels};
+const char* stream_name(detail::HiZStream s) { return s == detail::HiZStream::blocks ? " blocks" : " texels"; }
+
 TEST_F(OcclusionTest, HiZMatchesReferenceAtAllSizes) {
   const HiZCase cases[] = {{1, 1},    {7, 3},    {3, 7},    {2, 1},   {64, 64},  {65, 63},   {127, 129},
                            {130, 67}, {333, 97}, {4097, 2}, {2, 600}, {8200, 2}, {3, 16384}, {1030, 771}};
@@ -103,7 +109,9 @@ TEST_F(OcclusionTest, HiZMatchesReferenceAtAllSizes) {
     for (VkFormat format : {VK_FORMAT_D32_SFLOAT, VK_FORMAT_R32_SFLOAT}) {
       for (bool reversed : {false, true}) {
         if (format == VK_FORMAT_R32_SFLOAT && (c.w * c.h > 20000)) continue;  // big sizes once per format
-        const auto depth = random_depth(c.w, c.h, stream++);
+        auto depth = random_depth(c.w, c.h, stream++);
+        // The farthest depth at the last pixel: at odd sizes only the corner's extra read sees it.
+        depth.depth.back() = reversed ? 0.0f : 1.0f;
         auto img = make_depth(depth, format);
         HiZConfig config;
         config.extent = {c.w, c.h};
@@ -111,11 +119,14 @@ TEST_F(OcclusionTest, HiZMatchesReferenceAtAllSizes) {
         config.reversed_z = reversed;
         HiZPyramid hiz(context(), config);
         ASSERT_EQ(hiz.levels(), static_cast<uint32_t>(std::floor(std::log2(double(std::max(c.w, c.h))))));
-        poison_pyramid(hiz);
-        context().run_once([&](VkCommandBuffer cmd) { hiz.record(cmd, img.state); });
-        std::string what = std::to_string(c.w) + "x" + std::to_string(c.h) + (reversed ? " reversed" : " standard") +
-                           (format == VK_FORMAT_D32_SFLOAT ? " D32" : " R32");
-        expect_pyramid(read_pyramid(hiz), depth, reversed, what);
+        for (detail::HiZStream s : kStreams) {
+          detail::HiZAccess::select_stream(hiz, s);
+          poison_pyramid(hiz);
+          context().run_once([&](VkCommandBuffer cmd) { hiz.record(cmd, img.state); });
+          std::string what = std::to_string(c.w) + "x" + std::to_string(c.h) + (reversed ? " reversed" : " standard") +
+                             (format == VK_FORMAT_D32_SFLOAT ? " D32" : " R32") + stream_name(s);
+          expect_pyramid(read_pyramid(hiz), depth, reversed, what);
+        }
       }
     }
   }
@@ -124,16 +135,28 @@ TEST_F(OcclusionTest, HiZMatchesReferenceAtAllSizes) {
 // The counter resets itself: frames with different depth, in separate submissions and twice in
 // one command buffer, each give their own exact pyramid. Also the level cap.
 TEST_F(OcclusionTest, HiZRepeatsFramesAndCapsLevels) {
-  for (bool two_pass : {false, true}) {
+  // The stream pass the device type chooses: blocks on GPUs, texels on CPU devices.
+  {
+    HiZConfig config;
+    config.extent = {64, 64};
+    const HiZPyramid hiz(context(), config);
+    EXPECT_EQ(detail::HiZAccess::stream(hiz), context().info().type == VK_PHYSICAL_DEVICE_TYPE_CPU
+                                                  ? detail::HiZStream::texels
+                                                  : detail::HiZStream::blocks);
+  }
+  for (int run = 0; run < 4; ++run) {
+    const bool two_pass = run & 1;  // 8300 wide: tiles and the last workgroup's tail after either stream pass
+    const detail::HiZStream s = kStreams[run >> 1];
     const uint32_t w = two_pass ? 8300 : 1000, h = two_pass ? 3 : 37;
     HiZConfig config;
     config.extent = {w, h};
     HiZPyramid hiz(context(), config);
+    detail::HiZAccess::select_stream(hiz, s);
     for (uint32_t frame = 0; frame < 3; ++frame) {
       const auto a = random_depth(w, h, 100 + frame), b = random_depth(w, h, 200 + frame);
       auto ia = make_depth(a, config.format), ib = make_depth(b, config.format);
       context().run_once([&](VkCommandBuffer cmd) { hiz.record(cmd, ia.state); });
-      expect_pyramid(read_pyramid(hiz), a, false, "frame " + std::to_string(frame));
+      expect_pyramid(read_pyramid(hiz), a, false, "frame " + std::to_string(frame) + stream_name(s));
       context().run_once([&](VkCommandBuffer cmd) {
         hiz.record(cmd, ia.state);
         hiz.record(cmd, ib.state);
@@ -141,15 +164,23 @@ TEST_F(OcclusionTest, HiZRepeatsFramesAndCapsLevels) {
       expect_pyramid(read_pyramid(hiz), b, false, "second build in one command buffer");
     }
   }
-  HiZConfig capped;
-  capped.extent = {300, 200};
-  capped.max_cell_px = 5;
-  HiZPyramid hiz(context(), capped);
-  EXPECT_EQ(hiz.levels(), 3u);  // ceil(log2(5))
+  // Every cap from 1 to 7 levels, on an image with interior and edge blocks in the stream pass
+  // (whose unbuilt levels' bindings alias the last built level).
   const auto d = random_depth(300, 200, 9);
-  auto img = make_depth(d, capped.format);
-  context().run_once([&](VkCommandBuffer cmd) { hiz.record(cmd, img.state); });
-  expect_pyramid(read_pyramid(hiz), d, false, "capped");
+  auto img = make_depth(d, VK_FORMAT_D32_SFLOAT);
+  for (uint32_t levels = 1; levels <= 7; ++levels) {
+    HiZConfig capped;
+    capped.extent = {300, 200};
+    capped.max_cell_px = (1u << (levels - 1)) + 1;  // ceil(log2) = levels
+    HiZPyramid hiz(context(), capped);
+    ASSERT_EQ(hiz.levels(), levels);
+    for (detail::HiZStream s : kStreams) {
+      detail::HiZAccess::select_stream(hiz, s);
+      poison_pyramid(hiz);
+      context().run_once([&](VkCommandBuffer cmd) { hiz.record(cmd, img.state); });
+      expect_pyramid(read_pyramid(hiz), d, false, "capped at " + std::to_string(levels) + " levels" + stream_name(s));
+    }
+  }
 }
 
 // Everything the cull writes for one frame.

@@ -1,5 +1,5 @@
-// Visibility of lens-flare lights, kept on the GPU: a Hi-Z depth pyramid built in one
-// dispatch (HiZPyramid), and a cull (LightCuller) that projects the lights, culls them against the
+// Visibility of lens-flare lights, kept on the GPU: a Hi-Z depth pyramid built in two
+// dispatches (HiZPyramid), and a cull (LightCuller) that projects the lights, culls them against the
 // frustum, tests their occlusion on an N x N grid read from the pyramid, and compacts the visible
 // ones, in increasing light index (so every run gives the same order), into an instance buffer for an indirect draw or
 // dispatch. docs/OCCLUSION.md derives the fold rule, the level choice, the error bound and the
@@ -24,6 +24,10 @@
 #include <memory>
 
 namespace glint {
+
+namespace detail {
+struct HiZAccess;  // benchmarks' and tests' switch of the stream pass (src/visibility/hiz_internal.h)
+}  // namespace detail
 
 /// Creation-time settings of a Hi-Z pyramid. Checked by validate().
 struct HiZConfig {
@@ -62,7 +66,8 @@ class HiZPyramid {
   HiZPyramid& operator=(HiZPyramid&&) noexcept;
   ~HiZPyramid();
 
-  /// Records the build of every level from `depth` (one dispatch up to 4096 on a side, two above).
+  /// Records the build of every level from `depth`: one dispatch where the pyramid has at most 6
+  /// levels (2 on CPU devices), a second for the levels above, after a barrier.
   /// `depth`: config.format and config.extent, SAMPLED usage, `view` a 2D view with the depth aspect
   /// alone (a depth format; barriers cover depth and stencil of a combined format) or a
   /// colour (R32) view of mip 0. Afterwards `depth` is in SHADER_READ_ONLY_OPTIMAL, last read by
@@ -85,6 +90,7 @@ class HiZPyramid {
   struct Impl;
 
  private:
+  friend struct detail::HiZAccess;
   std::unique_ptr<Impl> impl_;
 };
 

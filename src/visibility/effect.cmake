@@ -5,6 +5,7 @@ set(GLINT_EFFECT_SOURCES hiz_pyramid.cpp light_culler.cpp object_cull.cpp)
 # src/core/compaction.h; the shared GLSL is src/core/shaders/compact.glsl).
 set(GLINT_EFFECT_KERNELS
   "shaders/hiz_stream|main|"
+  "shaders/hiz_stream_texels|main|"
   "shaders/hiz_build|main|"
   "shaders/compact_scan_tiles|main|"
   "shaders/light_cull|main|"

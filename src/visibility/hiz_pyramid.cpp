@@ -18,6 +18,7 @@
 #include "core/formats.h"
 #include "core/pipeline.h"
 #include "core/resources.h"
+#include "visibility/hiz_internal.h"
 #include "visibility/shaders/light_cull_params.h"  // push constants and buffer layouts shared with the kernels
 #include "visibility/visibility_util.h"
 
@@ -76,16 +77,22 @@ struct HiZPyramid::Impl {
   detail::OwnedBuffer counters;  // the counter word of the tile dispatch (16 bytes)
   Buffer counter_state;
   bool counters_cleared = false;
-  // Nearest, clamp-to-edge: hiz_stream.comp gathers 2x2 depth texels per fetch.
+  // Nearest, clamp-to-edge: the stream passes gather 2x2 depth texels per fetch.
   VkSampler sampler = VK_NULL_HANDLE;  // owned by the context
-  // The two dispatches (docs/OCCLUSION.md, "Hi-Z pyramid"): hiz_stream.comp writes levels 1 and 2
-  // from the depth image, hiz_build.comp the levels above 2 (made only when there are any). Both
-  // push their descriptors with every dispatch.
+  // The two dispatches (docs/OCCLUSION.md, "Hi-Z pyramid"): the stream pass writes levels 1 to
+  // stream_levels from the depth image, hiz_build.comp the levels above (made only when there are
+  // any). On GPUs the stream pass is hiz_stream.comp (levels 1 to 6 by 64x64 blocks, through
+  // shared memory), on CPU devices hiz_stream_texels.comp (levels 1 and 2, one invocation per
+  // level-2 texel, no barrier: on lavapipe the other took 4.5x as long). Both push their
+  // descriptors with every dispatch.
+  detail::HiZStream stream = detail::HiZStream::blocks;
+  uint32_t stream_levels = GLINT_HIZ_STREAM_LEVELS;
   detail::ComputePipeline stream_pipeline;
   detail::ComputePipeline tile_pipeline;
 
-  GlintHiZPush stream_push{};  // base = the depth image; tile_levels = levels it writes (1 or 2)
-  GlintHiZPush tile_push{};    // base = level 2
+  GlintHiZPush stream_push{};                    // base = the depth image; tile_levels = levels it writes
+  GlintHiZPush tile_push{};                      // base = level stream_levels
+  uint32_t stream_width = 0, stream_height = 0;  // invocations of the stream dispatch
   uint32_t tile_groups_x = 0, tile_groups_y = 0;
 
   ~Impl() { release(); }
@@ -105,31 +112,42 @@ struct HiZPyramid::Impl {
                                  std::max(1u, levels));
   }
 
-  // The two dispatches that build `levels` (>= 1) levels: the stream pass writes levels 1 and 2;
-  // the tile pass reduces level 2 by 64x64 tiles through up to 6 levels, and its last workgroup
-  // the rest. Level 2 is at most 16384 / 4 = 4096 = 64 tiles wide, so the tail always fits one
-  // workgroup, and 2 + 6 + 6 = 14 levels cover the largest pyramid.
+  // The two dispatches that build `levels` (>= 1) levels: the stream pass writes levels 1 to
+  // stream_levels (by 64x64 blocks of the depth image, the last block of a row or column up to the
+  // edge; or one invocation per level-2 texel); the tile pass reduces level stream_levels by 64x64
+  // tiles through up to 6 levels, and its last workgroup the rest. That level is at most
+  // 16384 / 4 = 4096 = 64 tiles wide, so the tail always fits one workgroup, and 2 + 6 + 6 = 14
+  // levels cover the largest pyramid.
   void plan() {
     const uint32_t reversed = config.reversed_z ? 1u : 0u;
+    const uint32_t first = stream_levels;
     stream_push.base_width = static_cast<int32_t>(config.extent.width);
     stream_push.base_height = static_cast<int32_t>(config.extent.height);
     stream_push.base_level = 0;
-    stream_push.tile_levels = std::min(2u, levels);
+    stream_push.tile_levels = std::min(first, levels);
     stream_push.reversed_z = reversed;
-    if (levels <= 2) return;
-    const uint32_t bw = std::max(1u, config.extent.width >> 2);
-    const uint32_t bh = std::max(1u, config.extent.height >> 2);
+    if (stream == detail::HiZStream::blocks) {  // a workgroup of 16x16 per 64x64 block
+      stream_width = std::max(1u, config.extent.width >> 6) * 16;
+      stream_height = std::max(1u, config.extent.height >> 6) * 16;
+    } else {  // an invocation per level-2 texel (level 2's size even when only level 1 is built)
+      stream_width = std::max(1u, config.extent.width >> 2);
+      stream_height = std::max(1u, config.extent.height >> 2);
+    }
+    if (levels <= first) return;
+    const uint32_t bw = std::max(1u, config.extent.width >> first);
+    const uint32_t bh = std::max(1u, config.extent.height >> first);
     tile_push.base_width = static_cast<int32_t>(bw);
     tile_push.base_height = static_cast<int32_t>(bh);
-    tile_push.base_level = 2;
-    tile_push.tile_levels = std::min(GLINT_HIZ_TILE_LEVELS, levels - 2);
+    tile_push.base_level = first;
+    tile_push.tile_levels = std::min(GLINT_HIZ_TILE_LEVELS, levels - first);
     tile_groups_x = std::max(1u, bw >> 6);
     tile_groups_y = std::max(1u, bh >> 6);
-    if (tile_groups_x > GLINT_HIZ_TILE || tile_groups_y > GLINT_HIZ_TILE || levels > 2 + 2 * GLINT_HIZ_TILE_LEVELS) {
+    if (tile_groups_x > GLINT_HIZ_TILE || tile_groups_y > GLINT_HIZ_TILE ||
+        levels > first + 2 * GLINT_HIZ_TILE_LEVELS) {
       throw Error(ErrorCode::vulkan_failure, concat("HiZPyramid: ", config.extent.width, "x", config.extent.height,
                                                     " does not fit the tile pass's tail"));
     }
-    tile_push.tail_levels = levels - 2 - tile_push.tile_levels;
+    tile_push.tail_levels = levels - first - tile_push.tile_levels;
     tile_push.reversed_z = reversed;
     tile_push.counter_index = 0;
   }
@@ -138,11 +156,43 @@ struct HiZPyramid::Impl {
   // but every binding needs a view.
   VkImageView level_view(uint32_t k) const { return pyramid.level_view(std::min(k, std::max(1u, levels)) - 1); }
 
-  // The stream pass's descriptors: the depth through the nearest sampler, levels 1 and 2.
+  // The stream pass's descriptors: the depth through the nearest sampler, levels 1 to stream_levels.
   detail::Bindings stream_bindings(const Image& depth) const {
-    return {{depth.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, sampler},
-            {level_view(1), VK_IMAGE_LAYOUT_GENERAL},
-            {level_view(2), VK_IMAGE_LAYOUT_GENERAL}};
+    detail::Bindings b{{depth.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, sampler}};
+    for (uint32_t k = 1; k <= stream_levels; ++k) b.push_back({level_view(k), VK_IMAGE_LAYOUT_GENERAL});
+    return b;
+  }
+
+  // Chooses the stream pass (`device`: by the device type), plans the dispatches and makes their
+  // pipelines.
+  void select(detail::HiZStream which) {
+    if (which == detail::HiZStream::device) {
+      which =
+          context->info().type == VK_PHYSICAL_DEVICE_TYPE_CPU ? detail::HiZStream::texels : detail::HiZStream::blocks;
+    }
+    stream = which;
+    stream_levels = which == detail::HiZStream::blocks ? GLINT_HIZ_STREAM_LEVELS : 2u;
+    plan();
+    stream_pipeline.reset();
+    tile_pipeline.reset();
+    if (levels == 0) return;  // 1x1: nothing to build
+    detail::PipelineDesc s;
+    s.kernel_id = which == detail::HiZStream::blocks ? "hiz_stream_main" : "hiz_stream_texels_main";
+    s.bindings = {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER};
+    for (uint32_t k = 0; k < stream_levels; ++k) s.bindings.push_back(VK_DESCRIPTOR_TYPE_STORAGE_IMAGE);
+    s.push_constant_bytes = sizeof(GlintHiZPush);
+    // The kernels' fixed local sizes.
+    s.workgroup = which == detail::HiZStream::blocks ? detail::Workgroup2D{16, 16} : detail::Workgroup2D{32, 4};
+    stream_pipeline = detail::ComputePipeline(*context, s);
+    if (levels <= stream_levels) return;
+    detail::PipelineDesc d;
+    d.kernel_id = "hiz_build_main";
+    for (uint32_t k = 0; k < GLINT_HIZ_MAX_LEVELS; ++k) d.bindings.push_back(VK_DESCRIPTOR_TYPE_STORAGE_IMAGE);
+    d.bindings.push_back(VK_DESCRIPTOR_TYPE_STORAGE_BUFFER);
+    d.push_constant_bytes = sizeof(GlintHiZPush);
+    d.workgroup = {256, 1};              // the kernel's local size is fixed at 256 (64x64 tiles)
+    d.specialization = {stream_levels};  // constant 2: the level it starts from
+    tile_pipeline = detail::ComputePipeline(*context, d);
   }
 
   // The tile pass's descriptors: a storage view per level 1..GLINT_HIZ_MAX_LEVELS, the counter.
@@ -174,27 +224,11 @@ HiZPyramid::HiZPyramid(const Context& context, const HiZConfig& config) : impl_(
   m.config = config;
   m.levels = hiz_level_count(config);
   m.make_image();
-  m.plan();
   const VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
   m.counters = detail::OwnedBuffer(context, 16, usage, false);
   m.counter_state = view_of(m.counters, usage);
   m.sampler = detail::clamp_sampler(context, VK_FILTER_NEAREST, VK_SAMPLER_MIPMAP_MODE_NEAREST, 0.0f);
-  if (m.levels == 0) return;  // 1x1: nothing to build
-  detail::PipelineDesc s;
-  s.kernel_id = "hiz_stream_main";
-  s.bindings = {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
-                VK_DESCRIPTOR_TYPE_STORAGE_IMAGE};
-  s.push_constant_bytes = sizeof(GlintHiZPush);
-  s.workgroup = {32, 4};  // the kernel's fixed local size
-  m.stream_pipeline = detail::ComputePipeline(context, s);
-  if (m.levels <= 2) return;
-  detail::PipelineDesc d;
-  d.kernel_id = "hiz_build_main";
-  for (uint32_t k = 0; k < GLINT_HIZ_MAX_LEVELS; ++k) d.bindings.push_back(VK_DESCRIPTOR_TYPE_STORAGE_IMAGE);
-  d.bindings.push_back(VK_DESCRIPTOR_TYPE_STORAGE_BUFFER);
-  d.push_constant_bytes = sizeof(GlintHiZPush);
-  d.workgroup = {256, 1};  // the kernel's local size is fixed at 256 (64x64 tiles)
-  m.tile_pipeline = detail::ComputePipeline(context, d);
+  m.select(detail::HiZStream::device);
 }
 
 HiZPyramid::HiZPyramid(HiZPyramid&&) noexcept = default;
@@ -244,7 +278,7 @@ void HiZPyramid::record(VkCommandBuffer cmd, Image& depth, Profiler* profiler) {
     return;
   }
   detail::Barriers b;
-  const bool tile_pass = m.levels > 2;
+  const bool tile_pass = m.levels > m.stream_levels;
   if (tile_pass && !m.counters_cleared) {  // once per object: the kernel resets the counter after each use
     b.use(m.counter_state, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);  // fill = "transfer"
     b.flush(cmd);
@@ -255,15 +289,20 @@ void HiZPyramid::record(VkCommandBuffer cmd, Image& depth, Profiler* profiler) {
   b.use(m.pyramid.state, VK_IMAGE_LAYOUT_GENERAL, kCompute, kStorageRead | kStorageWrite, std::max(1u, m.levels));
   if (tile_pass) b.use(m.counter_state, kCompute, kStorageRead | kStorageWrite);
   b.flush(cmd);
-  // Stream pass: one invocation per level-2 texel (level 2's size even when only level 1 is built).
-  const uint32_t n2x = std::max(1u, m.config.extent.width >> 2), n2y = std::max(1u, m.config.extent.height >> 2);
-  m.stream_pipeline.dispatch(cmd, m.stream_bindings(depth), m.stream_push, n2x, n2y);
-  if (tile_pass) {  // the tile pass reads level 2, which the stream pass wrote
+  m.stream_pipeline.dispatch(cmd, m.stream_bindings(depth), m.stream_push, m.stream_width, m.stream_height);
+  if (tile_pass) {  // the tile pass reads the stream pass's last level
     b.use(m.pyramid.state, VK_IMAGE_LAYOUT_GENERAL, kCompute, kStorageRead | kStorageWrite, std::max(1u, m.levels));
     b.flush(cmd);
     m.tile_pipeline.dispatch(cmd, m.tile_bindings(), m.tile_push, m.tile_groups_x * 256, m.tile_groups_y);
   }
   if (profiler) profiler->mark(cmd, "hi-z");
 }
+
+namespace detail {
+
+void HiZAccess::select_stream(HiZPyramid& hiz, HiZStream stream) { hiz.impl_->select(stream); }
+HiZStream HiZAccess::stream(const HiZPyramid& hiz) { return hiz.impl_->stream; }
+
+}  // namespace detail
 
 }  // namespace glint

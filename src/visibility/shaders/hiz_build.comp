@@ -1,20 +1,18 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
-// Hi-Z levels 3 and up, in one dispatch in the manner of AMD FidelityFX SPD (docs/OCCLUSION.md,
-// "Hi-Z pyramid"): the second of the pyramid's two dispatches. hiz_stream.comp has written levels
-// 1 and 2 from the depth image; this kernel takes level 2 as its base. Every workgroup reduces a
-// 64x64 tile of level 2 through up to six levels in shared memory; the last workgroup to finish
-// (found with an atomic counter after a memory barrier on the images) reduces the remaining levels
-// from the 64x64-or-smaller level it can then see. Level 2 is at most 4096 texels wide (the depth
-// image at most 16384), so the tail always fits one workgroup and 2 + 6 + 6 levels cover the
-// largest pyramid (14 levels).
-// Each texel holds the farthest depth it covers (max for standard Z, min for reversed Z).
-// Fold rule (docs/OCCLUSION.md): level sizes are max(1, size >> k) like Vulkan mips; child c of a
-// parent of width w covers parents 2c and 2c + 1, and the last child also covers parent w - 1 when
-// w is odd (the 3-wide case; 3x3 at the corner), so no source texel is ever dropped. Equivalently,
-// texel c of level k covers source pixels [c * 2^k, (c + 1) * 2^k), the last one up to the edge.
-// Tiles: the last tile of a row or column extends to the edge (64 to 127 wide), so every fold stays
-// inside one workgroup.
+// Hi-Z levels above the stream pass's, in one dispatch in the manner of AMD FidelityFX SPD
+// (docs/OCCLUSION.md, "Hi-Z pyramid"): the second of the pyramid's two dispatches, made only when
+// there are levels above the stream pass's. The stream pass has written levels 1 to kBaseLevel
+// (6 on GPUs, 2 on CPU devices) from the depth image; this kernel takes level kBaseLevel as its
+// base. Every workgroup reduces a 64x64 tile of the base through up to six levels in shared
+// memory; the last workgroup to finish (found with an atomic counter after a memory barrier on the
+// images) reduces the remaining levels from the 64x64-or-smaller level it can then see. The base
+// is at most 16384 / 4 = 4096 texels wide, so there are at most 64x64 tiles, the tail always fits
+// one workgroup, and 2 + 6 + 6 levels cover the largest pyramid (14 levels). From level 6, below
+// 8192 texels a side there is one tile and no tail.
+// Each texel holds the farthest depth it covers (max for standard Z, min for reversed Z), by the
+// fold rule of hiz_fold.glsl. Tiles: the last tile of a row or column extends to the edge (64 to
+// 127 wide), so every fold stays inside one workgroup.
 // Speed (docs/OCCLUSION.md, "Speed"): interior tiles, where no fold applies, take a fast path in
 // which each invocation reduces a 4x4 block of the base and keeps levels 1 and 2 above it in
 // registers; only edge tiles and the last workgroup run the general loops. Every store names its
@@ -23,8 +21,10 @@ layout(local_size_x = 256) in;
 
 #include "light_cull_params.h"
 
-// The level this kernel reads as its base (written by hiz_stream.comp before it).
-const uint kBaseLevel = 2u;
+// The level this kernel reads as its base, written by the stream pass before it: 6 after
+// hiz_stream.comp (GPUs), 2 after hiz_stream_texels.comp (CPU devices). A specialization constant,
+// so that every switch on a level folds away.
+layout(constant_id = 2) const uint kBaseLevel = GLINT_HIZ_STREAM_LEVELS;
 
 // Binding k - 1 is level k (level 1 is not accessed here: kept so that the numbering stays plain).
 layout(binding = 0, r32f) uniform coherent image2D hiz1;
@@ -44,12 +44,6 @@ layout(binding = 13, r32f) uniform coherent image2D hiz14;
 layout(std430, binding = 14) coherent buffer Counters { uint counters[]; };
 layout(push_constant) uniform Push { GlintHiZPush pc; };
 
-// Ping-pong tiles: A holds up to 64x64 texels (level 1 of an edge tile, or the tail's start level),
-// B up to 32x32.
-const int kStrideA = 64;
-const int kStrideB = 32;
-const int kOffsetB = 64 * 64;
-shared float tile[64 * 64 + 32 * 32];
 shared bool last_group;
 
 float farther(float a, float b) { return pc.reversed_z != 0u ? min(a, b) : max(a, b); }
@@ -95,6 +89,8 @@ float load_level(uint level, ivec2 p) {
 
 float farther4(float a, float b, float c, float d) { return farther(farther(a, b), farther(c, d)); }
 
+#include "hiz_fold.glsl"
+
 // Texel p of the base level (inside it). kBaseLevel is a constant: the switch folds away.
 float load_base(ivec2 p) { return load_level(kBaseLevel, p); }
 
@@ -106,54 +102,7 @@ float load_base_2x2(ivec2 p, ivec2 base) {
 }
 
 // Size of the level `j` levels above the base.
-ivec2 level_size(uint j) { return max(ivec2(1), ivec2(pc.base_width, pc.base_height) >> int(j)); }
-
-// Parents covered by child c of a level of `child` texels over `parent` texels (fold rule).
-ivec2 parent_range(int c, int child, int parent) {
-  return ivec2(2 * c, c == child - 1 ? parent - 1 : min(2 * c + 1, parent - 1));
-}
-
-// Children of level `j` (1..) that the region [begin, end) of the base level owns. `edge`: the
-// region reaches the base level's last texel, so it also owns the folded last child.
-ivec2 child_begin(ivec2 begin, uint j) { return begin >> int(j); }
-ivec2 child_end(ivec2 begin, ivec2 region, bvec2 edge, uint j) {
-  const ivec2 inner = (begin + region) >> int(j);
-  return ivec2(edge.x ? level_size(j).x : inner.x, edge.y ? level_size(j).y : inner.y);
-}
-
-// One reduction step in shared memory: level j - 1 (in `src`, origin at child_begin(j - 1)) to
-// level j (into `dst`), also stored to the pyramid.
-void reduce_shared(int src, int src_stride, int dst, int dst_stride, ivec2 begin, ivec2 region, bvec2 edge, uint j) {
-  const ivec2 cb = child_begin(begin, j);
-  const ivec2 cn = child_end(begin, region, edge, j) - cb;
-  const ivec2 pb = child_begin(begin, j - 1u);
-  const ivec2 child = level_size(j);
-  const ivec2 parent = level_size(j - 1u);
-  for (int i = int(gl_LocalInvocationIndex); i < cn.x * cn.y; i += 256) {
-    const ivec2 c = cb + ivec2(i % cn.x, i / cn.x);
-    const ivec2 rx = parent_range(c.x, child.x, parent.x) - pb.x;
-    const ivec2 ry = parent_range(c.y, child.y, parent.y) - pb.y;
-    float v = tile[src + ry.x * src_stride + rx.x];
-    for (int y = ry.x; y <= ry.y; ++y) {
-      for (int x = rx.x; x <= rx.y; ++x) v = farther(v, tile[src + y * src_stride + x]);
-    }
-    tile[dst + (c.y - cb.y) * dst_stride + (c.x - cb.x)] = v;
-    store_level(kBaseLevel + j, c, v);
-  }
-}
-
-// Levels j0 + 1 .. j0 + n of the region, level j0 already in tile A (origin child_begin(j0)).
-void reduce_levels(uint j0, uint n, ivec2 begin, ivec2 region, bvec2 edge) {
-  for (uint s = 0u; s < n; ++s) {
-    barrier();
-    const uint j = j0 + s + 1u;
-    if ((s & 1u) == 0u) {
-      reduce_shared(0, kStrideA, kOffsetB, kStrideB, begin, region, edge, j);
-    } else {
-      reduce_shared(kOffsetB, kStrideB, 0, kStrideA, begin, region, edge, j);
-    }
-  }
-}
+ivec2 level_size(uint j) { return fold_level_size(ivec2(pc.base_width, pc.base_height), j); }
 
 // Levels j are counted from the base level below (j = 1 is pyramid level kBaseLevel + 1).
 // Child c of level 1 (the general rule: 2x2, plus the folded column, row or corner at an odd edge).
@@ -172,7 +121,7 @@ float fold_level1(ivec2 c, float core, ivec2 child, ivec2 base) {
 // Level 1 of an edge tile (up to 63x63 children) into tile A, two children per invocation per step.
 void level1_general(ivec2 begin, ivec2 region, bvec2 edge, ivec2 base) {
   const ivec2 cb = child_begin(begin, 1u);
-  const ivec2 cn = child_end(begin, region, edge, 1u) - cb;
+  const ivec2 cn = child_end(begin, region, edge, base, 1u) - cb;
   const ivec2 child = level_size(1u);
   const int n = cn.x * cn.y;
   for (int i = int(gl_LocalInvocationIndex); i < n; i += 512) {
@@ -267,7 +216,7 @@ void main() {
     level1_general(begin, region, edge, base);
     // Levels 2 .. tile_levels in shared memory. The result of level tile_levels ends in A if
     // tile_levels is odd, in B if even.
-    reduce_levels(1u, pc.tile_levels - 1u, begin, region, edge);
+    reduce_levels(1u, pc.tile_levels - 1u, begin, region, edge, base, kBaseLevel);
   }
   if (pc.tail_levels == 0u) return;  // uniform: a push constant
 
@@ -294,5 +243,5 @@ void main() {
     tile[c.y * kStrideA + c.x] = load_level(kBaseLevel + t, c);
   }
   // The tail's region is the whole base level, which reaches both edges.
-  reduce_levels(t, pc.tail_levels, ivec2(0), base, bvec2(true));
+  reduce_levels(t, pc.tail_levels, ivec2(0), base, bvec2(true), base, kBaseLevel);
 }
