@@ -1,7 +1,7 @@
 // The fold rule of the Hi-Z pyramid over a region of one workgroup, in shared memory: shared by the
-// stream pass (hiz_stream.comp, base = the depth image, for the workgroups at the right and bottom
-// edges) and the tile pass (hiz_build.comp, base = level GLINT_HIZ_STREAM_LEVELS, for its edge tiles
-// and its tail). docs/OCCLUSION.md, "Hi-Z pyramid".
+// stream pass of GPUs (hiz_stream.comp, base = the depth image, for the workgroups at the right and
+// bottom edges) and the tile pass (hiz_build.comp, base = the stream pass's last level, 6 on GPUs
+// and 2 on CPU devices, for its edge tiles and its tail). docs/OCCLUSION.md, "Hi-Z pyramid".
 //
 // Fold rule: level sizes are max(1, size >> j) like Vulkan mips; child c of a parent of w texels
 // covers parents 2c and 2c + 1, and the last child also covers parent w - 1 when w is odd (the

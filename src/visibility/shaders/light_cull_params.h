@@ -20,9 +20,10 @@
 // Hi-Z levels: level 0 is the depth image itself, level k (k >= 1) is max(1, size >> k) on a side
 // and is stored in mip k - 1 of the pyramid image. 16384 needs 14 levels.
 #define GLINT_HIZ_MAX_LEVELS 14u
-// The stream pass (hiz_stream.comp) writes levels 1 to 6 from the depth image, a 64x64 block of
-// depth texels per workgroup. The tile pass (hiz_build.comp) reduces 64x64 tiles of level 6 through
-// 6 levels; its last workgroup reduces up to 6 more.
+// On GPUs the stream pass (hiz_stream.comp) writes levels 1 to 6 from the depth image, a 64x64
+// block of depth texels per workgroup (CPU devices: hiz_stream_texels.comp, levels 1 and 2). The
+// tile pass (hiz_build.comp) reduces 64x64 tiles of the stream pass's last level through 6 levels;
+// its last workgroup reduces up to 6 more.
 #define GLINT_HIZ_STREAM_LEVELS 6u
 #define GLINT_HIZ_TILE 64
 #define GLINT_HIZ_TILE_LEVELS 6u
@@ -30,7 +31,7 @@
 struct GlintHiZPush {
   GLINT_INT base_width;  // size of the base level this dispatch reads
   GLINT_INT base_height;
-  GLINT_UINT base_level;     // 0: the depth image (stream pass); 6: Hi-Z level 6 (tile pass)
+  GLINT_UINT base_level;     // 0: the depth image (stream pass); 6 or 2: that Hi-Z level (tile pass)
   GLINT_UINT tile_levels;    // levels every workgroup builds from its tile or block (1 to 6)
   GLINT_UINT tail_levels;    // levels the last workgroup then builds (0 to 6)
   GLINT_UINT reversed_z;     // 0: farthest = max (standard Z); 1: farthest = min (reversed Z)
