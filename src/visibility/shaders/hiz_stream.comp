@@ -7,7 +7,7 @@
 // invocations storing consecutive texels, and little else. hiz_build.comp then reduces level 6 to
 // the last level (1/4096 of the bytes), only for pyramids of more than 6 levels.
 //
-// Workgroup g (16x16 invocations, numbered from the bottom-right corner) owns the depth texels
+// Workgroup g (16x16 invocations; block_of() maps launch order to g) owns the depth texels
 // [64 g, 64 g + 64) per axis, the last workgroup of a row or column up to the edge (64 to 127
 // texels), and the texels of levels 1..6 over them: texel c of level k covers the depth texels
 // [c * 2^k, (c + 1) * 2^k), the last one of a row or column up to the edge (the fold rule,
