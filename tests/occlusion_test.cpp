@@ -33,6 +33,18 @@ reference::DepthImage random_depth(uint32_t w, uint32_t h, uint32_t stream) {
   return d;
 }
 
+// Runs f, which must throw Error with `code` and a message containing `needle`.
+template <typename F>
+void expect_error(F&& f, ErrorCode code, const std::string& needle) {
+  try {
+    f();
+    ADD_FAILURE() << "no error for " << needle;
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), code) << e.what();
+    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+  }
+}
+
 // Poisons every mip of the pyramid with NaN, so an unwritten texel fails the comparison.
 void poison_pyramid(HiZPyramid& hiz) {
   context().run_once([&](VkCommandBuffer cmd) {
@@ -130,6 +142,29 @@ TEST_F(OcclusionTest, HiZMatchesReferenceAtAllSizes) {
       }
     }
   }
+}
+
+// The stream pass by device type and shared memory (detail::hiz_resolve_stream): the block kernel
+// and the tile pass declare kHiZSharedBytes; a device with less builds with the texel stream pass
+// where no tile pass is needed and refuses larger pyramids by name.
+TEST_F(OcclusionTest, HiZStreamFitsTheDeviceSharedMemory) {
+  using detail::HiZStream;
+  const auto gpu = VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU, cpu = VK_PHYSICAL_DEVICE_TYPE_CPU;
+  const uint32_t need = detail::kHiZSharedBytes;
+  EXPECT_EQ(detail::hiz_resolve_stream(HiZStream::device, gpu, 49152, 11, "g"), HiZStream::blocks);
+  EXPECT_EQ(detail::hiz_resolve_stream(HiZStream::device, gpu, need, 11, "g"), HiZStream::blocks);
+  EXPECT_EQ(detail::hiz_resolve_stream(HiZStream::device, cpu, 32768, 11, "c"), HiZStream::texels);
+  EXPECT_EQ(detail::hiz_resolve_stream(HiZStream::device, gpu, 16384, 2, "g"), HiZStream::texels);
+  EXPECT_EQ(detail::hiz_resolve_stream(HiZStream::texels, gpu, need, 11, "g"), HiZStream::texels);
+  EXPECT_EQ(detail::hiz_resolve_stream(HiZStream::blocks, cpu, need, 11, "c"), HiZStream::blocks);
+  expect_error([&] { detail::hiz_resolve_stream(HiZStream::device, gpu, need - 1, 11, "small"); }, ErrorCode::no_device,
+               "11 levels need 20484 bytes of compute shared memory; device 'small' has 20483");
+  expect_error([&] { detail::hiz_resolve_stream(HiZStream::device, gpu, 16384, 3, "small"); }, ErrorCode::no_device,
+               "HiZConfig::max_cell_px <= 4");
+  expect_error([&] { detail::hiz_resolve_stream(HiZStream::blocks, gpu, 16384, 2, "small"); }, ErrorCode::no_device,
+               "device 'small' has 16384");
+  // This device builds every pyramid.
+  EXPECT_GE(context().info().max_shared_memory_bytes, need);
 }
 
 // The counter resets itself: frames with different depth, in separate submissions and twice in
@@ -742,15 +777,6 @@ TEST_F(OcclusionTest, EdgeMovingOverAFixedLightStaysWithinTheTexelBound) {
 
 // Bad settings and arguments throw Error naming the field, before anything is recorded or made.
 TEST_F(OcclusionTest, BadConfigAndArgumentsThrow) {
-  auto expect_error = [](auto&& f, ErrorCode code, const std::string& needle) {
-    try {
-      f();
-      ADD_FAILURE() << "no error for " << needle;
-    } catch (const Error& e) {
-      EXPECT_EQ(e.code(), code) << e.what();
-      EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
-    }
-  };
   HiZConfig hc;
   expect_error([&] { HiZPyramid(context(), hc); }, ErrorCode::invalid_argument, "HiZConfig::extent.width = 0");
   hc.extent = {16385, 4};

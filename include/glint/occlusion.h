@@ -58,7 +58,10 @@ uint32_t hiz_level_count(const HiZConfig& config);
 /// depth of every source pixel it covers (fold rule in docs/OCCLUSION.md).
 class HiZPyramid {
  public:
-  /// Throws Error if config is invalid or larger than the device allows.
+  /// Throws Error if config is invalid or larger than the device allows, and Error(no_device) if
+  /// the pyramid has more than 2 levels and the device's maxComputeSharedMemorySize is below the
+  /// 20484 bytes its kernels declare (Vulkan guarantees 16384; cap the levels with
+  /// HiZConfig::max_cell_px <= 4 there).
   HiZPyramid(const Context& context, const HiZConfig& config);
   HiZPyramid(const HiZPyramid&) = delete;
   HiZPyramid& operator=(const HiZPyramid&) = delete;

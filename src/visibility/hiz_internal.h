@@ -4,6 +4,7 @@
 #include <glint/occlusion.h>
 
 #include <cstdint>
+#include <string>
 
 namespace glint::detail {
 
@@ -18,6 +19,21 @@ enum class HiZStream : uint32_t {
   /// barrier; the tile pass starts at level 2.
   texels,
 };
+
+/// Compute shared memory the Hi-Z kernels declare, in bytes: the ping-pong tiles of hiz_fold.glsl
+/// (64x64 and 32x32 floats), which the block stream pass and the tile pass use, and the tile pass's
+/// last-workgroup flag. The texel stream pass declares none.
+constexpr uint32_t kHiZSharedBytes = (64 * 64 + 32 * 32) * 4 + 4;
+
+/// The stream pass a pyramid of `levels` levels runs on a device of type `type` with
+/// `shared_bytes` of compute shared memory (maxComputeSharedMemorySize), asked for `requested`:
+/// `device` resolves to `blocks` on GPUs and `texels` on CPU devices, and to `texels` where the
+/// blocks do not fit. Throws Error(no_device), naming the device and both sizes, where the passes
+/// it needs do not fit: `blocks` asked for by name, or the tile pass (a pyramid of more levels
+/// than the stream pass writes). Vulkan guarantees 16 KiB; lavapipe and desktop GPUs have 32 KiB
+/// or more.
+HiZStream hiz_resolve_stream(HiZStream requested, VkPhysicalDeviceType type, uint32_t shared_bytes, uint32_t levels,
+                             const std::string& device_name);
 
 struct HiZAccess {
   /// Selects the stream pass `hiz` records from now on (making its pipelines here). Call it while

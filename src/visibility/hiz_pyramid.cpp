@@ -166,10 +166,8 @@ struct HiZPyramid::Impl {
   // Chooses the stream pass (`device`: by the device type), plans the dispatches and makes their
   // pipelines.
   void select(detail::HiZStream which) {
-    if (which == detail::HiZStream::device) {
-      which =
-          context->info().type == VK_PHYSICAL_DEVICE_TYPE_CPU ? detail::HiZStream::texels : detail::HiZStream::blocks;
-    }
+    const DeviceInfo& info = context->info();
+    which = detail::hiz_resolve_stream(which, info.type, info.max_shared_memory_bytes, levels, info.name);
     stream = which;
     stream_levels = which == detail::HiZStream::blocks ? GLINT_HIZ_STREAM_LEVELS : 2u;
     plan();
@@ -299,6 +297,24 @@ void HiZPyramid::record(VkCommandBuffer cmd, Image& depth, Profiler* profiler) {
 }
 
 namespace detail {
+
+HiZStream hiz_resolve_stream(HiZStream requested, VkPhysicalDeviceType type, uint32_t shared_bytes, uint32_t levels,
+                             const std::string& device_name) {
+  const bool fits = shared_bytes >= kHiZSharedBytes;
+  HiZStream s = requested;
+  if (s == HiZStream::device) {
+    s = type != VK_PHYSICAL_DEVICE_TYPE_CPU && fits ? HiZStream::blocks : HiZStream::texels;
+  }
+  const uint32_t stream_levels = s == HiZStream::blocks ? GLINT_HIZ_STREAM_LEVELS : 2u;
+  if (!fits && (s == HiZStream::blocks || levels > stream_levels)) {
+    throw Error(ErrorCode::no_device,
+                concat("HiZPyramid: ", levels, " levels need ", kHiZSharedBytes,
+                       " bytes of compute shared memory; device '", device_name, "' has ", shared_bytes,
+                       " (maxComputeSharedMemorySize). A pyramid of at most 2 levels (HiZConfig::max_cell_px "
+                       "<= 4) needs none"));
+  }
+  return s;
+}
 
 void HiZAccess::select_stream(HiZPyramid& hiz, HiZStream stream) { hiz.impl_->select(stream); }
 HiZStream HiZAccess::stream(const HiZPyramid& hiz) { return hiz.impl_->stream; }

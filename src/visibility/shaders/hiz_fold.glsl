@@ -16,7 +16,8 @@
 //   float farther(float a, float b);                   // max (standard Z) or min (reversed Z)
 //   void store_level(uint level, ivec2 p, float v);    // texel p of pyramid level `level`
 // This file declares the shared ping-pong tiles: A holds up to 64x64 texels (the region's first
-// level), B up to 32x32 (20 KiB in all, within lavapipe's 32 KiB).
+// level), B up to 32x32 (20 KiB in all, within lavapipe's 32 KiB; the host checks the device's
+// limit against detail::kHiZSharedBytes in src/visibility/hiz_internal.h, which counts them).
 #ifndef GLINT_HIZ_FOLD_GLSL
 #define GLINT_HIZ_FOLD_GLSL
 
