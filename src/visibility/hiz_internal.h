@@ -6,6 +6,8 @@
 #include <cstdint>
 #include <string>
 
+#include "visibility/shaders/light_cull_params.h"
+
 namespace glint::detail {
 
 /// The stream pass an HiZPyramid runs (docs/OCCLUSION.md, "Hi-Z pyramid").
@@ -19,6 +21,10 @@ enum class HiZStream : uint32_t {
   /// barrier; the tile pass starts at level 2.
   texels,
 };
+
+/// Levels the stream pass `s` (`blocks` or `texels`) writes from the depth image; the tile pass
+/// starts at that level.
+constexpr uint32_t hiz_stream_levels(HiZStream s) { return s == HiZStream::blocks ? GLINT_HIZ_STREAM_LEVELS : 2u; }
 
 /// Compute shared memory the Hi-Z kernels declare, in bytes: the ping-pong tiles of hiz_fold.glsl
 /// (64x64 and 32x32 floats), which the block stream pass and the tile pass use, and the tile pass's

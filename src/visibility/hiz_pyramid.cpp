@@ -169,7 +169,7 @@ struct HiZPyramid::Impl {
     const DeviceInfo& info = context->info();
     which = detail::hiz_resolve_stream(which, info.type, info.max_shared_memory_bytes, levels, info.name);
     stream = which;
-    stream_levels = which == detail::HiZStream::blocks ? GLINT_HIZ_STREAM_LEVELS : 2u;
+    stream_levels = detail::hiz_stream_levels(which);
     plan();
     stream_pipeline.reset();
     tile_pipeline.reset();
@@ -305,8 +305,7 @@ HiZStream hiz_resolve_stream(HiZStream requested, VkPhysicalDeviceType type, uin
   if (s == HiZStream::device) {
     s = type != VK_PHYSICAL_DEVICE_TYPE_CPU && fits ? HiZStream::blocks : HiZStream::texels;
   }
-  const uint32_t stream_levels = s == HiZStream::blocks ? GLINT_HIZ_STREAM_LEVELS : 2u;
-  if (!fits && (s == HiZStream::blocks || levels > stream_levels)) {
+  if (!fits && (s == HiZStream::blocks || levels > hiz_stream_levels(s))) {
     throw Error(ErrorCode::no_device,
                 concat("HiZPyramid: ", levels, " levels need ", kHiZSharedBytes,
                        " bytes of compute shared memory; device '", device_name, "' has ", shared_bytes,
