@@ -9,11 +9,12 @@
 //
 // Workgroup g (16x16 invocations; block_of() maps launch order to g) owns the depth texels
 // [64 g, 64 g + 64) per axis, the last workgroup of a row or column up to the edge (64 to 127
-// texels), and the texels of levels 1..6 over them: texel c of level k covers the depth texels
+// texels; 64 exactly where the size is a multiple of 64), and the texels of levels 1..6 over them: texel c of level k covers the depth texels
 // [c * 2^k, (c + 1) * 2^k), the last one of a row or column up to the edge (the fold rule,
 // hiz_fold.glsl). Each texel holds the farthest depth it covers (max for standard Z, min for
 // reversed Z).
-// - Interior workgroups (not the last of their row or column), where no fold applies: invocation
+// - Interior workgroups, where no fold applies (all but the last of a row or column whose size is
+//   not a multiple of 64; 1920 and 3840 are 30 and 60 blocks): invocation
 //   (x, y) gathers the 4x4 depth texels at 4 (16 g + (x, y)), its 2x2 texels of level 1 and its
 //   texel of level 2. Level 1 goes through shared memory so that the workgroup stores it row by
 //   row (a 2x2 block per invocation would leave every other texel of a row to the next store);
@@ -159,9 +160,9 @@ void edge_block(ivec2 begin, ivec2 region, bvec2 edge, ivec2 base, vec2 inv_size
   reduce_levels(1u, pc.tile_levels - 1u, begin, region, edge, base, 0u);
 }
 
-// The block of the workgroup with linear index i (in launch order): the edge blocks first (the
-// last row, then the last column), so that their longer path does not finish last, then the
-// interior blocks row by row.
+// The block of the workgroup with linear index i (in launch order): the last row, then the last
+// column (the edge blocks, where the size is not a multiple of 64), so that their longer path does
+// not finish last, then the other blocks row by row.
 ivec2 block_of(int i, ivec2 groups) {
   if (i < groups.x) return ivec2(i, groups.y - 1);
   i -= groups.x;
@@ -175,7 +176,10 @@ void main() {
   const vec2 inv_size = 1.0 / vec2(base);
   const ivec2 groups = ivec2(gl_NumWorkGroups.xy);
   const ivec2 g = block_of(int(gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x), groups);
-  const bvec2 edge = equal(g, groups - 1);
+  // A block of the last row or column folds only where the size is not a multiple of 64: a last
+  // block of exactly 64 texels is built like any interior block.
+  const bvec2 last = equal(g, groups - 1), ragged = notEqual(base & 63, ivec2(0));
+  const bvec2 edge = bvec2(last.x && ragged.x, last.y && ragged.y);
   if (!any(edge)) {  // uniform per workgroup
     interior(g, inv_size);
     return;
