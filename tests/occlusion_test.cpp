@@ -116,8 +116,11 @@ const char* stream_name(detail::HiZStream s) { return s == detail::HiZStream::bl
 TEST_F(OcclusionTest, HiZMatchesReferenceAtAllSizes) {
   // 640x360 and 96x192: one side a multiple of 64, as in 1920x1080, so the block stream pass builds
   // that side's last blocks as interior ones; 96 = 64 + 32 folds (a mask of 31 would miss it).
-  const HiZCase cases[] = {{1, 1},    {7, 3},     {3, 7},    {2, 1},    {64, 64}, {65, 63},  {127, 129}, {130, 67},
-                           {333, 97}, {640, 360}, {96, 192}, {4097, 2}, {2, 600}, {8200, 2}, {3, 16384}, {1030, 771}};
+  // 191x190: a corner block of 127x126 depth texels, 63x63 of level 1 (the most an edge block
+  // gathers: all its batches of 8 per invocation).
+  const HiZCase cases[] = {{1, 1},     {7, 3},    {3, 7},     {2, 1},      {64, 64},  {65, 63},
+                           {127, 129}, {130, 67}, {333, 97},  {640, 360},  {96, 192}, {4097, 2},
+                           {2, 600},   {8200, 2}, {3, 16384}, {1030, 771}, {191, 190}};
   uint32_t stream = 1;
   for (const HiZCase& c : cases) {
     for (VkFormat format : {VK_FORMAT_D32_SFLOAT, VK_FORMAT_R32_SFLOAT}) {

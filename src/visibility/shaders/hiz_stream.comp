@@ -125,8 +125,12 @@ void interior(ivec2 g, vec2 inv_size) {
   }
 }
 
-// Children of level 1 per invocation in an edge workgroup: up to 63x63 over 256 invocations.
+// Children of level 1 per invocation in an edge workgroup: up to 63x63 over 256 invocations,
+// gathered kEdgeBatch at a time. The batch sets the kernel's register count (the interior path
+// alone needs 40 on the H100): all 16 gathers in flight took 118 registers there, 8 take 77 and
+// were the fastest (docs/OCCLUSION.md, "Speed").
 const int kEdgeLevel1PerInvocation = 16;
+const int kEdgeBatch = 8;
 
 // Edge workgroup: level 1 of the region [begin, begin + region) of the depth image into tile A
 // (origin begin / 2) by gathers, then levels 2..pc.tile_levels in shared memory.
@@ -136,26 +140,30 @@ void edge_block(ivec2 begin, ivec2 region, bvec2 edge, ivec2 base, vec2 inv_size
   const ivec2 n1 = fold_level_size(base, 1u);
   const int n = cn.x * cn.y;
   const int t = int(gl_LocalInvocationIndex);
-  // All core gathers first, so that they are in flight together.
-  float v[kEdgeLevel1PerInvocation];
-  for (int k = 0; k < kEdgeLevel1PerInvocation; ++k) {
-    const int i = min(t + 256 * k, n - 1);
-    v[k] = gather2x2(2 * (cb + ivec2(i % cn.x, i / cn.x)), inv_size);
-  }
-  for (int k = 0; k < kEdgeLevel1PerInvocation; ++k) {
-    const int i = t + 256 * k;
-    if (i >= n) break;
-    const ivec2 c = cb + ivec2(i % cn.x, i / cn.x);
-    const ivec2 p = 2 * c;
-    // The last texel of an odd size >= 3 also covers the depth texel 2c + 2.
-    const bool fx = c.x == n1.x - 1 && p.x + 2 < base.x;
-    const bool fy = c.y == n1.y - 1 && p.y + 2 < base.y;
-    float w = v[k];
-    if (fx) w = farther(w, gather2x2(p + ivec2(2, 0), inv_size));
-    if (fy) w = farther(w, gather2x2(p + ivec2(0, 2), inv_size));
-    if (fx && fy) w = farther(w, gather2x2(p + 2, inv_size));
-    tile[(c.y - cb.y) * kStrideA + (c.x - cb.x)] = w;
-    imageStore(hiz1, c, vec4(w));
+  for (int k0 = 0; k0 < kEdgeLevel1PerInvocation; k0 += kEdgeBatch) {
+    if (256 * k0 >= n) break;  // uniform
+    // The batch's core gathers first, so that they are in flight together.
+    float v[kEdgeBatch];
+    for (int k = 0; k < kEdgeBatch; ++k) {
+      const int i = min(t + 256 * (k0 + k), n - 1);
+      v[k] = gather2x2(2 * (cb + ivec2(i % cn.x, i / cn.x)), inv_size);
+    }
+    for (int k = 0; k < kEdgeBatch; ++k) {
+      const int i = t + 256 * (k0 + k);
+      if (i < n) {
+        const ivec2 c = cb + ivec2(i % cn.x, i / cn.x);
+        const ivec2 p = 2 * c;
+        // The last texel of an odd size >= 3 also covers the depth texel 2c + 2.
+        const bool fx = c.x == n1.x - 1 && p.x + 2 < base.x;
+        const bool fy = c.y == n1.y - 1 && p.y + 2 < base.y;
+        float w = v[k];
+        if (fx) w = farther(w, gather2x2(p + ivec2(2, 0), inv_size));
+        if (fy) w = farther(w, gather2x2(p + ivec2(0, 2), inv_size));
+        if (fx && fy) w = farther(w, gather2x2(p + 2, inv_size));
+        tile[(c.y - cb.y) * kStrideA + (c.x - cb.x)] = w;
+        imageStore(hiz1, c, vec4(w));
+      }
+    }
   }
   reduce_levels(1u, pc.tile_levels - 1u, begin, region, edge, base, 0u);
 }
