@@ -9,10 +9,10 @@
 //
 // Workgroup g (16x16 invocations; block_of() maps launch order to g) owns the depth texels
 // [64 g, 64 g + 64) per axis, the last workgroup of a row or column up to the edge (64 to 127
-// texels; 64 exactly where the size is a multiple of 64), and the texels of levels 1..6 over them: texel c of level k covers the depth texels
-// [c * 2^k, (c + 1) * 2^k), the last one of a row or column up to the edge (the fold rule,
-// hiz_fold.glsl). Each texel holds the farthest depth it covers (max for standard Z, min for
-// reversed Z).
+// texels; 64 exactly where the size is a multiple of 64), and the texels of levels 1..6 over
+// them: texel c of level k covers the depth texels [c * 2^k, (c + 1) * 2^k), the last one of a
+// row or column up to the edge (the fold rule, hiz_fold.glsl). Each texel holds the farthest
+// depth it covers (max for standard Z, min for reversed Z).
 // - Interior workgroups, where no fold applies (all but the last of a row or column whose size is
 //   not a multiple of 64; 1920 and 3840 are 30 and 60 blocks): invocation
 //   (x, y) gathers the 4x4 depth texels at 4 (16 g + (x, y)), its 2x2 texels of level 1 and its
