@@ -29,7 +29,7 @@ using namespace visibility_detail;
 
 // The GLSL push-constant blocks must match byte for byte (CONTRIBUTING.md, "Shared structs").
 static_assert(sizeof(GlintHiZPush) == 32);
-static_assert(offsetof(GlintHiZPush, counter_index) == 24);
+static_assert(offsetof(GlintHiZPush, counter_index) == 20);
 
 namespace {
 
@@ -116,14 +116,14 @@ struct HiZPyramid::Impl {
   // stream_levels (by 64x64 blocks of the depth image, the last block of a row or column up to the
   // edge; or one invocation per level-2 texel); the tile pass reduces level stream_levels by 64x64
   // tiles through up to 6 levels, and its last workgroup the rest. That level is at most
-  // 16384 / 4 = 4096 = 64 tiles wide, so the tail always fits one workgroup, and 2 + 6 + 6 = 14
-  // levels cover the largest pyramid.
+  // 16384 / 4 = 4096 = 64 tiles wide (after the texel stream pass; 256 = 4 tiles after the block
+  // one), so the tail always fits one workgroup, and 2 + 6 + 6 = 14 levels cover the largest
+  // pyramid.
   void plan() {
     const uint32_t reversed = config.reversed_z ? 1u : 0u;
     const uint32_t first = stream_levels;
     stream_push.base_width = static_cast<int32_t>(config.extent.width);
     stream_push.base_height = static_cast<int32_t>(config.extent.height);
-    stream_push.base_level = 0;
     stream_push.tile_levels = std::min(first, levels);
     stream_push.reversed_z = reversed;
     if (stream == detail::HiZStream::blocks) {  // a workgroup of 16x16 per 64x64 block
@@ -138,7 +138,6 @@ struct HiZPyramid::Impl {
     const uint32_t bh = std::max(1u, config.extent.height >> first);
     tile_push.base_width = static_cast<int32_t>(bw);
     tile_push.base_height = static_cast<int32_t>(bh);
-    tile_push.base_level = first;
     tile_push.tile_levels = std::min(GLINT_HIZ_TILE_LEVELS, levels - first);
     tile_groups_x = std::max(1u, bw >> 6);
     tile_groups_y = std::max(1u, bh >> 6);

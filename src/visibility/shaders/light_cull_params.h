@@ -31,12 +31,12 @@
 struct GlintHiZPush {
   GLINT_INT base_width;  // size of the base level this dispatch reads
   GLINT_INT base_height;
-  GLINT_UINT base_level;     // 0: the depth image (stream pass); 6 or 2: that Hi-Z level (tile pass)
   GLINT_UINT tile_levels;    // levels every workgroup builds from its tile or block (1 to 6)
   GLINT_UINT tail_levels;    // levels the last workgroup then builds (0 to 6)
   GLINT_UINT reversed_z;     // 0: farthest = max (standard Z); 1: farthest = min (reversed Z)
   GLINT_UINT counter_index;  // which word of the counter buffer counts finished workgroups
-  GLINT_UINT reserved;
+  GLINT_UINT reserved0;      // (the tile pass's base level is its specialization constant 2)
+  GLINT_UINT reserved1;
 };
 
 // Lights per workgroup of light_cull.comp: one workgroup's visibility is one 64-bit mask of the
