@@ -9,6 +9,7 @@
 #include <random>
 #include <vector>
 
+#include "blur/blur_steps.h"
 #include "core/half.h"
 #include "reference/blur_reference.h"
 #include "support/gpu_test.h"
@@ -210,9 +211,9 @@ struct MethodCase {
   float sigma;
 };
 const MethodCase kMethodCases[] = {
-    {BlurMethod::separable, false, 1.2f},  // fused, 9 taps
-    {BlurMethod::separable, false, 3.5f},  // fused, radius 11
-    {BlurMethod::separable, false, 6.0f},  // two line passes, radius 18
+    {BlurMethod::separable, false, 1.2f},  // fused, radius 5 (11 taps: truncation at 4 sigma)
+    {BlurMethod::separable, false, 3.5f},  // two line passes, radius 14
+    {BlurMethod::separable, false, 6.0f},  // two line passes, radius 24
     {BlurMethod::separable, true, 1.2f},   // linear sampling, 5 fetches
     {BlurMethod::separable, true, 4.0f},  {BlurMethod::pyramid, false, 4.0f}, {BlurMethod::pyramid, false, 9.0f},
     {BlurMethod::pyramid, false, 20.0f},  // 3 levels: levels 1 and 2 by the separable binomial (blur_down.comp)
@@ -277,6 +278,50 @@ TEST_F(BlurTest, EveryMethodSanitizesNanAndInfinity) {
     const CpuImage out = run_gauss(blur, input, kF16);
     ASSERT_TRUE(all_finite(out)) << "a non-finite input texel reached the output";
     EXPECT_LT(reference::rgba_relative_l2(out, reference_of(blur, input)), kTolFp16);
+  }
+}
+
+// Both kernels of a same-size separable step, each selected on every device (the streamed one is
+// the default; docs/BLUR.md "Streamed separable"), against the float64 reference: radius 2 (a step
+// of 8 rows longer than the 2 RADIUS lag), 5 and 12 (the largest), the pyramid's same-size level
+// blur (radius 8), fp32 and fp16. The sizes cross the streamed kernel's
+// strips of 64 (or fewer) columns and bands of 32 rows by one texel or part of one, and hold rows
+// and columns shorter than its apron; NaN (and in fp16 Inf) texels check that its loads sanitize.
+TEST_F(BlurTest, StreamedAndTiledSeparableKernelsMatchTheReference) {
+  const std::pair<uint32_t, uint32_t> sizes[] = {{83, 57}, {129, 65}, {300, 97}, {1, 40}, {40, 1}, {5, 3}};
+  const MethodCase cases[] = {{BlurMethod::separable, false, 0.5f},
+                              {BlurMethod::separable, false, 1.2f},
+                              {BlurMethod::separable, false, 3.0f},
+                              {BlurMethod::pyramid, false, 4.0f}};  // one level: its blur is same-size
+  using blur_steps::SeparableKernel;
+  for (SeparableKernel kernel : {SeparableKernel::stream, SeparableKernel::tiles}) {
+    for (const MethodCase& c : cases) {
+      for (Precision precision : {Precision::fp32, Precision::fp16}) {
+        GaussianBlur blur(context(), config_of(c, precision));
+        detail::BlurAccess::select_separable(blur, kernel);
+        const VkFormat format = precision == Precision::fp16 ? kF16 : kF32;
+        for (auto [w, h] : sizes) {
+          const std::string where = describe(c) + (kernel == SeparableKernel::stream ? " stream" : " tiles") +
+                                    (precision == Precision::fp16 ? " fp16 " : " fp32 ") + std::to_string(w) + "x" +
+                                    std::to_string(h);
+          SCOPED_TRACE(where);
+          CpuImage input = random_hdr(w, h, w * 31 + h);
+          input.at(w / 2, h / 3)[0] = std::nanf("");
+          // +Inf clamps to the chain's largest finite value, which the reference knows for fp16.
+          if (precision == Precision::fp16) input.at(w - 1, h - 1)[1] = INFINITY;
+          const CpuImage stored = as_stored(input, format);
+          const CpuImage out = run_gauss(blur, stored, format);
+          // A radius-12 strip in fp32 needs 19.2 KiB of shared memory, the largest of these; every
+          // device has 16 KiB at least, so only there may the streamed kernel fall back.
+          if (kernel == SeparableKernel::tiles || c.sigma < 3.0f || precision == Precision::fp16) {
+            EXPECT_EQ(detail::BlurAccess::streamed(blur), kernel == SeparableKernel::stream);
+          }
+          ASSERT_TRUE(all_finite(out)) << "unwritten or non-finite texels";
+          EXPECT_LT(reference::rgba_relative_l2(out, reference_of(blur, stored)),
+                    precision == Precision::fp16 ? kTolFp16 : kTolFp32);
+        }
+      }
+    }
   }
 }
 

@@ -11,6 +11,10 @@
 
 namespace glint {
 
+namespace detail {
+struct BlurAccess;  // tests' and benchmarks' switch of the separable kernel (src/blur/blur_steps.h)
+}
+
 /// Settings of a BlurPyramid. All fields are shape fields: set_config() rebuilds what they decide.
 struct BlurPyramidConfig {
   /// Gaussian sigma of each level's blur, in texels of that level (0.3 to 4; taps
@@ -222,6 +226,7 @@ class GaussianBlur {
   struct Impl;
 
  private:
+  friend struct detail::BlurAccess;
   std::unique_ptr<Impl> impl_;
 };
 

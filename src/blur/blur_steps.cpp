@@ -30,6 +30,16 @@ uint32_t fused_shared_bytes(FusedShape s, uint32_t radius, bool half_shared) {
   return (half_shared ? 8 : 16) * (padded(w + 2 * radius) * (h + 2 * radius) + padded(w) * (h + 2 * radius));
 }
 
+// Shared memory of src/blur/shaders/blur_stream.comp: a step's source rows and the ring of
+// STEP + 2 RADIUS filtered rows, each row skewed by one element every 2^SKEW (16 elements of 8
+// bytes in fp16, 8 of 16 in fp32), plus the unused arrays' one element each.
+uint32_t stream_shared_bytes(detail::Workgroup2D wg, uint32_t radius, bool half_shared) {
+  const uint32_t strip = 4 * wg.x, step = wg.y, skew = half_shared ? 4 : 3;
+  const uint32_t load_w = strip + 2 * radius;
+  const uint32_t load_s = load_w + ((load_w - 1) >> skew), row_s = strip + ((strip - 1) >> skew);
+  return (half_shared ? 8 : 16) * (load_s * step + row_s * (step + 2 * radius)) + 24;
+}
+
 // Throws Error(unsupported_size) "<where>: <role> extent WxH is out of range: accepted 1 to N on
 // each side" (role may be empty). The message is built only when it is thrown.
 void check_extent_named(const Context& context, VkExtent2D e, const char* where, const char* role) {
@@ -71,6 +81,27 @@ FusedShape fused_shape(const DeviceInfo& info, uint32_t radius, bool half_shared
       info, {{{32, 8}, 4}, {{32, 8}, 2}, {{32, 8}, 1}, {{16, 8}, 2}, {{16, 8}, 1}, {{8, 8}, 1}},
       {{{16, 8}, 1}, {{8, 8}, 1}}, [&](FusedShape s) { return fused_shared_bytes(s, radius, half_shared); },
       concat("blur radius ", radius));
+}
+
+bool stream_shape(const DeviceInfo& info, uint32_t radius, bool half_shared, StreamShape& shape) {
+  // Strips of 64 columns walked 8 rows a step (128 invocations), then shorter and narrower ones for
+  // large radii in fp32. Of the shapes measured on the H100 this one was the fastest (docs/BLUR.md
+  // "Streamed separable").
+  for (detail::Workgroup2D wg : {detail::Workgroup2D{16, 8}, {16, 4}, {8, 4}}) {
+    if (wg.x * wg.y <= info.max_workgroup_invocations &&
+        stream_shared_bytes(wg, radius, half_shared) <= info.max_shared_memory_bytes) {
+      shape.workgroup = wg;
+      return true;
+    }
+  }
+  return false;
+}
+
+uint32_t stream_band_rows(uint32_t width, uint32_t height, uint32_t strip_width) {
+  const uint64_t strips = (uint64_t(width) + strip_width - 1) / strip_width;
+  const uint64_t bands = std::max<uint64_t>(1, (kStreamGroups + strips - 1) / strips);
+  const uint64_t rows = (height + bands - 1) / bands;
+  return static_cast<uint32_t>(std::min<uint64_t>(height, std::max<uint64_t>(rows, kStreamMinBand)));
 }
 
 float max_value_for(VkFormat a, VkFormat b) {
@@ -176,7 +207,7 @@ VkExtent2D half_extent(VkExtent2D e) { return {blur_plan::half_size(e.width), bl
 // `binomial` picks the pyramid method's downsample over the area average (docs/BLUR.md).
 Step fused_step(StepProgram& prog, const DeviceInfo& info, int src, int dst, VkExtent2D src_size, VkExtent2D dst_size,
                 VkFormat dst_format, double sigma, double truncation, bool binomial, uint32_t flags, float max_value,
-                std::string label, bool fp32_shared) {
+                std::string label, bool fp32_shared, SeparableKernel kernel) {
   const std::vector<double> w = blur_plan::gaussian_half_taps(sigma, truncation);
   const uint32_t radius = static_cast<uint32_t>(w.size()) - 1;
   if (radius > kFusedMaxRadius)
@@ -191,6 +222,23 @@ Step fused_step(StepProgram& prog, const DeviceInfo& info, int src, int dst, VkE
   const bool exact_half = src_size.width == 2 * dst_size.width && src_size.height == 2 * dst_size.height;
   const uint32_t mode = binomial ? 3u : same ? 0u : exact_half ? 1u : 2u;
   Step s;
+  StreamShape stream;
+  if (mode == 0 && kernel == SeparableKernel::stream && stream_shape(info, radius, half_shared, stream)) {
+    s.pipeline = &prog.pipeline("blur_stream", dst_format, stream.workgroup, {radius, half_shared ? 1u : 0u},
+                                {VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
+    s.src = src;
+    s.dst = dst;
+    s.push = make_push(src_size, dst_size, flags, max_value);
+    for (uint32_t t = 0; t <= radius; ++t) s.push.weights[t] = static_cast<float>(w[t]);
+    const uint32_t strip = 4 * stream.workgroup.x;
+    const uint32_t band = stream_band_rows(dst_size.width, dst_size.height, strip);
+    s.push.band_rows = static_cast<int32_t>(band);
+    s.invocations_x = (dst_size.width + 3) / 4;  // RUN columns per invocation
+    s.invocations_y = (dst_size.height + band - 1) / band * stream.workgroup.y;
+    s.streamed = true;
+    s.label = std::move(label);
+    return s;
+  }
   // Prefetching the load step (shaders/blur_level.comp, PREFETCH) pays on GPUs only.
   const uint32_t prefetch = info.type == VK_PHYSICAL_DEVICE_TYPE_CPU ? 0u : 1u;
   s.pipeline = &prog.pipeline("blur_level", dst_format, shape.workgroup,

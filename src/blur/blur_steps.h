@@ -64,6 +64,7 @@ struct Step {
   uint32_t invocations_y = 0;
   uint32_t rows = 1;                          // output rows per invocation: invocations_y = ceil(rows of output / this)
   bool sampler = false;                       // binding 0 is a combined image sampler
+  bool streamed = false;                      // runs the streamed kernel (blur_stream.comp)
   const detail::OwnedBuffer* taps = nullptr;  // binding 2
   std::string label;
 };
@@ -106,12 +107,36 @@ BlurPush make_push(VkExtent2D src, VkExtent2D dst, uint32_t flags, float max_val
 
 VkExtent2D half_extent(VkExtent2D e);
 
+/// Which kernel runs a same-size separable step (docs/BLUR.md "Streamed separable"). `stream`, the
+/// default: the streamed kernel (src/blur/shaders/blur_stream.comp) wherever one of its strips
+/// fits the device's shared memory, else the tiled one (src/blur/shaders/blur_level.comp); the
+/// streamed one was the faster on both devices measured, the H100 and lavapipe. `tiles` forces the
+/// tiled kernel (tests and benchmarks, through detail::BlurAccess).
+enum class SeparableKernel : uint32_t { stream, tiles };
+
+// The streamed kernel's strip: workgroup (STRIP_W / 4, STEP rows) of blur_stream.comp.
+struct StreamShape {
+  detail::Workgroup2D workgroup{16, 8};
+};
+
+/// The widest strip of the streamed kernel whose shared memory and invocations fit the device, or
+/// none (false) where no strip fits.
+bool stream_shape(const DeviceInfo& info, uint32_t radius, bool half_shared, StreamShape& shape);
+
+/// Rows each workgroup of the streamed kernel writes for an image `width` x `height` with strips
+/// of `strip_width` columns: bands of at least kStreamMinBand rows (at most 2 RADIUS / band of the
+/// rows are filtered twice), enough of them for about kStreamGroups workgroups.
+uint32_t stream_band_rows(uint32_t width, uint32_t height, uint32_t strip_width);
+inline constexpr uint32_t kStreamMinBand = 32;
+inline constexpr uint32_t kStreamGroups = 2048;
+
 // A fused level-blur step B(src -> dst, sigma) (docs/BLUR.md); sigma 0 is the area downsample alone.
 // `binomial` picks the pyramid method's downsample over the area average (docs/BLUR.md). The
-// shared copies are fp16 where dst_format is RGBA16F, unless `fp32_shared`.
+// shared copies are fp16 where dst_format is RGBA16F, unless `fp32_shared`. A same-size step
+// (no downsample) runs on the kernel `kernel` picks.
 Step fused_step(StepProgram& prog, const DeviceInfo& info, int src, int dst, VkExtent2D src_size, VkExtent2D dst_size,
                 VkFormat dst_format, double sigma, double truncation, bool binomial, uint32_t flags, float max_value,
-                std::string label, bool fp32_shared = false);
+                std::string label, bool fp32_shared = false, SeparableKernel kernel = SeparableKernel::stream);
 
 // The pyramid's B-spline upsample (src/blur/shaders/blur_upsample.comp) from `src` to `dst`: its
 // tile shape from the device (the largest whose shared footprint and invocations fit).
@@ -128,3 +153,16 @@ Step simple_step(StepProgram& prog, const char* kernel, int src, int dst, VkExte
                                                            VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
 
 }  // namespace glint::blur_steps
+
+namespace glint::detail {
+
+/// Tests' and benchmarks' switch of the kernel GaussianBlur's same-size separable steps run on.
+struct BlurAccess {
+  /// Selects the kernel of `blur`'s separable steps from its next prepare() or record() on. Call
+  /// it while no recorded frame of `blur` is pending.
+  static void select_separable(GaussianBlur& blur, blur_steps::SeparableKernel kernel);
+  /// Whether the program of `blur`'s last prepare() or record() runs the streamed kernel.
+  static bool streamed(const GaussianBlur& blur);
+};
+
+}  // namespace glint::detail

@@ -27,12 +27,13 @@ using namespace blur_steps;
 using detail::check_range;
 using detail::concat;
 
-static_assert(sizeof(BlurPush) == 120, "BlurPush layout changed: update src/blur/shaders/blur_params.h users");
+static_assert(sizeof(BlurPush) == 124, "BlurPush layout changed: update src/blur/shaders/blur_params.h users");
 static_assert(offsetof(BlurPush, max_value) == 16);
 static_assert(offsetof(BlurPush, tap_count) == 28);
 static_assert(offsetof(BlurPush, weights) == 32);
 static_assert(offsetof(BlurPush, src_origin_x) == 96);
 static_assert(offsetof(BlurPush, ratio_y) == 116);
+static_assert(offsetof(BlurPush, band_rows) == 120);
 static_assert(static_cast<uint32_t>(BlurMethod::separable) - 1 == static_cast<uint32_t>(blur_plan::Method::separable));
 static_assert(static_cast<uint32_t>(BlurMethod::pyramid) == static_cast<uint32_t>(blur_plan::Method::pyramid));
 static_assert(static_cast<uint32_t>(BlurMethod::dual) == static_cast<uint32_t>(blur_plan::Method::dual));
@@ -139,7 +140,8 @@ struct GaussianBlur::Impl {
   };
   detail::SizeCache<Size> cache;
   Size* cur = nullptr;      // the size of the last prepare() or record()
-  uint32_t generation = 0;  // bumped by set_config()
+  uint32_t generation = 0;  // bumped by set_config() and detail::BlurAccess::select_separable()
+  SeparableKernel separable_kernel = SeparableKernel::stream;
 
   VkFormat level_format() const { return precision_format(config.precision); }
 
@@ -257,7 +259,7 @@ struct GaussianBlur::Impl {
     } else if (choice.method == BlurMethod::separable && choice.radius <= kFusedMaxRadius) {
       prog.steps.push_back(fused_step(prog, info, kInput, kOutput, size, size, out_format, config.sigma_px,
                                       blur_plan::kGaussTruncation, false, sanitize, max_value,
-                                      "gauss separable (fused)"));
+                                      "gauss separable (fused)", false, separable_kernel));
     } else if (choice.method == BlurMethod::separable) {
       const std::vector<double> w = blur_plan::gaussian_half_taps(config.sigma_px, blur_plan::kGaussTruncation);
       const detail::OwnedBuffer* buf = prog.add_taps(std::vector<float>(w.begin(), w.end()));
@@ -303,9 +305,9 @@ struct GaussianBlur::Impl {
         prev = e;
         if (split) {
           const int blurred = add(e);
-          prog.steps.push_back(fused_step(prog, info, src, blurred, e, e, lf, choice.level_sigma,
-                                          blur_plan::kGaussTruncation, false, 0u, max_value,
-                                          concat("gauss pyramid level ", j, " (blur)"), plan_made.fp32_shared));
+          prog.steps.push_back(fused_step(
+              prog, info, src, blurred, e, e, lf, choice.level_sigma, blur_plan::kGaussTruncation, false, 0u, max_value,
+              concat("gauss pyramid level ", j, " (blur)"), plan_made.fp32_shared, separable_kernel));
           src = blurred;
         }
       }
@@ -388,6 +390,19 @@ void GaussianBlur::record(VkCommandBuffer cmd, Image& input, Image& output, Prof
   if (size.choice.linear_sampling) detail::check_color_read(ctx, input.format, "GaussianBlur::record", "input", true);
   impl_->cache.recorded(&size, cmd);
   size.prog.record(cmd, input, &output, profiler);
+}
+
+void detail::BlurAccess::select_separable(GaussianBlur& blur, blur_steps::SeparableKernel kernel) {
+  GaussianBlur::Impl& impl = *blur.impl_;
+  impl.separable_kernel = kernel;
+  ++impl.generation;  // as set_config(): the current size plans again
+  if (impl.cur) impl.size_for(impl.cur->extent, impl.cur->output_format, "BlurAccess::select_separable");
+}
+
+bool detail::BlurAccess::streamed(const GaussianBlur& blur) {
+  if (!blur.impl_->cur) return false;
+  const std::vector<Step>& steps = blur.impl_->cur->prog.steps;
+  return std::any_of(steps.begin(), steps.end(), [](const Step& s) { return s.streamed; });
 }
 
 void GaussianBlur::release_unused() { impl_->cache.release_unused(impl_->cur); }
