@@ -88,17 +88,16 @@ reference::DoubleImage own_reference(const GaussianBlur& blur, const CpuImage& i
   }
 }
 
-// Times `blur` from `in` to `dst` once per benchmark iteration (the median frame of
-// frames_per_iteration(), as manual time) and returns those medians in milliseconds.
-std::vector<double> time_frames(benchmark::State& state, GaussianBlur& blur, detail::OwnedImage& in,
-                                detail::OwnedImage& dst) {
+// Times `record` once per benchmark iteration (the median frame of frames_per_iteration(), as
+// manual time) and returns those medians in milliseconds.
+template <typename Record>
+std::vector<double> time_frames(benchmark::State& state, Record record) {
   const Context& ctx = context();
   const int frames = frames_per_iteration();
   Profiler profiler(ctx, frames + 1);
   std::vector<double> frame_ms;
   for (auto _ : state) {
-    const double median =
-        median_frame_ms(ctx, profiler, frames, [&](VkCommandBuffer cmd) { blur.record(cmd, in.state, dst.state); });
+    const double median = median_frame_ms(ctx, profiler, frames, record);
     frame_ms.push_back(median);
     state.SetIterationTime(median * 1e-3);
   }
@@ -122,7 +121,8 @@ void run_gauss_benchmark(benchmark::State& state, BlurMethod method, bool linear
   detail::upload(ctx, in.state, random_hdr(width, height, 99));
   GaussianBlur blur(ctx, config);
   blur.prepare({width, height});
-  const std::vector<double> frame_ms = time_frames(state, blur, in, dst);
+  const std::vector<double> frame_ms =
+      time_frames(state, [&](VkCommandBuffer cmd) { blur.record(cmd, in.state, dst.state); });
 
   // Accuracy of the method the timed run chose (auto resolved), fp32 storage so that the method's
   // own error shows.
@@ -181,43 +181,60 @@ BENCHMARK(BM_BlurPyramid)->Apply(all_sigmas);
 BENCHMARK(BM_BlurDual)->Apply(all_sigmas);
 BENCHMARK(BM_BlurAuto)->Apply(all_sigmas);
 
-// The two kernels of a same-size separable step (docs/BLUR.md "Streamed separable"), forced
-// through detail::BlurAccess: the tiled one (kernel 1) and the streamed one (kernel 2, the
-// default), in the separable method (method 1: sigma 1.2, radius 5, and sigma 3, radius 12, the
-// largest) and in the pyramid's one-level blur (method 2, sigma 4), RGBA16F. 3840x2160 and
-// 1920x1080 for GPUs, 960x540 for CPU devices. Args: kernel, method, sigma x 10, width, height.
-// Counters: median_us, streamed (1 when the streamed kernel ran: it falls back to the tiles
-// where no strip fits), taps.
-void BM_BlurSameSizeKernel(benchmark::State& state) {
+// The two kernels of a level-blur step (docs/BLUR.md "Streamed separable"), forced through
+// detail::BlurAccess: the tiled one (kernel 1) and the streamed one (kernel 2, wherever a strip
+// fits). Method 1: GaussianBlur separable (sigma 1.2, radius 5; sigma 3, radius 12, the largest);
+// method 2: GaussianBlur pyramid, one level (sigma 4: its level blur reads at the same size);
+// method 3: BlurPyramid, every level sigma_texels = sigma (1.2: the default), whose levels read the
+// exact 2:1 mean where the sizes halve exactly. RGBA16F. 3840x2160 and 1920x1080 for GPUs, 960x540
+// for CPU devices. Args: kernel, method, sigma x 10, width, height. Counters: median_us, streamed
+// (the steps that ran the streamed kernel), taps (GaussianBlur).
+void BM_BlurLevelKernel(benchmark::State& state) {
   const auto kernel = state.range(0) == 1 ? blur_steps::SeparableKernel::tiles : blur_steps::SeparableKernel::stream;
+  const auto sigma = static_cast<float>(state.range(2) / 10.0);
   const auto width = static_cast<uint32_t>(state.range(3));
   const auto height = static_cast<uint32_t>(state.range(4));
   const Context& ctx = context();
   const VkFormat format = VK_FORMAT_R16G16B16A16_SFLOAT;
-  GaussianBlurConfig config;
-  config.method = state.range(1) == 1 ? BlurMethod::separable : BlurMethod::pyramid;
-  config.sigma_px = static_cast<float>(state.range(2) / 10.0);
   detail::OwnedImage in(ctx, {width, height}, format, detail::kToolImageUsage);
   detail::OwnedImage dst(ctx, {width, height}, format, detail::kToolImageUsage);
   detail::upload(ctx, in.state, random_hdr(width, height, 99));
-  GaussianBlur blur(ctx, config);
-  detail::BlurAccess::select_separable(blur, kernel);
-  blur.prepare({width, height});
-  const std::vector<double> frame_ms = time_frames(state, blur, in, dst);
-  const double bytes = static_cast<double>(blur.min_bytes_moved(format, format));
-  state.counters["bytes_per_second"] = benchmark::Counter(bytes, benchmark::Counter::kIsIterationInvariantRate);
+  std::vector<double> frame_ms;
+  uint32_t streamed = 0;
+  std::string label;
+  if (state.range(1) == 3) {
+    BlurPyramidConfig config;
+    config.sigma_texels = {sigma, sigma, sigma};
+    BlurPyramid pyramid(ctx, config);
+    detail::BlurAccess::select_separable(pyramid, kernel);
+    pyramid.prepare({width, height});
+    frame_ms = time_frames(state, [&](VkCommandBuffer cmd) { pyramid.record(cmd, in.state); });
+    streamed = detail::BlurAccess::streamed(pyramid);
+    label = "BlurPyramid";
+  } else {
+    GaussianBlurConfig config;
+    config.method = state.range(1) == 1 ? BlurMethod::separable : BlurMethod::pyramid;
+    config.sigma_px = sigma;
+    GaussianBlur blur(ctx, config);
+    detail::BlurAccess::select_separable(blur, kernel);
+    blur.prepare({width, height});
+    frame_ms = time_frames(state, [&](VkCommandBuffer cmd) { blur.record(cmd, in.state, dst.state); });
+    streamed = detail::BlurAccess::streamed(blur);
+    state.counters["taps"] = 2.0 * blur.choice().radius + 1.0;
+    label = blur_method_name(blur.choice().method);
+  }
   state.counters["median_us"] = median_of(frame_ms) * 1e3;
-  state.counters["streamed"] = detail::BlurAccess::streamed(blur) ? 1 : 0;
-  state.counters["taps"] = 2.0 * blur.choice().radius + 1.0;
-  state.SetLabel(std::string(blur_method_name(blur.choice().method)) +
-                 (detail::BlurAccess::streamed(blur) ? ", streamed" : ", tiles") + " on " + ctx.info().name);
+  state.counters["streamed"] = streamed;
+  state.SetLabel(label + ", " + std::to_string(streamed) + " streamed steps on " + ctx.info().name);
 }
-BENCHMARK(BM_BlurSameSizeKernel)
+BENCHMARK(BM_BlurLevelKernel)
     ->ArgsProduct({{1, 2}, {1}, {12, 30}, {3840}, {2160}})
     ->ArgsProduct({{1, 2}, {1}, {12}, {1920}, {1080}})
     ->ArgsProduct({{1, 2}, {2}, {40}, {3840}, {2160}})
+    ->ArgsProduct({{1, 2}, {3}, {12}, {3840}, {2160}})
+    ->ArgsProduct({{1, 2}, {3}, {12}, {1920}, {1080}})
     ->ArgsProduct({{1, 2}, {1}, {12, 30}, {960}, {540}})
-    ->ArgsProduct({{1, 2}, {2}, {40}, {960}, {540}})
+    ->ArgsProduct({{1, 2}, {2, 3}, {40}, {960}, {540}})
     ->ArgNames({"kernel", "method", "sigma10", "w", "h"})
     ->UseManualTime()
     ->Unit(benchmark::kMicrosecond);

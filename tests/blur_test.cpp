@@ -100,6 +100,40 @@ TEST_F(BlurTest, PyramidMatchesReferenceOnRandomInput) {
   }
 }
 
+// BlurPyramid's levels on both kernels (docs/BLUR.md "Streamed separable"), each selected on every
+// device: at 200x136 every level halves exactly (100x68, 50x34, 25x17), so each reads its source
+// as the exact 2:1 mean, which the streamed kernel takes (100 columns are two strips, 68 rows three
+// bands); at 97x61 only 48x30 -> 24x15 does, and the tiles run the other levels' any-ratio mean.
+TEST_F(BlurTest, PyramidLevelsOnBothKernelsMatchTheReference) {
+  using blur_steps::SeparableKernel;
+  for (SeparableKernel kernel : {SeparableKernel::stream, SeparableKernel::tiles}) {
+    for (Precision precision : {Precision::fp32, Precision::fp16}) {
+      BlurPyramidConfig config;
+      config.sigma_texels = {1.2f, 0.8f, 2.0f};
+      config.precision = precision;
+      BlurPyramid pyramid(context(), config);
+      detail::BlurAccess::select_separable(pyramid, kernel);
+      for (auto [w, h] : {std::pair<uint32_t, uint32_t>{200, 136}, {97, 61}}) {
+        CpuImage input = random_hdr(w, h, w + h);
+        input.at(w / 3, h / 2)[2] = std::nanf("");
+        const auto levels = run_pyramid(pyramid, input, precision == Precision::fp16 ? kF16 : kF32);
+        uint32_t exact = 0;  // levels whose size is exactly half the one above
+        for (uint32_t k = 1, pw = w, ph = h; k <= 3;
+             pw = pyramid.level_size(k).width, ph = pyramid.level_size(k).height, ++k)
+          exact += pw == 2 * pyramid.level_size(k).width && ph == 2 * pyramid.level_size(k).height;
+        EXPECT_EQ(detail::BlurAccess::streamed(pyramid), kernel == SeparableKernel::stream ? exact : 0u);
+        const auto ref = reference::blur_pyramid(input, sigmas_of(config));
+        for (int k = 0; k < 3; ++k) {
+          SCOPED_TRACE(testing::Message() << (kernel == SeparableKernel::stream ? "stream " : "tiles ") << w << "x" << h
+                                          << " level " << k + 1 << (precision == Precision::fp16 ? " fp16" : " fp32"));
+          ASSERT_TRUE(all_finite(levels[k]));
+          EXPECT_LT(reference::rgba_relative_l2(levels[k], ref[k]), precision == Precision::fp16 ? kTolFp16 : kTolFp32);
+        }
+      }
+    }
+  }
+}
+
 TEST_F(BlurTest, PyramidLevelSizesAndDegenerateInputs) {
   struct Case {
     uint32_t w, h;
@@ -314,7 +348,7 @@ TEST_F(BlurTest, StreamedAndTiledSeparableKernelsMatchTheReference) {
           // A radius-12 strip in fp32 needs 19.2 KiB of shared memory, the largest of these; every
           // device has 16 KiB at least, so only there may the streamed kernel fall back.
           if (kernel == SeparableKernel::tiles || c.sigma < 3.0f || precision == Precision::fp16) {
-            EXPECT_EQ(detail::BlurAccess::streamed(blur), kernel == SeparableKernel::stream);
+            EXPECT_EQ(detail::BlurAccess::streamed(blur), kernel == SeparableKernel::stream ? 1u : 0u);
           }
           ASSERT_TRUE(all_finite(out)) << "unwritten or non-finite texels";
           EXPECT_LT(reference::rgba_relative_l2(out, reference_of(blur, stored)),

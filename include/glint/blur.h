@@ -107,6 +107,7 @@ class BlurPyramid {
   struct Impl;
 
  private:
+  friend struct detail::BlurAccess;
   std::unique_ptr<Impl> impl_;
 };
 

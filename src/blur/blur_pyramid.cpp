@@ -33,7 +33,8 @@ struct BlurPyramid::Impl {
   };
   detail::SizeCache<Size> cache;
   Size* cur = nullptr;      // the size of the last prepare() or record()
-  uint32_t generation = 0;  // bumped by set_config()
+  uint32_t generation = 0;  // bumped by set_config() and detail::BlurAccess::select_separable()
+  SeparableKernel separable_kernel = SeparableKernel::device;
 
   VkFormat level_format() const { return precision_format(config.precision); }
 
@@ -63,7 +64,7 @@ struct BlurPyramid::Impl {
       prog.steps.push_back(fused_step(prog, info, k == 0 ? kInput : k - 1, k, prev, sizes[k], level_format(),
                                       config.sigma_texels[k], blur_plan::kPyramidTruncation, false,
                                       k == 0 ? GLINT_BLUR_FLAG_SANITIZE : 0u, max_value,
-                                      concat("blur pyramid level ", k + 1)));
+                                      concat("blur pyramid level ", k + 1), false, separable_kernel));
       prev = sizes[k];
     }
     return made;
@@ -84,6 +85,17 @@ BlurPyramid::BlurPyramid(const Context& context, const BlurPyramidConfig& config
 BlurPyramid::BlurPyramid(BlurPyramid&&) noexcept = default;
 BlurPyramid& BlurPyramid::operator=(BlurPyramid&&) noexcept = default;
 BlurPyramid::~BlurPyramid() = default;
+
+void detail::BlurAccess::select_separable(BlurPyramid& pyramid, blur_steps::SeparableKernel kernel) {
+  BlurPyramid::Impl& impl = *pyramid.impl_;
+  impl.separable_kernel = kernel;
+  ++impl.generation;  // as set_config(): the current size plans again
+  if (impl.cur) impl.size_for(impl.cur->extent, "BlurAccess::select_separable");
+}
+
+uint32_t detail::BlurAccess::streamed(const BlurPyramid& pyramid) {
+  return pyramid.impl_->cur ? pyramid.impl_->cur->prog.streamed_steps() : 0;
+}
 
 void BlurPyramid::set_config(const BlurPyramidConfig& config) {
   config.validate();

@@ -97,6 +97,13 @@ bool stream_shape(const DeviceInfo& info, uint32_t radius, bool half_shared, Str
   return false;
 }
 
+bool stream_fills_device(const DeviceInfo& info, VkExtent2D size, uint32_t strip_width) {
+  if (info.type == VK_PHYSICAL_DEVICE_TYPE_CPU) return true;
+  const uint64_t strips = (uint64_t(size.width) + strip_width - 1) / strip_width;
+  const uint32_t band = stream_band_rows(size.width, size.height, strip_width);
+  return strips * ((size.height + band - 1) / band) >= kStreamMinGroups;
+}
+
 uint32_t stream_band_rows(uint32_t width, uint32_t height, uint32_t strip_width) {
   const uint64_t strips = (uint64_t(width) + strip_width - 1) / strip_width;
   const uint64_t bands = std::max<uint64_t>(1, (kStreamGroups + strips - 1) / strips);
@@ -146,6 +153,10 @@ const detail::ComputePipeline& StepProgram::pipeline(const std::string& kernel, 
   d.workgroup = wg;
   d.specialization = std::move(spec);
   return pipelines->emplace(key, detail::ComputePipeline(*context, d)).first->second;
+}
+
+uint32_t StepProgram::streamed_steps() const {
+  return static_cast<uint32_t>(std::count_if(steps.begin(), steps.end(), [](const Step& s) { return s.streamed; }));
 }
 
 int StepProgram::add_image(VkExtent2D e, VkFormat f) {
@@ -223,9 +234,15 @@ Step fused_step(StepProgram& prog, const DeviceInfo& info, int src, int dst, VkE
   const uint32_t mode = binomial ? 3u : same ? 0u : exact_half ? 1u : 2u;
   Step s;
   StreamShape stream;
-  if (mode == 0 && kernel == SeparableKernel::stream && stream_shape(info, radius, half_shared, stream)) {
-    s.pipeline = &prog.pipeline("blur_stream", dst_format, stream.workgroup, {radius, half_shared ? 1u : 0u},
-                                {VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
+  if (mode <= 1 && kernel != SeparableKernel::tiles && stream_shape(info, radius, half_shared, stream) &&
+      (kernel == SeparableKernel::stream || stream_fills_device(info, dst_size, 4 * stream.workgroup.x))) {
+    // Two steps' rows in flight for a same-size read; one for the 2:1 mean, whose four fetches a
+    // texel fill the registers (H100, 3-level BlurPyramid at 3840x2160: 94.0 us with one, 96.8 with
+    // two, 124.7 with the tiles).
+    const uint32_t ahead = mode == 0 ? 2u : 1u;
+    s.pipeline =
+        &prog.pipeline("blur_stream", dst_format, stream.workgroup, {radius, half_shared ? 1u : 0u, mode, ahead},
+                       {VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
     s.src = src;
     s.dst = dst;
     s.push = make_push(src_size, dst_size, flags, max_value);

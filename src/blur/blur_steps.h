@@ -87,6 +87,9 @@ struct StepProgram {
   const detail::ComputePipeline& pipeline(const std::string& kernel, VkFormat dst_format, detail::Workgroup2D wg,
                                           std::vector<uint32_t> spec, std::vector<VkDescriptorType> bindings);
 
+  /// Steps that run the streamed kernel (blur_stream.comp).
+  uint32_t streamed_steps() const;
+
   // Owned images can also be copied from (BlurPyramid hands its levels to the caller).
   int add_image(VkExtent2D e, VkFormat f);
 
@@ -107,12 +110,14 @@ BlurPush make_push(VkExtent2D src, VkExtent2D dst, uint32_t flags, float max_val
 
 VkExtent2D half_extent(VkExtent2D e);
 
-/// Which kernel runs a same-size separable step (docs/BLUR.md "Streamed separable"). `stream`, the
-/// default: the streamed kernel (src/blur/shaders/blur_stream.comp) wherever one of its strips
-/// fits the device's shared memory, else the tiled one (src/blur/shaders/blur_level.comp); the
-/// streamed one was the faster on both devices measured, the H100 and lavapipe. `tiles` forces the
-/// tiled kernel (tests and benchmarks, through detail::BlurAccess).
-enum class SeparableKernel : uint32_t { stream, tiles };
+/// Which kernel runs a level-blur step that reads its source at the same size or at an exact 2:1
+/// mean (docs/BLUR.md "Streamed separable"): the streamed kernel (src/blur/shaders/blur_stream.comp)
+/// or the tiled one (src/blur/shaders/blur_level.comp, which also takes the other reads).
+/// `device`, the default: the streamed kernel where one of its strips fits the device's shared
+/// memory and, on GPUs, the image makes at least kStreamMinGroups workgroups
+/// (stream_fills_device()); else the tiles. `stream` drops the second condition and `tiles` forces
+/// the tiled kernel (tests and benchmarks, through detail::BlurAccess).
+enum class SeparableKernel : uint32_t { device, stream, tiles };
 
 // The streamed kernel's strip: workgroup (STRIP_W / 4, STEP rows) of blur_stream.comp.
 struct StreamShape {
@@ -130,13 +135,20 @@ uint32_t stream_band_rows(uint32_t width, uint32_t height, uint32_t strip_width)
 inline constexpr uint32_t kStreamMinBand = 32;
 inline constexpr uint32_t kStreamGroups = 2048;
 
+/// Whether the streamed kernel's strips of `strip_width` columns make at least kStreamMinGroups
+/// workgroups for a `size` output; always true on CPU devices. Fewer leave a GPU's SMs idle (the
+/// H100 runs three of these 128-invocation workgroups on each of its 132 SMs): its 3-level
+/// BlurPyramid at 1920x1080, whose 960x540 level makes 255, took 44.6 us streamed and 43.6 tiled.
+bool stream_fills_device(const DeviceInfo& info, VkExtent2D size, uint32_t strip_width);
+inline constexpr uint32_t kStreamMinGroups = 512;
+
 // A fused level-blur step B(src -> dst, sigma) (docs/BLUR.md); sigma 0 is the area downsample alone.
 // `binomial` picks the pyramid method's downsample over the area average (docs/BLUR.md). The
 // shared copies are fp16 where dst_format is RGBA16F, unless `fp32_shared`. A same-size step
 // (no downsample) runs on the kernel `kernel` picks.
 Step fused_step(StepProgram& prog, const DeviceInfo& info, int src, int dst, VkExtent2D src_size, VkExtent2D dst_size,
                 VkFormat dst_format, double sigma, double truncation, bool binomial, uint32_t flags, float max_value,
-                std::string label, bool fp32_shared = false, SeparableKernel kernel = SeparableKernel::stream);
+                std::string label, bool fp32_shared = false, SeparableKernel kernel = SeparableKernel::device);
 
 // The pyramid's B-spline upsample (src/blur/shaders/blur_upsample.comp) from `src` to `dst`: its
 // tile shape from the device (the largest whose shared footprint and invocations fit).
@@ -156,13 +168,16 @@ Step simple_step(StepProgram& prog, const char* kernel, int src, int dst, VkExte
 
 namespace glint::detail {
 
-/// Tests' and benchmarks' switch of the kernel GaussianBlur's same-size separable steps run on.
+/// Tests' and benchmarks' switch of the kernel the level-blur steps of GaussianBlur and
+/// BlurPyramid run on (blur_steps::SeparableKernel).
 struct BlurAccess {
-  /// Selects the kernel of `blur`'s separable steps from its next prepare() or record() on. Call
-  /// it while no recorded frame of `blur` is pending.
+  /// Selects the kernel of `blur`'s (`pyramid`'s) level-blur steps and plans the current size
+  /// again. Call it while no recorded frame of it is pending.
   static void select_separable(GaussianBlur& blur, blur_steps::SeparableKernel kernel);
-  /// Whether the program of `blur`'s last prepare() or record() runs the streamed kernel.
-  static bool streamed(const GaussianBlur& blur);
+  static void select_separable(BlurPyramid& pyramid, blur_steps::SeparableKernel kernel);
+  /// How many steps of the program of the last prepare() or record() run the streamed kernel.
+  static uint32_t streamed(const GaussianBlur& blur);
+  static uint32_t streamed(const BlurPyramid& pyramid);
 };
 
 }  // namespace glint::detail

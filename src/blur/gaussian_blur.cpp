@@ -141,7 +141,7 @@ struct GaussianBlur::Impl {
   detail::SizeCache<Size> cache;
   Size* cur = nullptr;      // the size of the last prepare() or record()
   uint32_t generation = 0;  // bumped by set_config() and detail::BlurAccess::select_separable()
-  SeparableKernel separable_kernel = SeparableKernel::stream;
+  SeparableKernel separable_kernel = SeparableKernel::device;
 
   VkFormat level_format() const { return precision_format(config.precision); }
 
@@ -399,10 +399,8 @@ void detail::BlurAccess::select_separable(GaussianBlur& blur, blur_steps::Separa
   if (impl.cur) impl.size_for(impl.cur->extent, impl.cur->output_format, "BlurAccess::select_separable");
 }
 
-bool detail::BlurAccess::streamed(const GaussianBlur& blur) {
-  if (!blur.impl_->cur) return false;
-  const std::vector<Step>& steps = blur.impl_->cur->prog.steps;
-  return std::any_of(steps.begin(), steps.end(), [](const Step& s) { return s.streamed; });
+uint32_t detail::BlurAccess::streamed(const GaussianBlur& blur) {
+  return blur.impl_->cur ? blur.impl_->cur->prog.streamed_steps() : 0;
 }
 
 void GaussianBlur::release_unused() { impl_->cache.release_unused(impl_->cur); }

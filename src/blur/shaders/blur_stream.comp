@@ -2,13 +2,13 @@
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_samplerless_texture_functions : require
 #extension GL_EXT_control_flow_attributes : require
-// Streamed separable Gaussian at the source's size (docs/BLUR.md "Streamed separable"): the same
-// sums as src/blur/shaders/blur_level.comp with MODE 0, walked differently. A workgroup owns a
-// strip of STRIP_W columns and BAND_ROWS rows (push constant `band_rows`) and walks it down in
-// steps of STEP rows:
-//   - the source rows of the next two steps are fetched into registers (two sets, used by turns)
-//     while a step computes, so the memory latency hides behind the work of two steps instead of
-//     behind a barrier (the tiled kernel loads, waits, then computes);
+// Streamed level blur (docs/BLUR.md "Streamed separable"): the same sums as
+// src/blur/shaders/blur_level.comp with MODE 0 (the source at the same size) or 1 (the exact 2:1
+// mean of the source), walked differently. A workgroup owns a strip of STRIP_W columns and
+// `band_rows` rows (push constant) and walks it down in steps of STEP rows:
+//   - the source rows of the next AHEAD steps are fetched into registers (with AHEAD 2, two sets
+//     used by turns) while a step computes, so the memory latency hides behind the work of those
+//     steps instead of behind a barrier (the tiled kernel loads, waits, then computes);
 //   - every source row is filtered along x once and kept in a ring of STEP + 2 RADIUS rows of
 //     shared memory, which the vertical pass reads: the vertical apron of 2 RADIUS rows is
 //     filtered once per band (RADIUS rows above, RADIUS below), not once per tile.
@@ -24,6 +24,8 @@
 layout(local_size_x_id = 0, local_size_y_id = 1) in;  // (STRIP_W / RUN, STEP)
 layout(constant_id = 2) const int RADIUS = 4;        // taps 2 * RADIUS + 1
 layout(constant_id = 3) const bool HALF_SHARED = false;  // shared copies as packed fp16
+layout(constant_id = 4) const int MODE = 0;   // source read: 0 same size, 1 exact 2:1 area (2x2 mean)
+layout(constant_id = 5) const int AHEAD = 2;  // steps whose source rows are in flight (1 or 2)
 
 layout(binding = 0) uniform texture2D src;
 #include "dst_image.glsl"
@@ -72,11 +74,19 @@ ivec2 size;
 int x0, band, band_end, local_index, steps, ring_base, hx, hrow, vx, vrow;
 bool column_in;
 
+// Texel q of the destination grid (clamped to it) read from the source.
+vec4 load_source(ivec2 q) {
+  q = clamp(q, ivec2(0), size - 1);
+  if (MODE == 0) return src_texel(q);
+  ivec2 s = 2 * q;
+  return 0.25 * (src_texel(s) + src_texel(s + ivec2(1, 0)) + src_texel(s + ivec2(0, 1)) + src_texel(s + ivec2(1, 1)));
+}
+
 // The source texels of the STEP rows from image row `row0`, each invocation's LOADS of them.
 void fetch(out vec4 fetched[LOADS], int row0) {
   [[unroll]] for (int n = 0; n < LOADS; ++n) {
     int i = min(local_index + n * GROUP_SIZE, LOAD_W * STEP - 1);
-    fetched[n] = src_texel(ivec2(x0 - RADIUS + i % LOAD_W, row0 + i / LOAD_W));
+    fetched[n] = load_source(ivec2(x0 - RADIUS + i % LOAD_W, row0 + i / LOAD_W));
   }
 }
 
@@ -89,7 +99,7 @@ void walk_step(int k, inout vec4 fetched[LOADS]) {
     if (i < LOAD_W * STEP) put_src((i / LOAD_W) * LOAD_S + skew(i % LOAD_W), fetched[n]);
   }
   barrier();  // also orders the previous step's vertical reads before this step's ring writes
-  if (k + 2 < steps) fetch(fetched, hy + 2 * STEP);
+  if (k + AHEAD < steps) fetch(fetched, hy + AHEAD * STEP);
 
   // Horizontal pass: RUN outputs of row hy + hrow into its ring slot.
   {
@@ -138,13 +148,18 @@ void main() {
   vrow = (local_index / STRIP_W) * RUN;    // rows vrow .. vrow + RUN - 1 of the step's outputs
   column_in = x0 + vx < size.x;
 
-  // Two register sets, used by turns: the rows of the next two steps are in flight while a step
-  // computes.
-  vec4 fetched_a[LOADS], fetched_b[LOADS];
+  // One register set (AHEAD 1), or two used by turns: the rows of the next AHEAD steps are in
+  // flight while a step computes.
+  vec4 fetched_a[LOADS];
   fetch(fetched_a, band - RADIUS);
-  if (steps > 1) fetch(fetched_b, band - RADIUS + STEP);
-  for (int k = 0; k < steps; k += 2) {
-    walk_step(k, fetched_a);
-    if (k + 1 < steps) walk_step(k + 1, fetched_b);
+  if (AHEAD == 1) {
+    for (int k = 0; k < steps; ++k) walk_step(k, fetched_a);
+  } else {
+    vec4 fetched_b[LOADS];
+    if (steps > 1) fetch(fetched_b, band - RADIUS + STEP);
+    for (int k = 0; k < steps; k += 2) {
+      walk_step(k, fetched_a);
+      if (k + 1 < steps) walk_step(k + 1, fetched_b);
+    }
   }
 }
