@@ -136,11 +136,12 @@ inline constexpr uint32_t kStreamMinBand = 32;
 inline constexpr uint32_t kStreamGroups = 2048;
 
 /// Whether the streamed kernel's strips of `strip_width` columns make at least kStreamMinGroups
-/// workgroups for a `size` output; always true on CPU devices. Fewer leave a GPU's SMs idle (the
-/// H100 runs three of these 128-invocation workgroups on each of its 132 SMs): its 3-level
-/// BlurPyramid at 1920x1080, whose 960x540 level makes 255, took 44.6 us streamed and 43.6 tiled.
+/// workgroups for a `size` output; always true on CPU devices. A few long walks leave a GPU's SMs
+/// idle where many short tiles would not (docs/BLUR.md "Streamed separable": on the H100 the
+/// 3-level BlurPyramid at 1920x1080, whose 240x135 level makes 20 groups, took 44.5 us with every
+/// level streamed, 43.9 tiled and 38.6 with this floor).
 bool stream_fills_device(const DeviceInfo& info, VkExtent2D size, uint32_t strip_width);
-inline constexpr uint32_t kStreamMinGroups = 512;
+inline constexpr uint32_t kStreamMinGroups = 64;
 
 // A fused level-blur step B(src -> dst, sigma) (docs/BLUR.md); sigma 0 is the area downsample alone.
 // `binomial` picks the pyramid method's downsample over the area average (docs/BLUR.md). The
