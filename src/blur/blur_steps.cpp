@@ -32,12 +32,13 @@ uint32_t fused_shared_bytes(FusedShape s, uint32_t radius, bool half_shared) {
 
 // Shared memory of src/blur/shaders/blur_stream.comp: a step's source rows and the ring of
 // STEP + 2 RADIUS filtered rows, each row skewed by one element every 2^SKEW (16 elements of 8
-// bytes in fp16, 8 of 16 in fp32), plus the unused arrays' one element each.
+// bytes in fp16, 8 of 16 in fp32), plus the unused arrays' one element each (two fp32 elements of
+// 16 bytes with fp16 copies, two packed ones of 8 with fp32 copies).
 uint32_t stream_shared_bytes(detail::Workgroup2D wg, uint32_t radius, bool half_shared) {
   const uint32_t strip = 4 * wg.x, step = wg.y, skew = half_shared ? 4 : 3;
   const uint32_t load_w = strip + 2 * radius;
   const uint32_t load_s = load_w + ((load_w - 1) >> skew), row_s = strip + ((strip - 1) >> skew);
-  return (half_shared ? 8 : 16) * (load_s * step + row_s * (step + 2 * radius)) + 24;
+  return (half_shared ? 8 : 16) * (load_s * step + row_s * (step + 2 * radius)) + (half_shared ? 32 : 16);
 }
 
 // Throws Error(unsupported_size) "<where>: <role> extent WxH is out of range: accepted 1 to N on
