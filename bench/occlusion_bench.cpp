@@ -2,7 +2,8 @@
 // and the cull + occlusion grid + compaction of a light list, on device-local resources. GPU time
 // from timestamps as manual time (median of the frames of one command buffer), bytes/s over the
 // bytes each stage must move, and error counters against the float64 references:
-// - BM_HiZBuild: texels that differ from the reference pyramid (must be 0);
+// - BM_HiZBuild: texels that differ from the reference pyramid (must be 0); BM_HiZStreamPass
+//   times the same build with either stream pass forced (detail::HiZAccess);
 // - BM_LightCull: mean |grid fraction - brute force| over the first 2000 tested lights of the
 //   fixed scene (the occlusion error of docs/charts/occlusion_pareto.svg), and how often the
 //   documented bound or the conservative rule is broken (must be 0).
@@ -13,12 +14,14 @@
 #include <cmath>
 #include <cstring>
 #include <memory>
+#include <string>
 
 #include "bench_support.h"
 #include "core/barriers.h"
 #include "core/resources.h"
 #include "reference/occlusion_reference.h"
 #include "support/transfer.h"
+#include "visibility/hiz_internal.h"
 
 namespace glint::bench {
 namespace {
@@ -34,15 +37,15 @@ reference::Scene scene_for(uint32_t w, uint32_t h, uint32_t lights, double max_s
   return reference::random_scene(w, h, lights, 2024, false, max_size);
 }
 
-void BM_HiZBuild(benchmark::State& state) {
-  const auto w = static_cast<uint32_t>(state.range(0));
-  const auto h = static_cast<uint32_t>(state.range(1));
+// The Hi-Z build of a w x h D32 depth buffer with stream pass `stream`.
+void run_hiz_build(benchmark::State& state, uint32_t w, uint32_t h, detail::HiZStream stream) {
   const Context& ctx = context();
   const auto scene = scene_for(w, h, 0, 1);
   auto depth = depth_image(ctx, scene.depth);
   HiZConfig config;
   config.extent = {w, h};
   HiZPyramid hiz(ctx, config);
+  if (stream != detail::HiZStream::device) detail::HiZAccess::select_stream(hiz, stream);
   const int frames = frames_for(ctx, uint64_t(w) * h / 64);
   Profiler profiler(ctx, frames + 1);
   std::vector<double> all;
@@ -66,13 +69,34 @@ void BM_HiZBuild(benchmark::State& state) {
   state.counters["floor_bytes"] = bytes;
   state.counters["levels"] = hiz.levels();
   state.counters["mismatches_vs_f64"] = double(mismatches);
-  state.SetLabel("D32 on " + ctx.info().name);
+  const bool blocks = detail::HiZAccess::stream(hiz) == detail::HiZStream::blocks;
+  state.SetLabel(std::string("D32, ") + (blocks ? "block" : "texel") + " stream pass on " + ctx.info().name);
+}
+
+// Args: width, height. The device's stream pass (blocks on GPUs, texels on CPU devices).
+void BM_HiZBuild(benchmark::State& state) {
+  run_hiz_build(state, static_cast<uint32_t>(state.range(0)), static_cast<uint32_t>(state.range(1)),
+                detail::HiZStream::device);
 }
 
 BENCHMARK(BM_HiZBuild)
     ->Args({1920, 1080})
     ->Args({3840, 2160})
     ->ArgNames({"w", "h"})
+    ->UseManualTime()
+    ->Unit(benchmark::kMicrosecond);
+
+// Args: stream pass (detail::HiZStream: 1 blocks, levels 1-6 by 64x64 blocks; 2 texels, levels
+// 1-2), width, height: both passes on any device (docs/OCCLUSION.md "Speed").
+void BM_HiZStreamPass(benchmark::State& state) {
+  run_hiz_build(state, static_cast<uint32_t>(state.range(1)), static_cast<uint32_t>(state.range(2)),
+                static_cast<detail::HiZStream>(state.range(0)));
+}
+
+BENCHMARK(BM_HiZStreamPass)
+    ->ArgsProduct({{1, 2}, {1920}, {1080}})
+    ->ArgsProduct({{1, 2}, {3840}, {2160}})
+    ->ArgNames({"stream", "w", "h"})
     ->UseManualTime()
     ->Unit(benchmark::kMicrosecond);
 
