@@ -318,9 +318,9 @@ TEST_F(BlurTest, EveryMethodSanitizesNanAndInfinity) {
 // Both kernels of a same-size separable step, each selected on every device (the streamed one is
 // the default; docs/BLUR.md "Streamed separable"), against the float64 reference: radius 2 (a step
 // of 8 rows longer than the 2 RADIUS lag), 5 and 12 (the largest), the pyramid's same-size level
-// blur (radius 8), fp32 and fp16. The sizes cross the streamed kernel's
-// strips of 64 (or fewer) columns and bands of 32 rows by one texel or part of one, and hold rows
-// and columns shorter than its apron; NaN (and in fp16 Inf) texels check that its loads sanitize.
+// blur (radius 8), fp32 and fp16. The sizes cross the streamed kernel's strips of 64 (or fewer)
+// columns and bands of 32 rows by one texel or part of one, and hold rows and columns shorter than
+// its apron; NaN (and in fp16 Inf) texels check that its loads sanitize.
 TEST_F(BlurTest, StreamedAndTiledSeparableKernelsMatchTheReference) {
   const std::pair<uint32_t, uint32_t> sizes[] = {{83, 57}, {129, 65}, {300, 97}, {1, 40}, {40, 1}, {5, 3}};
   const MethodCase cases[] = {{BlurMethod::separable, false, 0.5f},
