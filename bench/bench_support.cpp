@@ -86,6 +86,14 @@ Buffer buffer_view(const detail::OwnedBuffer& b, VkBufferUsageFlags usage, bool 
   return v;
 }
 
+ImagePair rgba16f_pair(const Context& ctx, VkExtent2D extent, uint32_t stream) {
+  const VkFormat format = VK_FORMAT_R16G16B16A16_SFLOAT;
+  ImagePair pair{detail::OwnedImage(ctx, extent, format, detail::kToolImageUsage),
+                 detail::OwnedImage(ctx, extent, format, detail::kToolImageUsage)};
+  detail::upload(ctx, pair.src.state, random_hdr(extent.width, extent.height, stream));
+  return pair;
+}
+
 detail::OwnedImage depth_image(const Context& ctx, const reference::DepthImage& d) {
   detail::OwnedImage img(ctx, {d.width, d.height}, VK_FORMAT_D32_SFLOAT,
                          VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT);

@@ -27,6 +27,13 @@ detail::OwnedBuffer device_buffer(const Context& context, const void* data, VkDe
 /// `b` as a glint::Buffer of its whole size with `usage` | TRANSFER_DST, last used by the upload
 /// copy (after_copy) or not yet used.
 Buffer buffer_view(const detail::OwnedBuffer& b, VkBufferUsageFlags usage, bool after_copy);
+/// An RGBA16F source holding random_hdr(extent, stream) and an RGBA16F destination of the same
+/// extent, both with the tools' usage (sampled, storage, transfer).
+struct ImagePair {
+  detail::OwnedImage src;
+  detail::OwnedImage dst;
+};
+ImagePair rgba16f_pair(const Context& context, VkExtent2D extent, uint32_t stream);
 /// A sampled D32 depth image holding `depth`.
 detail::OwnedImage depth_image(const Context& context, const reference::DepthImage& depth);
 

@@ -116,9 +116,7 @@ void run_gauss_benchmark(benchmark::State& state, BlurMethod method, bool linear
   config.linear_sampling = linear;
 
   // Timing at the requested size, RGBA16F in and out, fp16 intermediates (the default).
-  detail::OwnedImage in(ctx, {width, height}, format, detail::kToolImageUsage);
-  detail::OwnedImage dst(ctx, {width, height}, format, detail::kToolImageUsage);
-  detail::upload(ctx, in.state, random_hdr(width, height, 99));
+  auto [in, dst] = rgba16f_pair(ctx, {width, height}, 99);
   GaussianBlur blur(ctx, config);
   blur.prepare({width, height});
   const std::vector<double> frame_ms =
@@ -195,10 +193,7 @@ void BM_BlurLevelKernel(benchmark::State& state) {
   const auto width = static_cast<uint32_t>(state.range(3));
   const auto height = static_cast<uint32_t>(state.range(4));
   const Context& ctx = context();
-  const VkFormat format = VK_FORMAT_R16G16B16A16_SFLOAT;
-  detail::OwnedImage in(ctx, {width, height}, format, detail::kToolImageUsage);
-  detail::OwnedImage dst(ctx, {width, height}, format, detail::kToolImageUsage);
-  detail::upload(ctx, in.state, random_hdr(width, height, 99));
+  auto [in, dst] = rgba16f_pair(ctx, {width, height}, 99);
   std::vector<double> frame_ms;
   uint32_t streamed = 0;
   std::string label;
@@ -252,10 +247,7 @@ void BM_BlurAutoVsBest(benchmark::State& state) {
   const auto height = static_cast<uint32_t>(state.range(2));
   const float bound = static_cast<float>(state.range(3)) / 1000.0f;
   const Context& ctx = context();
-  const VkFormat format = VK_FORMAT_R16G16B16A16_SFLOAT;
-  detail::OwnedImage in(ctx, {width, height}, format, detail::kToolImageUsage);
-  detail::OwnedImage dst(ctx, {width, height}, format, detail::kToolImageUsage);
-  detail::upload(ctx, in.state, random_hdr(width, height, 99));
+  auto [in, dst] = rgba16f_pair(ctx, {width, height}, 99);
   const int frames = frames_per_iteration();
   Profiler profiler(ctx, frames + 1);
   // Median frame time of `blur` in microseconds; one frame only when that one is beyond `cutoff`.

@@ -17,10 +17,7 @@ void BM_CopyFloor(benchmark::State& state) {
   const auto width = static_cast<uint32_t>(state.range(0));
   const auto height = static_cast<uint32_t>(state.range(1));
   const Context& ctx = context();
-  const VkFormat format = VK_FORMAT_R16G16B16A16_SFLOAT;
-  detail::OwnedImage src(ctx, {width, height}, format, detail::kToolImageUsage);
-  detail::OwnedImage dst(ctx, {width, height}, format, detail::kToolImageUsage);
-  detail::upload(ctx, src.state, random_hdr(width, height, 7));
+  auto [src, dst] = rgba16f_pair(ctx, {width, height}, 7);
   detail::PipelineDesc desc;
   desc.kernel_id = "image_copy_rgba16f";
   desc.bindings = {VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE};

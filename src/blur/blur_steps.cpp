@@ -84,14 +84,14 @@ FusedShape fused_shape(const DeviceInfo& info, uint32_t radius, bool half_shared
       concat("blur radius ", radius));
 }
 
-bool stream_shape(const DeviceInfo& info, uint32_t radius, bool half_shared, StreamShape& shape) {
+bool stream_shape(const DeviceInfo& info, uint32_t radius, bool half_shared, detail::Workgroup2D& workgroup) {
   // Strips of 64 columns walked 8 rows a step (128 invocations), then shorter and narrower ones for
   // large radii in fp32. Of the shapes measured on the H100 this one was the fastest (docs/BLUR.md
   // "Streamed separable").
   for (detail::Workgroup2D wg : {detail::Workgroup2D{16, 8}, {16, 4}, {8, 4}}) {
     if (wg.x * wg.y <= info.max_workgroup_invocations &&
         stream_shared_bytes(wg, radius, half_shared) <= info.max_shared_memory_bytes) {
-      shape.workgroup = wg;
+      workgroup = wg;
       return true;
     }
   }
@@ -234,25 +234,24 @@ Step fused_step(StepProgram& prog, const DeviceInfo& info, int src, int dst, VkE
   const bool exact_half = src_size.width == 2 * dst_size.width && src_size.height == 2 * dst_size.height;
   const uint32_t mode = binomial ? 3u : same ? 0u : exact_half ? 1u : 2u;
   Step s;
-  StreamShape stream;
+  detail::Workgroup2D stream;
   if (mode <= 1 && kernel != SeparableKernel::tiles && stream_shape(info, radius, half_shared, stream) &&
-      (kernel == SeparableKernel::stream || stream_fills_device(info, dst_size, 4 * stream.workgroup.x))) {
+      (kernel == SeparableKernel::stream || stream_fills_device(info, dst_size, 4 * stream.x))) {
     // Two steps' rows in flight for a same-size read; one for the 2:1 mean, whose four fetches a
     // texel fill the registers (H100, 3-level BlurPyramid at 3840x2160: 94.0 us with one, 96.8 with
     // two, 124.7 with the tiles).
     const uint32_t ahead = mode == 0 ? 2u : 1u;
-    s.pipeline =
-        &prog.pipeline("blur_stream", dst_format, stream.workgroup, {radius, half_shared ? 1u : 0u, mode, ahead},
-                       {VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
+    s.pipeline = &prog.pipeline("blur_stream", dst_format, stream, {radius, half_shared ? 1u : 0u, mode, ahead},
+                                {VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
     s.src = src;
     s.dst = dst;
     s.push = make_push(src_size, dst_size, flags, max_value);
     for (uint32_t t = 0; t <= radius; ++t) s.push.weights[t] = static_cast<float>(w[t]);
-    const uint32_t strip = 4 * stream.workgroup.x;
+    const uint32_t strip = 4 * stream.x;
     const uint32_t band = stream_band_rows(dst_size.width, dst_size.height, strip);
     s.push.band_rows = static_cast<int32_t>(band);
     s.invocations_x = (dst_size.width + 3) / 4;  // RUN columns per invocation
-    s.invocations_y = (dst_size.height + band - 1) / band * stream.workgroup.y;
+    s.invocations_y = (dst_size.height + band - 1) / band * stream.y;
     s.streamed = true;
     s.label = std::move(label);
     return s;

@@ -119,14 +119,9 @@ VkExtent2D half_extent(VkExtent2D e);
 /// the tiled kernel (tests and benchmarks, through detail::BlurAccess).
 enum class SeparableKernel : uint32_t { device, stream, tiles };
 
-// The streamed kernel's strip: workgroup (STRIP_W / 4, STEP rows) of blur_stream.comp.
-struct StreamShape {
-  detail::Workgroup2D workgroup{16, 8};
-};
-
-/// The widest strip of the streamed kernel whose shared memory and invocations fit the device, or
-/// none (false) where no strip fits.
-bool stream_shape(const DeviceInfo& info, uint32_t radius, bool half_shared, StreamShape& shape);
+/// The streamed kernel's workgroup (STRIP_W / 4 invocations across, STEP rows) of the widest strip
+/// whose shared memory and invocations fit the device, or none (false) where no strip fits.
+bool stream_shape(const DeviceInfo& info, uint32_t radius, bool half_shared, detail::Workgroup2D& workgroup);
 
 /// Rows each workgroup of the streamed kernel writes for an image `width` x `height` with strips
 /// of `strip_width` columns: bands of at least kStreamMinBand rows (at most 2 RADIUS / band of the
