@@ -48,18 +48,19 @@ Work separable_work(uint32_t radius, uint32_t width, uint32_t height, bool linea
 Work pyramid_work(uint32_t levels, uint32_t level_radius, uint32_t width, uint32_t height, const Padding& padding,
                   bool fp32_shared) {
   Work w;
-  w.dispatches = levels + 1.0 + (pyramid_splits_last(levels) ? 1.0 : 0.0);
+  w.dispatches = levels + 2.0;  // k downsamples, the last level's blur, the upsample
   w.bytes = kBytesPerTexel * (texels(padding.padded_width, padding.padded_height) + texels(width, height));
   w.fetch_taps = 16.0 * texels(width, height);
-  if (pyramid_splits_last(levels))  // the downsampled level written and read once more
-    w.bytes += 2.0 * kBytesPerTexel * texels(half_size(padding.padded_width), half_size(padding.padded_height));
   uint32_t lw = padding.padded_width, lh = padding.padded_height;
   for (uint32_t j = 1; j <= levels; ++j) {
     lw = half_size(lw);
     lh = half_size(lh);
     w.bytes += 2.0 * kBytesPerTexel * texels(lw, lh);  // written once, read once
     w.fetch_taps += 16.0 * texels(lw, lh);
-    if (j == levels) w.shared_taps += texels(lw, lh) * 2.0 * (2.0 * level_radius + 1.0) * (fp32_shared ? 2.0 : 1.0);
+    if (j == levels) {  // its blur at the same size: written once, read once
+      w.bytes += 2.0 * kBytesPerTexel * texels(lw, lh);
+      w.shared_taps += texels(lw, lh) * 2.0 * (2.0 * level_radius + 1.0) * (fp32_shared ? 2.0 : 1.0);
+    }
   }
   return w;
 }

@@ -450,9 +450,11 @@ double rounding_bound(const Plan& plan, const Storage& st) {
       u = st.level_unit + st.output_unit + 2.0 * 2.0 * std::ldexp(1.0, -int(st.sub_texel_bits)) +
           arith * 2.0 * (plan.radius + 2.0);
       break;
-    case Method::pyramid:  // k levels, the fused kernel's copies at the last, the B-spline output
-      u = (plan.levels + (pyramid_splits_last(plan.levels) ? 1.0 : 0.0)) * st.level_unit +
-          (st.level_half && !plan.fp32_shared ? 2.0 * half : 0.0) + st.output_unit +
+    case Method::pyramid:
+      // k levels, the last one's blur (a store of its own), one shared copy of that blur, the
+      // B-spline output. The blur reads the stored level, which its first shared copy (fp16 where
+      // the levels are) holds exactly; only its second copy, the horizontal pass's sums, rounds.
+      u = (plan.levels + 1.0) * st.level_unit + (st.level_half && !plan.fp32_shared ? half : 0.0) + st.output_unit +
           arith * (16.0 * plan.levels + line_taps + 16.0);
       break;
     case Method::dual:  // k down, k - 1 up into levels, the last up into the output

@@ -84,7 +84,7 @@ Plan plan_pyramid(double sigma_px, uint32_t width, uint32_t height, double max_r
     p.expected_relative_l2 = error;
     if (storage) {
       p.expected_relative_l2 += rounding_bound(p, *storage);
-      // fp16 levels: where the last level's two fp16 shared copies would break the bound, keep them
+      // fp16 levels: where the last level's fp16 shared copies would break the bound, keep them
       // in fp32 (the level is at most a quarter of the input's texels; its shared bytes double).
       if (storage->level_half && p.expected_relative_l2 > max_relative_l2) {
         p.fp32_shared = true;

@@ -89,8 +89,8 @@ struct Plan {
   uint32_t levels = 0;     //!< pyramid / dual: k
   double level_sigma = 0;  //!< pyramid: sigma_k in texels of level k (taps at kGaussTruncation)
   double dual_offset = 1;  //!< dual: o
-  /// pyramid: the last level's fused blur keeps its shared copies in fp32 although the levels are
-  /// RGBA16F (two fp16 roundings fewer; twice the shared bytes): chosen only when the fp16 copies
+  /// pyramid: the last level's blur keeps its shared copies in fp32 although the levels are
+  /// RGBA16F (one fp16 rounding fewer; twice the shared bytes): chosen only when the fp16 copies
   /// would miss the bound and these meet it.
   bool fp32_shared = false;
   double effective_sigma_px = 0;    //!< sigma of the method's impulse response (input pixels)
@@ -99,12 +99,6 @@ struct Plan {
   Work work;                        //!< what the plan's dispatches do
   double cost = 0;                  //!< estimated microseconds (CostModel::estimate_us(work))
 };
-
-/// Whether a pyramid of `levels` levels stores its last level twice: at one level the downsample
-/// of the input and the level blur run as two dispatches (the downsample alone through shared
-/// memory, then the same-size fused blur), which on the H100 beat the fused blur that downsamples
-/// the full-resolution input in its load; the intermediate is one more store (docs/BLUR.md).
-inline bool pyramid_splits_last(uint32_t levels) { return levels == 1; }
 
 /// The border padding of a pyramid (levels, radius) or dual (levels, dual_offset) plan on an input
 /// of width x height (zero pads, the input size, for separable). See Padding.

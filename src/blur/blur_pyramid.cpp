@@ -62,7 +62,7 @@ struct BlurPyramid::Impl {
     prev = size;
     for (int k = 0; k < 3; ++k) {
       prog.steps.push_back(fused_step(prog, info, k == 0 ? kInput : k - 1, k, prev, sizes[k], level_format(),
-                                      config.sigma_texels[k], blur_plan::kPyramidTruncation, false,
+                                      config.sigma_texels[k], blur_plan::kPyramidTruncation,
                                       k == 0 ? GLINT_BLUR_FLAG_SANITIZE : 0u, max_value,
                                       concat("blur pyramid level ", k + 1), false, separable_kernel));
       prev = sizes[k];

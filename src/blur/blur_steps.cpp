@@ -216,9 +216,8 @@ BlurPush make_push(VkExtent2D src, VkExtent2D dst, uint32_t flags, float max_val
 VkExtent2D half_extent(VkExtent2D e) { return {blur_plan::half_size(e.width), blur_plan::half_size(e.height)}; }
 
 // A fused level-blur step B(src -> dst, sigma) (docs/BLUR.md); sigma 0 is the area downsample alone.
-// `binomial` picks the pyramid method's downsample over the area average (docs/BLUR.md).
 Step fused_step(StepProgram& prog, const DeviceInfo& info, int src, int dst, VkExtent2D src_size, VkExtent2D dst_size,
-                VkFormat dst_format, double sigma, double truncation, bool binomial, uint32_t flags, float max_value,
+                VkFormat dst_format, double sigma, double truncation, uint32_t flags, float max_value,
                 std::string label, bool fp32_shared, SeparableKernel kernel) {
   const std::vector<double> w = blur_plan::gaussian_half_taps(sigma, truncation);
   const uint32_t radius = static_cast<uint32_t>(w.size()) - 1;
@@ -232,7 +231,7 @@ Step fused_step(StepProgram& prog, const DeviceInfo& info, int src, int dst, VkE
   // The source read, fixed per pipeline so each variant compiles only its own path.
   const bool same = src_size.width == dst_size.width && src_size.height == dst_size.height;
   const bool exact_half = src_size.width == 2 * dst_size.width && src_size.height == 2 * dst_size.height;
-  const uint32_t mode = binomial ? 3u : same ? 0u : exact_half ? 1u : 2u;
+  const uint32_t mode = same ? 0u : exact_half ? 1u : 2u;
   Step s;
   detail::Workgroup2D stream;
   if (mode <= 1 && kernel != SeparableKernel::tiles && stream_shape(info, radius, half_shared, stream) &&

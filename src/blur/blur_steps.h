@@ -139,11 +139,11 @@ bool stream_fills_device(const DeviceInfo& info, VkExtent2D size, uint32_t strip
 inline constexpr uint32_t kStreamMinGroups = 64;
 
 // A fused level-blur step B(src -> dst, sigma) (docs/BLUR.md); sigma 0 is the area downsample alone.
-// `binomial` picks the pyramid method's downsample over the area average (docs/BLUR.md). The
-// shared copies are fp16 where dst_format is RGBA16F, unless `fp32_shared`. A step that reads its
+// The source is read at the same size, as the exact 2:1 mean or as the area average of any
+// ratio. The shared copies are fp16 where dst_format is RGBA16F, unless `fp32_shared`. A step that reads its
 // source at the same size or as the exact 2:1 mean runs on the kernel `kernel` picks.
 Step fused_step(StepProgram& prog, const DeviceInfo& info, int src, int dst, VkExtent2D src_size, VkExtent2D dst_size,
-                VkFormat dst_format, double sigma, double truncation, bool binomial, uint32_t flags, float max_value,
+                VkFormat dst_format, double sigma, double truncation, uint32_t flags, float max_value,
                 std::string label, bool fp32_shared = false, SeparableKernel kernel = SeparableKernel::device);
 
 // The pyramid's B-spline upsample (src/blur/shaders/blur_upsample.comp) from `src` to `dst`: its

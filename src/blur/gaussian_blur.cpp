@@ -258,8 +258,8 @@ struct GaussianBlur::Impl {
       // (GaussianBlurConfig::linear_sampling, docs/BLUR.md "Notation").
     } else if (choice.method == BlurMethod::separable && choice.radius <= kFusedMaxRadius) {
       prog.steps.push_back(fused_step(prog, info, kInput, kOutput, size, size, out_format, config.sigma_px,
-                                      blur_plan::kGaussTruncation, false, sanitize, max_value,
-                                      "gauss separable (fused)", false, separable_kernel));
+                                      blur_plan::kGaussTruncation, sanitize, max_value, "gauss separable (fused)",
+                                      false, separable_kernel));
     } else if (choice.method == BlurMethod::separable) {
       const std::vector<double> w = blur_plan::gaussian_half_taps(config.sigma_px, blur_plan::kGaussTruncation);
       const detail::OwnedBuffer* buf = prog.add_taps(std::vector<float>(w.begin(), w.end()));
@@ -288,29 +288,22 @@ struct GaussianBlur::Impl {
       for (uint32_t j = 1; j <= choice.levels; ++j) {
         const VkExtent2D e = half_extent(prev);
         const int dst = add(e);
-        const bool last = j == choice.levels;
         const uint32_t flags = src == kInput ? sanitize : 0u;
-        // The last level fuses D with its blur, unless the plan splits it (blur_plan::
-        // pyramid_splits_last: D from the full-resolution input, then the level's blur); the
-        // others are D alone (src/blur/shaders/blur_down.comp).
-        const bool split = last && blur_plan::pyramid_splits_last(choice.levels);
-        const std::string label = concat("gauss pyramid level ", j, last && !split ? " (blur)" : " (down)");
-        Step s = last && !split
-                     ? fused_step(prog, info, src, dst, prev, e, lf, choice.level_sigma, blur_plan::kGaussTruncation,
-                                  true, flags, max_value, label, plan_made.fp32_shared)
-                     : down_step(prog, info, src, dst, prev, e, lf, flags, max_value, label);
+        // Every level is D alone (src/blur/shaders/blur_down.comp); the last one is then blurred at
+        // its own size. Storing it first beat the fused blur that downsampled its source in its
+        // load (16 fetches a loaded texel) at every level count on the H100 (docs/BLUR.md).
+        Step s = down_step(prog, info, src, dst, prev, e, lf, flags, max_value,
+                           concat("gauss pyramid level ", j, " (down)"));
         if (src == kInput) read_padded_input(s, size, pad);
         prog.steps.push_back(std::move(s));
         src = dst;
         prev = e;
-        if (split) {
-          const int blurred = add(e);
-          prog.steps.push_back(fused_step(
-              prog, info, src, blurred, e, e, lf, choice.level_sigma, blur_plan::kGaussTruncation, false, 0u, max_value,
-              concat("gauss pyramid level ", j, " (blur)"), plan_made.fp32_shared, separable_kernel));
-          src = blurred;
-        }
       }
+      const int blurred = add(prev);
+      prog.steps.push_back(fused_step(
+          prog, info, src, blurred, prev, prev, lf, choice.level_sigma, blur_plan::kGaussTruncation, 0u, max_value,
+          concat("gauss pyramid level ", choice.levels, " (blur)"), plan_made.fp32_shared, separable_kernel));
+      src = blurred;
       Step up = upsample_step(prog, info, src, kOutput, prev, padded, out_format, max_value, "gauss pyramid upsample");
       write_padded_output(up, size, pad);
       prog.steps.push_back(std::move(up));

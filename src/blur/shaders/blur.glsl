@@ -63,18 +63,6 @@ vec2 source_position(ivec2 xy) {
   return (vec2(xy + ivec2(p.dst_origin_x, p.dst_origin_y)) + 0.5) * ratio - 0.5 - vec2(p.src_origin_x, p.src_origin_y);
 }
 
-// Binomial downsample (docs/BLUR.md, "pyramid"): [1 3 3 1] / 8 per axis on an exact 2:1
-// reduction, as the mean of four bilinear reads at the mapped position +-0.375 * ratio; the
-// identity along an axis whose ratio is 1. Its stopband is far better than the 2x2 box's, which
-// lets too much above the level's Nyquist frequency alias into the blur.
-vec4 binomial_sample(ivec2 xy) {
-  vec2 ratio = vec2(p.ratio_x, p.ratio_y);
-  vec2 c = source_position(xy);
-  vec2 o = mix(0.375 * ratio, vec2(0.0), equal(ratio, vec2(1.0)));
-  return 0.25 * (src_bilinear(c + vec2(-o.x, -o.y)) + src_bilinear(c + vec2(o.x, -o.y)) +
-                 src_bilinear(c + vec2(-o.x, o.y)) + src_bilinear(c + vec2(o.x, o.y)));
-}
-
 // Uniform cubic B-spline weights for the four texels around a position with fraction t.
 vec4 bspline_weights(float t) {
   float s = 1.0 - t;

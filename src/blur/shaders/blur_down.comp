@@ -5,16 +5,17 @@
 // The pyramid method's binomial downsample D (docs/BLUR.md, "pyramid") on an exact 2:1 step of
 // the padded chain: [1 3 3 1] / 8 along each axis, destination texel x reading source texels
 // 2x - 1 .. 2x + 2 (relative to the chain's origins). Equal in exact arithmetic to the mean of the
-// four bilinear reads at map(x) +- 0.375 r that blur.glsl's binomial_sample() takes, whose
-// fractions are 1/4 and 3/4 on this step.
-// binomial_sample() fetches 16 texels per output, and neighbouring outputs share half of them on
+// four bilinear reads at map(x) +- 0.375 r, whose fractions are 1/4 and 3/4 on this step.
+// Those four reads fetch 16 texels per output, and neighbouring outputs share half of them on
 // each axis: every source texel is fetched (and sanitized) four times. Here a workgroup loads its
-// tile's source block once into shared memory, sums it along x into shared rows, then along y:
-// The last level of a pyramid (D fused with the level blur) stays in blur_level.comp. H100,
-// 3840x2160, whole blur (glint_bench medians, same machine): sigma 16 283 -> 271 us and sigma 64
-// 321 -> 312 us against the 16-fetch form at the first level (with every fetch in flight, 128
-// registers), which the levels after it had also beaten (a single frame's stage times had shown
-// the first level the other way round, 93 against 147 us: not what the whole blur does).
+// tile's source block once into shared memory, sums it along x into shared rows, then along y.
+// Every level of a pyramid is made here, the last one too, which the level blur then reads at the
+// same size (docs/BLUR.md). H100, 3840x2160, whole blur (glint_bench medians, same machine):
+// sigma 16 283 -> 271 us and sigma 64 321 -> 312 us against the 16-fetch form at the first level
+// (with every fetch in flight, 128 registers), which the levels after it had also beaten (a single
+// frame's stage times had shown the first level the other way round, 93 against 147 us: not what
+// the whole blur does); the last level read by the level blur in its load instead of stored here
+// first: sigma 8 251 -> 299 us, sigma 16 251 -> 272 us.
 layout(local_size_x_id = 0, local_size_y_id = 1) in;
 layout(constant_id = 2) const int ROWS = 1;  // output rows per invocation: tile = (WG.x, WG.y * ROWS)
 // Every fetch of the load step issued before the first shared store (GPUs: their latencies

@@ -16,12 +16,12 @@ layout(local_size_x_id = 0, local_size_y_id = 1) in;
 layout(constant_id = 2) const int ROWS = 1;         // output rows per invocation: tile = (WG.x, WG.y * ROWS)
 layout(constant_id = 3) const int RADIUS = 4;       // taps 2 * RADIUS + 1 (0: downsample only)
 layout(constant_id = 4) const int MODE = 0;         // source read: 0 same size, 1 exact 2:1 area,
-                                                    // 2 any-ratio area, 3 binomial (docs/BLUR.md)
+                                                    // 2 any-ratio area (docs/BLUR.md)
 layout(constant_id = 5) const bool HALF_SHARED = false;
 // Issue every source fetch of the load step before the first shared store (GPUs: the latencies
 // overlap), or load in a plain loop (CPU devices: invocations run in order as SIMD lanes, so there
 // is no latency to hide, and unrolling LOADS calls of load_source() - up to 16 texel fetches each
-// for MODE 3 - multiplies the code the device's JIT compiles, by minutes per variant on lavapipe).
+// for MODE 2 - multiplies the code the device's JIT compiles, by minutes per variant on lavapipe).
 // Both store the same values.
 layout(constant_id = 6) const bool PREFETCH = true;
 
@@ -42,9 +42,8 @@ const int LOADS = (LOAD_W * LOAD_H + GROUP_SIZE - 1) / GROUP_SIZE;  // source te
 // Loads issued together by the prefetching load step: all of them where a load is one fetch (MODE
 // 0) or 4 (exact 2:1 area: 139 registers on the H100, but batches of two loads took the 3-level
 // BlurPyramid from 124.8 to 144.5 us at 59 registers); one at a time where a load is up to 16
-// (binomial, any-ratio area), which otherwise kept all their texels in registers (255 on the
-// H100; the binomial level blur from a full-resolution input, before the pyramid's one-level
-// split, 253 -> 223 us at 94 in a single frame).
+// (any-ratio area), which otherwise kept all their texels in registers (255 on the H100, for the
+// binomial downsample this kernel once read in its load: 253 -> 223 us at 94 in a single frame).
 const int BATCH = MODE <= 1 ? LOADS : 1;
 const int BATCHES = (LOADS + BATCH - 1) / BATCH;
 const int RUN = 4;                        // horizontal outputs per invocation (TILE_W is a multiple)
@@ -86,8 +85,7 @@ vec4 load_source(ivec2 q) {
     ivec2 s = 2 * q;
     return 0.25 * (src_texel(s) + src_texel(s + ivec2(1, 0)) + src_texel(s + ivec2(0, 1)) + src_texel(s + ivec2(1, 1)));
   }
-  if (MODE == 2) return area_sample(q);
-  return binomial_sample(q);
+  return area_sample(q);
 }
 
 void main() {
