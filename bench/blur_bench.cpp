@@ -14,6 +14,7 @@
 #include <glint/blur.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -104,6 +105,22 @@ std::vector<double> time_frames(benchmark::State& state, Record record) {
   return frame_ms;
 }
 
+// The counter of a stage mark: "us_" and the step's label, "gauss " dropped, every run of other
+// characters than letters and digits one '_' ("gauss pyramid level 1 (down)" ->
+// "us_pyramid_level_1_down").
+std::string stage_key(const std::string& label) {
+  const std::string name = label.rfind("gauss ", 0) == 0 ? label.substr(6) : label;
+  std::string key = "us_";
+  for (char ch : name) {
+    if (std::isalnum(static_cast<unsigned char>(ch)))
+      key += ch;
+    else if (key.back() != '_')
+      key += '_';
+  }
+  while (key.back() == '_') key.pop_back();
+  return key;
+}
+
 void run_gauss_benchmark(benchmark::State& state, BlurMethod method, bool linear) {
   const double sigma = state.range(0) / 10.0;
   const auto width = static_cast<uint32_t>(state.range(1));
@@ -121,6 +138,15 @@ void run_gauss_benchmark(benchmark::State& state, BlurMethod method, bool linear
   blur.prepare({width, height});
   const std::vector<double> frame_ms =
       time_frames(state, [&](VkCommandBuffer cmd) { blur.record(cmd, in.state, dst.state); });
+  // Stage breakdown of one more frame (a timestamp after each dispatch, which serialises them, so
+  // the stages add up to more than the frame), for docs/PERF.md: one counter per step.
+  Profiler stages(ctx, 16);
+  ctx.run_once([&](VkCommandBuffer cmd) {
+    stages.reset(cmd);
+    stages.mark(cmd, "start");
+    blur.record(cmd, in.state, dst.state, &stages);
+  });
+  for (const auto& st : stages.results()) state.counters[stage_key(st.label)] += st.ms * 1e3;
 
   // Accuracy of the method the timed run chose (auto resolved), fp32 storage so that the method's
   // own error shows.
