@@ -121,6 +121,20 @@ std::string stage_key(const std::string& label) {
   return key;
 }
 
+// Stage breakdown of one more frame (a timestamp after each dispatch, which serialises them, so
+// the stages add up to more than the frame), for docs/PERF.md: one counter per step.
+template <typename Record>
+void add_stage_counters(benchmark::State& state, Record record) {
+  const Context& ctx = context();
+  Profiler stages(ctx, 16);
+  ctx.run_once([&](VkCommandBuffer cmd) {
+    stages.reset(cmd);
+    stages.mark(cmd, "start");
+    record(cmd, &stages);
+  });
+  for (const auto& st : stages.results()) state.counters[stage_key(st.label)] += st.ms * 1e3;
+}
+
 void run_gauss_benchmark(benchmark::State& state, BlurMethod method, bool linear) {
   const double sigma = state.range(0) / 10.0;
   const auto width = static_cast<uint32_t>(state.range(1));
@@ -138,15 +152,7 @@ void run_gauss_benchmark(benchmark::State& state, BlurMethod method, bool linear
   blur.prepare({width, height});
   const std::vector<double> frame_ms =
       time_frames(state, [&](VkCommandBuffer cmd) { blur.record(cmd, in.state, dst.state); });
-  // Stage breakdown of one more frame (a timestamp after each dispatch, which serialises them, so
-  // the stages add up to more than the frame), for docs/PERF.md: one counter per step.
-  Profiler stages(ctx, 16);
-  ctx.run_once([&](VkCommandBuffer cmd) {
-    stages.reset(cmd);
-    stages.mark(cmd, "start");
-    blur.record(cmd, in.state, dst.state, &stages);
-  });
-  for (const auto& st : stages.results()) state.counters[stage_key(st.label)] += st.ms * 1e3;
+  add_stage_counters(state, [&](VkCommandBuffer cmd, Profiler* p) { blur.record(cmd, in.state, dst.state, p); });
 
   // Accuracy of the method the timed run chose (auto resolved), fp32 storage so that the method's
   // own error shows.
@@ -207,12 +213,13 @@ BENCHMARK(BM_BlurAuto)->Apply(all_sigmas);
 
 // The two kernels of a level-blur step (docs/BLUR.md "Streamed separable"), forced through
 // detail::BlurAccess: the tiled one (kernel 1) and the streamed one (kernel 2, wherever a strip
-// fits). Method 1: GaussianBlur separable (sigma 1.2, radius 5; sigma 3, radius 12, the largest);
-// method 2: GaussianBlur pyramid, one level (sigma 4: its level blur reads at the same size);
-// method 3: BlurPyramid, every level sigma_texels = sigma (1.2: the default), whose levels read the
-// exact 2:1 mean where the sizes halve exactly. RGBA16F. 3840x2160 and 1920x1080 for GPUs, 960x540
-// for CPU devices. Args: kernel, method, sigma x 10, width, height. Counters: median_us, streamed
-// (the steps that ran the streamed kernel), taps (GaussianBlur).
+// fits); a GaussianBlur pyramid's downsamples take the same choice (blur_down.comp or
+// blur_down_stream.comp), and its rows report each step's time (us_<step> counters). Method 1: GaussianBlur separable
+// (sigma 1.2, radius 5; sigma 3, radius 12, the largest); method 2: GaussianBlur pyramid, one level (sigma 4: its level
+// blur reads at the same size); method 3: BlurPyramid, every level sigma_texels = sigma (1.2: the default), whose
+// levels read the exact 2:1 mean where the sizes halve exactly. RGBA16F. 3840x2160 and 1920x1080 for GPUs, 960x540 for
+// CPU devices. Args: kernel, method, sigma x 10, width, height. Counters: median_us, streamed (the steps that ran the
+// streamed kernel), taps (GaussianBlur).
 void BM_BlurLevelKernel(benchmark::State& state) {
   const auto kernel = state.range(0) == 1 ? blur_steps::SeparableKernel::tiles : blur_steps::SeparableKernel::stream;
   const auto sigma = static_cast<float>(state.range(2) / 10.0);
@@ -240,6 +247,7 @@ void BM_BlurLevelKernel(benchmark::State& state) {
     detail::BlurAccess::select_separable(blur, kernel);
     blur.prepare({width, height});
     frame_ms = time_frames(state, [&](VkCommandBuffer cmd) { blur.record(cmd, in.state, dst.state); });
+    add_stage_counters(state, [&](VkCommandBuffer cmd, Profiler* p) { blur.record(cmd, in.state, dst.state, p); });
     streamed = detail::BlurAccess::streamed(blur);
     state.counters["taps"] = 2.0 * blur.choice().radius + 1.0;
     label = blur_method_name(blur.choice().method);

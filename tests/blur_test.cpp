@@ -318,7 +318,9 @@ TEST_F(BlurTest, EveryMethodSanitizesNanAndInfinity) {
 // Both kernels of a same-size separable step, each selected on every device (the streamed one is
 // the default; docs/BLUR.md "Streamed separable"), against the float64 reference: radius 2 (a step
 // of 8 rows longer than the 2 RADIUS lag), 5 and 12 (the largest), the pyramid's same-size level
-// blur (radius 8), fp32 and fp16. The sizes cross the streamed kernel's strips of 64 (or fewer)
+// blur (radius 8), fp32 and fp16; with them the pyramid's downsamples on either of their kernels
+// (blur_down.comp tiles, blur_down_stream.comp walks bands of kDownBandRows rows), one level at
+// sigma 4 and several at sigma 16. The sizes cross the streamed kernel's strips of 64 (or fewer)
 // columns and bands of 32 rows by one texel or part of one, and hold rows and columns shorter than
 // its apron; NaN (and in fp16 Inf) texels check that its loads sanitize.
 TEST_F(BlurTest, StreamedAndTiledSeparableKernelsMatchTheReference) {
@@ -326,7 +328,8 @@ TEST_F(BlurTest, StreamedAndTiledSeparableKernelsMatchTheReference) {
   const MethodCase cases[] = {{BlurMethod::separable, false, 0.5f},
                               {BlurMethod::separable, false, 1.2f},
                               {BlurMethod::separable, false, 3.0f},
-                              {BlurMethod::pyramid, false, 4.0f}};  // one level: its blur is same-size
+                              {BlurMethod::pyramid, false, 4.0f},    // one level: its blur is same-size
+                              {BlurMethod::pyramid, false, 16.0f}};  // levels downsampled on either kernel
   using blur_steps::SeparableKernel;
   for (SeparableKernel kernel : {SeparableKernel::stream, SeparableKernel::tiles}) {
     for (const MethodCase& c : cases) {
@@ -347,8 +350,16 @@ TEST_F(BlurTest, StreamedAndTiledSeparableKernelsMatchTheReference) {
           const CpuImage out = run_gauss(blur, stored, format);
           // A radius-12 strip in fp32 needs 19.2 KiB of shared memory, the largest of these; every
           // device has 16 KiB at least, so only there may the streamed kernel fall back.
-          if (kernel == SeparableKernel::tiles || c.sigma < 3.0f || precision == Precision::fp16) {
-            EXPECT_EQ(detail::BlurAccess::streamed(blur), kernel == SeparableKernel::stream ? 1u : 0u);
+          // The level blur and a pyramid's downsamples; the downsample kernel uses no shared
+          // memory, so every device runs it where it is selected.
+          const uint32_t downs = c.method == BlurMethod::pyramid ? blur.choice().levels : 0u;
+          const uint32_t streamed = detail::BlurAccess::streamed(blur);
+          if (kernel == SeparableKernel::tiles) {
+            EXPECT_EQ(streamed, 0u);
+          } else if (c.sigma < 3.0f || precision == Precision::fp16) {
+            EXPECT_EQ(streamed, 1u + downs);
+          } else {
+            EXPECT_GE(streamed, downs);
           }
           ASSERT_TRUE(all_finite(out)) << "unwritten or non-finite texels";
           EXPECT_LT(reference::rgba_relative_l2(out, reference_of(blur, stored)),

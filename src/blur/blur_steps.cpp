@@ -315,10 +315,25 @@ Step upsample_step(StepProgram& prog, const DeviceInfo& info, int src, int dst, 
 }
 
 Step down_step(StepProgram& prog, const DeviceInfo& info, int src, int dst, VkExtent2D src_size, VkExtent2D dst_size,
-               VkFormat dst_format, uint32_t flags, float max_value, std::string label) {
+               VkFormat dst_format, uint32_t flags, float max_value, std::string label, SeparableKernel kernel) {
   if (src_size.width != 2 * dst_size.width || src_size.height != 2 * dst_size.height) {
     throw Error(ErrorCode::invalid_argument, concat("down_step: ", src_size.width, "x", src_size.height, " -> ",
                                                     dst_size.width, "x", dst_size.height, " is not an exact 2:1 step"));
+  }
+  if (kernel != SeparableKernel::tiles) {
+    // 64 columns by one band of rows a workgroup; no shared memory, so it fits every device.
+    Step s;
+    s.pipeline = &prog.pipeline("blur_down_stream", dst_format, {64, 1}, {},
+                                {VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
+    s.src = src;
+    s.dst = dst;
+    s.push = make_push(src_size, dst_size, flags, max_value);
+    s.push.band_rows = static_cast<int32_t>(kDownBandRows);
+    s.invocations_x = dst_size.width;
+    s.invocations_y = (dst_size.height + kDownBandRows - 1) / kDownBandRows;
+    s.streamed = true;
+    s.label = std::move(label);
+    return s;
   }
   // Output tiles of 32x8 on GPUs (a source block of 66x18), 16x8 on CPU devices. Shared memory:
   // the block (2 TW + 2) x (2 TH + 2) and its rows summed along x, (2 TH + 2) x TW, 16 bytes each.

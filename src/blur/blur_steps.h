@@ -150,10 +150,15 @@ Step fused_step(StepProgram& prog, const DeviceInfo& info, int src, int dst, VkE
 // tile shape from the device (the largest whose shared footprint and invocations fit).
 Step upsample_step(StepProgram& prog, const DeviceInfo& info, int src, int dst, VkExtent2D src_size,
                    VkExtent2D dst_size, VkFormat dst_format, float max_value, std::string label);
-// The pyramid's binomial downsample (src/blur/shaders/blur_down.comp) of an exact 2:1 step from
-// `src` to `dst`: its tile shape from the device, as upsample_step's.
+// The pyramid's binomial downsample of an exact 2:1 step from `src` to `dst`: the streamed kernel
+// (src/blur/shaders/blur_down_stream.comp: one destination column and kDownBandRows rows per
+// invocation, marked Step::streamed) unless `kernel` is tiles, which forces the tiled one
+// (src/blur/shaders/blur_down.comp, its tile shape from the device as upsample_step's) for the
+// tests and benchmarks that compare them.
 Step down_step(StepProgram& prog, const DeviceInfo& info, int src, int dst, VkExtent2D src_size, VkExtent2D dst_size,
-               VkFormat dst_format, uint32_t flags, float max_value, std::string label);
+               VkFormat dst_format, uint32_t flags, float max_value, std::string label,
+               SeparableKernel kernel = SeparableKernel::device);
+inline constexpr uint32_t kDownBandRows = 8;
 // A plain per-texel step (dual down/up) with 2D workgroups.
 Step simple_step(StepProgram& prog, const char* kernel, int src, int dst, VkExtent2D src_size, VkExtent2D dst_size,
                  VkFormat dst_format, uint32_t flags, float max_value, std::string label,

@@ -289,11 +289,11 @@ struct GaussianBlur::Impl {
         const VkExtent2D e = half_extent(prev);
         const int dst = add(e);
         const uint32_t flags = src == kInput ? sanitize : 0u;
-        // Every level is D alone (src/blur/shaders/blur_down.comp); the last one is then blurred at
-        // its own size. Storing it first beat the fused blur that downsampled its source in its
-        // load (16 fetches a loaded texel) at every level count on the H100 (docs/BLUR.md).
+        // Every level is D alone (blur_steps::down_step); the last one is then blurred at its own
+        // size. Storing it first beat the fused blur that downsampled its source in its load (16
+        // fetches a loaded texel) at every level count on the H100 (docs/BLUR.md).
         Step s = down_step(prog, info, src, dst, prev, e, lf, flags, max_value,
-                           concat("gauss pyramid level ", j, " (down)"));
+                           concat("gauss pyramid level ", j, " (down)"), separable_kernel);
         if (src == kInput) read_padded_input(s, size, pad);
         prog.steps.push_back(std::move(s));
         src = dst;
