@@ -9,13 +9,15 @@
 // Those four reads fetch 16 texels per output, and neighbouring outputs share half of them on
 // each axis: every source texel is fetched (and sanitized) four times. Here a workgroup loads its
 // tile's source block once into shared memory, sums it along x into shared rows, then along y.
-// Every level of a pyramid is made here, the last one too, which the level blur then reads at the
-// same size (docs/BLUR.md). H100, 3840x2160, whole blur (glint_bench medians, same machine):
+// The pyramid's levels are made by blur_down_stream.comp (the same sums in the same order, walking
+// bands of rows without shared memory: faster on the H100 and on lavapipe, docs/BLUR.md); this
+// tiled form runs where blur_steps::SeparableKernel::tiles is selected, for the tests and
+// benchmarks that compare the two. H100, 3840x2160, whole blur (glint_bench medians, same machine):
 // sigma 16 283 -> 271 us and sigma 64 321 -> 312 us against the 16-fetch form at the first level
 // (with every fetch in flight, 128 registers), which the levels after it had also beaten (a single
 // frame's stage times had shown the first level the other way round, 93 against 147 us: not what
-// the whole blur does); the last level read by the level blur in its load instead of stored here
-// first: sigma 8 251 -> 299 us, sigma 16 251 -> 272 us.
+// the whole blur does); the last level stored here before its blur, instead of downsampled in the
+// level blur's load: sigma 8 299 -> 251 us, sigma 16 272 -> 251 us.
 layout(local_size_x_id = 0, local_size_y_id = 1) in;
 layout(constant_id = 2) const int ROWS = 1;  // output rows per invocation: tile = (WG.x, WG.y * ROWS)
 // Every fetch of the load step issued before the first shared store (GPUs: their latencies
