@@ -214,12 +214,13 @@ BENCHMARK(BM_BlurAuto)->Apply(all_sigmas);
 // The two kernels of a level-blur step (docs/BLUR.md "Streamed separable"), forced through
 // detail::BlurAccess: the tiled one (kernel 1) and the streamed one (kernel 2, wherever a strip
 // fits); a GaussianBlur pyramid's downsamples take the same choice (blur_down.comp or
-// blur_down_stream.comp), and its rows report each step's time (us_<step> counters). Method 1: GaussianBlur separable
-// (sigma 1.2, radius 5; sigma 3, radius 12, the largest); method 2: GaussianBlur pyramid, one level (sigma 4: its level
-// blur reads at the same size); method 3: BlurPyramid, every level sigma_texels = sigma (1.2: the default), whose
-// levels read the exact 2:1 mean where the sizes halve exactly. RGBA16F. 3840x2160 and 1920x1080 for GPUs, 960x540 for
-// CPU devices. Args: kernel, method, sigma x 10, width, height. Counters: median_us, streamed (the steps that ran the
-// streamed kernel), taps (GaussianBlur).
+// blur_down_stream.comp), and its rows report each step's time (us_<step> counters). Method 1:
+// GaussianBlur separable (sigma 1.2, radius 5; sigma 3, radius 12, the largest); method 2:
+// GaussianBlur pyramid, one level (sigma 4: its level blur reads at the same size); method 3:
+// BlurPyramid, every level sigma_texels = sigma (1.2: the default), whose levels read the exact
+// 2:1 mean where the sizes halve exactly. RGBA16F. 3840x2160 and 1920x1080 for GPUs, 960x540 for
+// CPU devices. Args: kernel, method, sigma x 10, width, height. Counters: median_us, streamed (the
+// steps that ran a streamed kernel), taps (GaussianBlur).
 void BM_BlurLevelKernel(benchmark::State& state) {
   const auto kernel = state.range(0) == 1 ? blur_steps::SeparableKernel::tiles : blur_steps::SeparableKernel::stream;
   const auto sigma = static_cast<float>(state.range(2) / 10.0);

@@ -87,7 +87,7 @@ struct StepProgram {
   const detail::ComputePipeline& pipeline(const std::string& kernel, VkFormat dst_format, detail::Workgroup2D wg,
                                           std::vector<uint32_t> spec, std::vector<VkDescriptorType> bindings);
 
-  /// Steps that run the streamed kernel (blur_stream.comp).
+  /// Steps that run a streamed kernel (blur_stream.comp, blur_down_stream.comp).
   uint32_t streamed_steps() const;
 
   // Owned images can also be copied from (BlurPyramid hands its levels to the caller).
@@ -116,7 +116,8 @@ VkExtent2D half_extent(VkExtent2D e);
 /// `device`, the default: the streamed kernel where one of its strips fits the device's shared
 /// memory and, on GPUs, the image makes at least kStreamMinGroups workgroups
 /// (stream_fills_device()); else the tiles. `stream` drops the second condition and `tiles` forces
-/// the tiled kernel (tests and benchmarks, through detail::BlurAccess).
+/// the tiled kernel (tests and benchmarks, through detail::BlurAccess). The pyramid's downsamples
+/// (down_step) take the same choice: streamed unless `tiles`.
 enum class SeparableKernel : uint32_t { device, stream, tiles };
 
 /// The streamed kernel's workgroup (STRIP_W / 4 invocations across, STEP rows) of the widest strip
@@ -170,13 +171,14 @@ Step simple_step(StepProgram& prog, const char* kernel, int src, int dst, VkExte
 namespace glint::detail {
 
 /// Tests' and benchmarks' switch of the kernel the level-blur steps of GaussianBlur and
-/// BlurPyramid run on (blur_steps::SeparableKernel).
+/// BlurPyramid, and GaussianBlur's pyramid downsamples, run on (blur_steps::SeparableKernel).
 struct BlurAccess {
-  /// Selects the kernel of `blur`'s (`pyramid`'s) level-blur steps and plans the current size
-  /// again. Call it while no recorded frame of it is pending.
+  /// Selects the kernel of `blur`'s (`pyramid`'s) level-blur and downsample steps and plans the
+  /// current size again. Call it while no recorded frame of it is pending.
   static void select_separable(GaussianBlur& blur, blur_steps::SeparableKernel kernel);
   static void select_separable(BlurPyramid& pyramid, blur_steps::SeparableKernel kernel);
-  /// How many steps of the program of the last prepare() or record() run the streamed kernel.
+  /// How many steps of the program of the last prepare() or record() run a streamed kernel (the
+  /// level blur's or the downsample's).
   static uint32_t streamed(const GaussianBlur& blur);
   static uint32_t streamed(const BlurPyramid& pyramid);
 };
