@@ -318,11 +318,13 @@ TEST_F(BlurTest, EveryMethodSanitizesNanAndInfinity) {
 // Both kernels of a same-size separable step, each selected on every device (the streamed one is
 // the default; docs/BLUR.md "Streamed separable"), against the float64 reference: radius 2 (a step
 // of 8 rows longer than the 2 RADIUS lag), 5 and 12 (the largest), the pyramid's same-size level
-// blur (radius 8), fp32 and fp16; with them the pyramid's downsamples on either of their kernels
-// (blur_down.comp tiles, blur_down_stream.comp walks bands of kDownBandRows rows), one level at
-// sigma 4 and several at sigma 16. The sizes cross the streamed kernel's strips of 64 (or fewer)
-// columns and bands of 32 rows by one texel or part of one, and hold rows and columns shorter than
-// its apron; NaN (and in fp16 Inf) texels check that its loads sanitize.
+// blur (radius 8), fp32 and fp16; with them the pyramid's downsamples and upsample on either of
+// their kernels (blur_down.comp and blur_upsample.comp tile; blur_down_stream.comp walks bands of
+// kDownBandRows rows, blur_upsample_stream.comp bands of kUpBandRows rows, every other row an
+// invocation), one level at sigma 4 (2x) and several at sigma 16. The sizes cross the streamed
+// kernels' strips of 64 (or fewer) columns and bands of 32 and 64 rows by one texel or part of
+// one, and hold rows and columns shorter than its apron; NaN (and in fp16 Inf) texels check that
+// its loads sanitize.
 TEST_F(BlurTest, StreamedAndTiledSeparableKernelsMatchTheReference) {
   const std::pair<uint32_t, uint32_t> sizes[] = {{83, 57}, {129, 65}, {300, 97}, {1, 40}, {40, 1}, {5, 3}};
   const MethodCase cases[] = {{BlurMethod::separable, false, 0.5f},
@@ -350,16 +352,16 @@ TEST_F(BlurTest, StreamedAndTiledSeparableKernelsMatchTheReference) {
           const CpuImage out = run_gauss(blur, stored, format);
           // A radius-12 strip in fp32 needs 19.2 KiB of shared memory, the largest of these; every
           // device has 16 KiB at least, so only there may the streamed kernel fall back.
-          // The level blur and a pyramid's downsamples; the downsample kernel uses no shared
-          // memory, so every device runs it where it is selected.
-          const uint32_t downs = c.method == BlurMethod::pyramid ? blur.choice().levels : 0u;
+          // The level blur and a pyramid's downsamples and upsample; the downsample and upsample
+          // kernels use no shared memory, so every device runs them where they are selected.
+          const uint32_t pyramid_steps = c.method == BlurMethod::pyramid ? blur.choice().levels + 1u : 0u;
           const uint32_t streamed = detail::BlurAccess::streamed(blur);
           if (kernel == SeparableKernel::tiles) {
             EXPECT_EQ(streamed, 0u);
           } else if (c.sigma < 3.0f || precision == Precision::fp16) {
-            EXPECT_EQ(streamed, 1u + downs);
+            EXPECT_EQ(streamed, 1u + pyramid_steps);
           } else {
-            EXPECT_GE(streamed, downs);
+            EXPECT_GE(streamed, pyramid_steps);
           }
           ASSERT_TRUE(all_finite(out)) << "unwritten or non-finite texels";
           EXPECT_LT(reference::rgba_relative_l2(out, reference_of(blur, stored)),

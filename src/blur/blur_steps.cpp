@@ -294,11 +294,34 @@ Step tiled_step(StepProgram& prog, const char* kernel, FusedShape shape, int src
 }  // namespace
 
 Step upsample_step(StepProgram& prog, const DeviceInfo& info, int src, int dst, VkExtent2D src_size,
-                   VkExtent2D dst_size, VkFormat dst_format, float max_value, std::string label) {
-  // The kernel's shared footprint holds a tile's source texels at a magnification of 2 or more.
+                   VkExtent2D dst_size, VkFormat dst_format, float max_value, std::string label,
+                   SeparableKernel kernel) {
+  // Both kernels rely on a magnification of 2 or more: the tiled one's shared footprint holds a
+  // tile's source texels, and the streamed one's level rows move by at most one for each of its
+  // invocation's rows (kUpWorkgroup.y = 2 output rows apart).
   if (2 * src_size.width > dst_size.width || 2 * src_size.height > dst_size.height) {
     throw Error(ErrorCode::invalid_argument, concat("upsample_step: ", src_size.width, "x", src_size.height, " -> ",
                                                     dst_size.width, "x", dst_size.height, " magnifies less than 2x"));
+  }
+  if (kernel != SeparableKernel::tiles) {
+    // The kUpWorkgroup.y invocations of a column share a band of kUpBandRows rows, each taking every
+    // kUpWorkgroup.y-th row; no shared memory, so it fits every device. 16x2 and bands of 64 rows
+    // were the fastest of the shapes measured on the H100 (docs/BLUR.md "pyramid").
+    static_assert(kUpWorkgroup.y == 2, "level rows move by at most one a step at a magnification of 2");
+    static_assert(kUpBandRows % kUpWorkgroup.y == 0, "the band's rows divide among the workgroup's rows");
+    Step s;
+    s.pipeline = &prog.pipeline("blur_upsample_stream", dst_format, kUpWorkgroup, {},
+                                {VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
+    s.src = src;
+    s.dst = dst;
+    s.push = make_push(src_size, dst_size, 0u, max_value);
+    s.push.band_rows = static_cast<int32_t>(kUpBandRows);
+    s.rows = kUpBandRows / kUpWorkgroup.y;
+    s.invocations_x = dst_size.width;
+    s.invocations_y = (dst_size.height + s.rows - 1) / s.rows;
+    s.streamed = true;
+    s.label = std::move(label);
+    return s;
   }
   // Output tiles of 64x16 on GPUs (wide rows: coalesced writes, a footprint of 36x12 level
   // texels); CPU devices (lavapipe) get 16x8, as their other 2D kernels. Shared memory: the
@@ -329,6 +352,7 @@ Step down_step(StepProgram& prog, const DeviceInfo& info, int src, int dst, VkEx
     s.dst = dst;
     s.push = make_push(src_size, dst_size, flags, max_value);
     s.push.band_rows = static_cast<int32_t>(kDownBandRows);
+    s.rows = kDownBandRows;
     s.invocations_x = dst_size.width;
     s.invocations_y = (dst_size.height + kDownBandRows - 1) / kDownBandRows;
     s.streamed = true;

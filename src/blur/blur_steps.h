@@ -87,7 +87,7 @@ struct StepProgram {
   const detail::ComputePipeline& pipeline(const std::string& kernel, VkFormat dst_format, detail::Workgroup2D wg,
                                           std::vector<uint32_t> spec, std::vector<VkDescriptorType> bindings);
 
-  /// Steps that run a streamed kernel (blur_stream.comp, blur_down_stream.comp).
+  /// Steps that run a streamed kernel (blur_stream.comp, blur_down_stream.comp, blur_upsample_stream.comp).
   uint32_t streamed_steps() const;
 
   // Owned images can also be copied from (BlurPyramid hands its levels to the caller).
@@ -147,10 +147,17 @@ Step fused_step(StepProgram& prog, const DeviceInfo& info, int src, int dst, VkE
                 VkFormat dst_format, double sigma, double truncation, uint32_t flags, float max_value,
                 std::string label, bool fp32_shared = false, SeparableKernel kernel = SeparableKernel::device);
 
-// The pyramid's B-spline upsample (src/blur/shaders/blur_upsample.comp) from `src` to `dst`: its
-// tile shape from the device (the largest whose shared footprint and invocations fit).
+// The pyramid's B-spline upsample from `src` to `dst`, magnifying 2x or more on each axis: the
+// streamed kernel (src/blur/shaders/blur_upsample_stream.comp: workgroups of kUpWorkgroup, each
+// invocation one output column and every kUpWorkgroup.y-th row of a band of kUpBandRows rows,
+// marked Step::streamed) unless `kernel` is tiles, which forces the tiled one
+// (src/blur/shaders/blur_upsample.comp, its tile shape from the device: the largest whose shared
+// footprint and invocations fit) for the tests and benchmarks that compare them.
 Step upsample_step(StepProgram& prog, const DeviceInfo& info, int src, int dst, VkExtent2D src_size,
-                   VkExtent2D dst_size, VkFormat dst_format, float max_value, std::string label);
+                   VkExtent2D dst_size, VkFormat dst_format, float max_value, std::string label,
+                   SeparableKernel kernel = SeparableKernel::device);
+inline constexpr detail::Workgroup2D kUpWorkgroup{16, 2};
+inline constexpr uint32_t kUpBandRows = 64;
 // The pyramid's binomial downsample of an exact 2:1 step from `src` to `dst`: the streamed kernel
 // (src/blur/shaders/blur_down_stream.comp: one destination column and kDownBandRows rows per
 // invocation, marked Step::streamed) unless `kernel` is tiles, which forces the tiled one

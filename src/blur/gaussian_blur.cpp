@@ -304,7 +304,8 @@ struct GaussianBlur::Impl {
           prog, info, src, blurred, prev, prev, lf, choice.level_sigma, blur_plan::kGaussTruncation, 0u, max_value,
           concat("gauss pyramid level ", choice.levels, " (blur)"), plan_made.fp32_shared, separable_kernel));
       src = blurred;
-      Step up = upsample_step(prog, info, src, kOutput, prev, padded, out_format, max_value, "gauss pyramid upsample");
+      Step up = upsample_step(prog, info, src, kOutput, prev, padded, out_format, max_value, "gauss pyramid upsample",
+                              separable_kernel);
       write_padded_output(up, size, pad);
       prog.steps.push_back(std::move(up));
     } else {  // dual, on the padded extent as the pyramid
