@@ -215,6 +215,29 @@ BlurPush make_push(VkExtent2D src, VkExtent2D dst, uint32_t flags, float max_val
 
 VkExtent2D half_extent(VkExtent2D e) { return {blur_plan::half_size(e.width), blur_plan::half_size(e.height)}; }
 
+namespace {
+
+// A step of `pipeline` from `src` (src_size texels) to `dst` (dst_size): its push constants, and
+// one invocation per destination column and `rows` destination rows. `band_rows` > 0 marks a
+// streamed kernel's step, whose workgroups walk bands of that many rows (BlurPush::band_rows).
+Step make_step(const detail::ComputePipeline& pipeline, int src, int dst, VkExtent2D src_size, VkExtent2D dst_size,
+               uint32_t flags, float max_value, uint32_t rows, std::string label, uint32_t band_rows = 0) {
+  Step s;
+  s.pipeline = &pipeline;
+  s.src = src;
+  s.dst = dst;
+  s.push = make_push(src_size, dst_size, flags, max_value);
+  s.push.band_rows = static_cast<int32_t>(band_rows);
+  s.streamed = band_rows > 0;
+  s.rows = rows;
+  s.invocations_x = dst_size.width;
+  s.invocations_y = (dst_size.height + rows - 1) / rows;
+  s.label = std::move(label);
+  return s;
+}
+
+}  // namespace
+
 // A fused level-blur step B(src -> dst, sigma) (docs/BLUR.md); sigma 0 is the area downsample alone.
 Step fused_step(StepProgram& prog, const DeviceInfo& info, int src, int dst, VkExtent2D src_size, VkExtent2D dst_size,
                 VkFormat dst_format, double sigma, double truncation, uint32_t flags, float max_value,
@@ -232,7 +255,6 @@ Step fused_step(StepProgram& prog, const DeviceInfo& info, int src, int dst, VkE
   const bool same = src_size.width == dst_size.width && src_size.height == dst_size.height;
   const bool exact_half = src_size.width == 2 * dst_size.width && src_size.height == 2 * dst_size.height;
   const uint32_t mode = same ? 0u : exact_half ? 1u : 2u;
-  Step s;
   detail::Workgroup2D stream;
   if (mode <= 1 && kernel != SeparableKernel::tiles && stream_shape(info, radius, half_shared, stream) &&
       (kernel == SeparableKernel::stream || stream_fills_device(info, dst_size, 4 * stream.x))) {
@@ -240,34 +262,23 @@ Step fused_step(StepProgram& prog, const DeviceInfo& info, int src, int dst, VkE
     // texel fill the registers (H100, 3-level BlurPyramid at 3840x2160: 94.0 us with one, 96.8 with
     // two, 124.7 with the tiles).
     const uint32_t ahead = mode == 0 ? 2u : 1u;
-    s.pipeline = &prog.pipeline("blur_stream", dst_format, stream, {radius, half_shared ? 1u : 0u, mode, ahead},
-                                {VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
-    s.src = src;
-    s.dst = dst;
-    s.push = make_push(src_size, dst_size, flags, max_value);
+    const detail::ComputePipeline& pipeline =
+        prog.pipeline("blur_stream", dst_format, stream, {radius, half_shared ? 1u : 0u, mode, ahead},
+                      {VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
+    const uint32_t band = stream_band_rows(dst_size.width, dst_size.height, 4 * stream.x);
+    Step s = make_step(pipeline, src, dst, src_size, dst_size, flags, max_value, 1, std::move(label), band);
     for (uint32_t t = 0; t <= radius; ++t) s.push.weights[t] = static_cast<float>(w[t]);
-    const uint32_t strip = 4 * stream.x;
-    const uint32_t band = stream_band_rows(dst_size.width, dst_size.height, strip);
-    s.push.band_rows = static_cast<int32_t>(band);
-    s.invocations_x = (dst_size.width + 3) / 4;  // RUN columns per invocation
-    s.invocations_y = (dst_size.height + band - 1) / band * stream.y;
-    s.streamed = true;
-    s.label = std::move(label);
+    s.invocations_x = (dst_size.width + 3) / 4;                        // RUN columns per invocation
+    s.invocations_y = (dst_size.height + band - 1) / band * stream.y;  // a workgroup row of stream.y a band
     return s;
   }
   // Prefetching the load step (shaders/blur_level.comp, PREFETCH) pays on GPUs only.
   const uint32_t prefetch = info.type == VK_PHYSICAL_DEVICE_TYPE_CPU ? 0u : 1u;
-  s.pipeline = &prog.pipeline("blur_level", dst_format, shape.workgroup,
-                              {shape.rows, radius, mode, half_shared ? 1u : 0u, prefetch},
-                              {VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
-  s.src = src;
-  s.dst = dst;
-  s.push = make_push(src_size, dst_size, flags, max_value);
+  const detail::ComputePipeline& pipeline = prog.pipeline(
+      "blur_level", dst_format, shape.workgroup, {shape.rows, radius, mode, half_shared ? 1u : 0u, prefetch},
+      {VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
+  Step s = make_step(pipeline, src, dst, src_size, dst_size, flags, max_value, shape.rows, std::move(label));
   for (uint32_t t = 0; t <= radius; ++t) s.push.weights[t] = static_cast<float>(w[t]);
-  s.invocations_x = dst_size.width;
-  s.rows = shape.rows;
-  s.invocations_y = (dst_size.height + shape.rows - 1) / shape.rows;
-  s.label = std::move(label);
   return s;
 }
 
@@ -276,19 +287,12 @@ namespace {
 // A step of a tiled kernel that takes only the source and destination (and the rows constant).
 Step tiled_step(StepProgram& prog, const char* kernel, FusedShape shape, int src, int dst, VkExtent2D src_size,
                 VkExtent2D dst_size, VkFormat dst_format, uint32_t flags, float max_value, std::string label) {
-  Step s;
   // Constant 3: prefetch the load step on GPUs only (as fused_step's).
   const uint32_t prefetch = prog.context->info().type == VK_PHYSICAL_DEVICE_TYPE_CPU ? 0u : 1u;
-  s.pipeline = &prog.pipeline(kernel, dst_format, shape.workgroup, {shape.rows, prefetch},
-                              {VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
-  s.src = src;
-  s.dst = dst;
-  s.push = make_push(src_size, dst_size, flags, max_value);
-  s.rows = shape.rows;
-  s.invocations_x = dst_size.width;
-  s.invocations_y = (dst_size.height + shape.rows - 1) / shape.rows;
-  s.label = std::move(label);
-  return s;
+  const detail::ComputePipeline& pipeline =
+      prog.pipeline(kernel, dst_format, shape.workgroup, {shape.rows, prefetch},
+                    {VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
+  return make_step(pipeline, src, dst, src_size, dst_size, flags, max_value, shape.rows, std::move(label));
 }
 
 }  // namespace
@@ -309,19 +313,11 @@ Step upsample_step(StepProgram& prog, const DeviceInfo& info, int src, int dst, 
     // were the fastest of the shapes measured on the H100 (docs/BLUR.md "pyramid").
     static_assert(kUpWorkgroup.y == 2, "level rows move by at most one a step at a magnification of 2");
     static_assert(kUpBandRows % kUpWorkgroup.y == 0, "the band's rows divide among the workgroup's rows");
-    Step s;
-    s.pipeline = &prog.pipeline("blur_upsample_stream", dst_format, kUpWorkgroup, {},
-                                {VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
-    s.src = src;
-    s.dst = dst;
-    s.push = make_push(src_size, dst_size, 0u, max_value);
-    s.push.band_rows = static_cast<int32_t>(kUpBandRows);
-    s.rows = kUpBandRows / kUpWorkgroup.y;
-    s.invocations_x = dst_size.width;
-    s.invocations_y = (dst_size.height + s.rows - 1) / s.rows;
-    s.streamed = true;
-    s.label = std::move(label);
-    return s;
+    const detail::ComputePipeline& pipeline =
+        prog.pipeline("blur_upsample_stream", dst_format, kUpWorkgroup, {},
+                      {VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
+    return make_step(pipeline, src, dst, src_size, dst_size, 0u, max_value, kUpBandRows / kUpWorkgroup.y,
+                     std::move(label), kUpBandRows);
   }
   // Output tiles of 64x16 on GPUs (wide rows: coalesced writes, a footprint of 36x12 level
   // texels); CPU devices (lavapipe) get 16x8, as their other 2D kernels. Shared memory: the
@@ -345,19 +341,11 @@ Step down_step(StepProgram& prog, const DeviceInfo& info, int src, int dst, VkEx
   }
   if (kernel != SeparableKernel::tiles) {
     // 64 columns by one band of rows a workgroup; no shared memory, so it fits every device.
-    Step s;
-    s.pipeline = &prog.pipeline("blur_down_stream", dst_format, {64, 1}, {},
-                                {VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
-    s.src = src;
-    s.dst = dst;
-    s.push = make_push(src_size, dst_size, flags, max_value);
-    s.push.band_rows = static_cast<int32_t>(kDownBandRows);
-    s.rows = kDownBandRows;
-    s.invocations_x = dst_size.width;
-    s.invocations_y = (dst_size.height + kDownBandRows - 1) / kDownBandRows;
-    s.streamed = true;
-    s.label = std::move(label);
-    return s;
+    const detail::ComputePipeline& pipeline =
+        prog.pipeline("blur_down_stream", dst_format, {64, 1}, {},
+                      {VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
+    return make_step(pipeline, src, dst, src_size, dst_size, flags, max_value, kDownBandRows, std::move(label),
+                     kDownBandRows);
   }
   // Output tiles of 32x8 on GPUs (a source block of 66x18), 16x8 on CPU devices. Shared memory:
   // the block (2 TW + 2) x (2 TH + 2) and its rows summed along x, (2 TH + 2) x TW, 16 bytes each.
@@ -375,15 +363,9 @@ Step down_step(StepProgram& prog, const DeviceInfo& info, int src, int dst, VkEx
 Step simple_step(StepProgram& prog, const char* kernel, int src, int dst, VkExtent2D src_size, VkExtent2D dst_size,
                  VkFormat dst_format, uint32_t flags, float max_value, std::string label,
                  std::vector<VkDescriptorType> bindings) {
-  Step s;
-  s.pipeline = &prog.pipeline(kernel, dst_format, detail::choose_workgroup_2d(*prog.context), {}, std::move(bindings));
-  s.src = src;
-  s.dst = dst;
-  s.push = make_push(src_size, dst_size, flags, max_value);
-  s.invocations_x = dst_size.width;
-  s.invocations_y = dst_size.height;
-  s.label = std::move(label);
-  return s;
+  const detail::ComputePipeline& pipeline =
+      prog.pipeline(kernel, dst_format, detail::choose_workgroup_2d(*prog.context), {}, std::move(bindings));
+  return make_step(pipeline, src, dst, src_size, dst_size, flags, max_value, 1, std::move(label));
 }
 
 }  // namespace glint::blur_steps

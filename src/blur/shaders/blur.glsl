@@ -63,6 +63,28 @@ vec2 source_position(ivec2 xy) {
   return (vec2(xy + ivec2(p.dst_origin_x, p.dst_origin_y)) + 0.5) * ratio - 0.5 - vec2(p.src_origin_x, p.src_origin_y);
 }
 
+// The binomial downsample's [1 3 3 1] / 8 along one axis, of four consecutive texels (or of four
+// rows' sums): every downsample kernel forms it here, so the tiled and streamed ones sum the same
+// terms in the same order.
+vec4 binomial4(vec4 a, vec4 b, vec4 c, vec4 d) {
+  return (a + d) * 0.125 + (b + c) * 0.375;
+}
+
+// The B-spline upsample's two passes, shared by its tiled and streamed kernels: along x, the sum
+// of the four texels weighed by w in one expression; along y, the four rows' sums weighed by w
+// and added to zero one after the other.
+vec4 bspline_row(vec4 w, vec4 t0, vec4 t1, vec4 t2, vec4 t3) {
+  return w.x * t0 + w.y * t1 + w.z * t2 + w.w * t3;
+}
+vec4 bspline_column(vec4 w, vec4 r0, vec4 r1, vec4 r2, vec4 r3) {
+  vec4 sum = vec4(0.0);
+  sum += w.x * r0;
+  sum += w.y * r1;
+  sum += w.z * r2;
+  sum += w.w * r3;
+  return sum;
+}
+
 // Uniform cubic B-spline weights for the four texels around a position with fraction t.
 vec4 bspline_weights(float t) {
   float s = 1.0 - t;

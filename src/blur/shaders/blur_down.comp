@@ -65,13 +65,13 @@ void main() {
   barrier();
   for (int j = ly; j < IH; j += int(gl_WorkGroupSize.y)) {
     const int b = j * IW + 2 * lx;
-    s_row[j * TW + lx] = (s_src[b] + s_src[b + 3]) * 0.125 + (s_src[b + 1] + s_src[b + 2]) * 0.375;
+    s_row[j * TW + lx] = binomial4(s_src[b], s_src[b + 1], s_src[b + 2], s_src[b + 3]);
   }
   barrier();
   for (int r = 0; r < ROWS; ++r) {
     const int y = ly * ROWS + r;
     const int b = 2 * y * TW + lx;
-    const vec4 v = (s_row[b] + s_row[b + 3 * TW]) * 0.125 + (s_row[b + TW] + s_row[b + 2 * TW]) * 0.375;
+    const vec4 v = binomial4(s_row[b], s_row[b + TW], s_row[b + 2 * TW], s_row[b + 3 * TW]);
     const ivec2 xy = tile + ivec2(lx, y);
     if (all(lessThan(xy, size))) imageStore(dst, xy, v);
   }

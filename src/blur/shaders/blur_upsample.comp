@@ -78,7 +78,7 @@ void main() {
   const int c = int(fx) - 1 - f0.x;
   for (int j = ly; j < fs.y; j += int(gl_WorkGroupSize.y)) {
     const int b = j * FW + c;
-    s_row[j * TW + lx] = wx.x * s_src[b] + wx.y * s_src[b + 1] + wx.z * s_src[b + 2] + wx.w * s_src[b + 3];
+    s_row[j * TW + lx] = bspline_row(wx, s_src[b], s_src[b + 1], s_src[b + 2], s_src[b + 3]);
   }
   barrier();
   // 3. ROWS outputs of column tile.x + lx.
@@ -88,8 +88,7 @@ void main() {
     const float fy = floor(qy);
     const vec4 wy = bspline_weights(qy - fy);
     const int b = (int(fy) - 1 - f0.y) * TW + lx;
-    vec4 sum = vec4(0.0);
-    for (int j = 0; j < 4; ++j) sum += wy[j] * s_row[b + j * TW];
+    const vec4 sum = bspline_column(wy, s_row[b], s_row[b + TW], s_row[b + 2 * TW], s_row[b + 3 * TW]);
     if (all(lessThanEqual(xy, last))) imageStore(dst, xy, sum);
   }
 }

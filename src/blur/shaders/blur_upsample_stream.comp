@@ -2,19 +2,20 @@
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_samplerless_texture_functions : require
 // The pyramid method's B-spline upsample (docs/BLUR.md, "pyramid"), the same sums as
-// blur_upsample.comp in the same order, walking the image instead of tiling it: an invocation owns
-// one output column and every gl_WorkGroupSize.y-th row of a band of p.band_rows rows, from row
-// gl_LocalInvocationID.y of the band on. At a magnification of 2^k >= 2 an output column reads
-// four level texels a level row, and going down by one of its rows moves its four level rows by
-// at most one (the host's workgroups are 2 high), so the invocation keeps the four rows' horizontal
-// B-spline sums in registers and, when the rows move, forms the new row's sum: four fetches per
-// level row, no shared memory and no barrier. Each output is the vertical B-spline of the four sums
-// and its one write. A workgroup 16 wide and 2 high puts two adjacent rows in each subgroup of 32,
-// so a store can fill whole 32-byte sectors of a 2D tiling whose sectors span two rows (NVIDIA's
-// block-linear layout, as open drivers describe it) where one row fills halves: on the H100, 16x2 against 64x1 took the 2x upsample from 75 to 69 us and
-// the 8x one from 59 to 46 us at 3840x2160, bands of 16 rows both (docs/BLUR.md). blur_upsample.comp
-// instead loads a tile's footprint into shared memory and waits at two barriers per tile; this
-// kernel runs where the host picks it (src/blur/blur_steps.cpp, upsample_step).
+// blur_upsample.comp in the same order (blur.glsl, bspline_row and bspline_column), walking the
+// image instead of tiling it: an invocation owns one output column and every gl_WorkGroupSize.y-th
+// row of a band of p.band_rows rows, from row gl_LocalInvocationID.y of the band on. At a
+// magnification of 2^k >= 2 an output column reads four level texels a level row, and going down by
+// one of its rows moves its four level rows by at most one (the host's workgroups are 2 high), so
+// the invocation keeps the four rows' horizontal B-spline sums in registers and, when the rows
+// move, forms the new row's sum: four fetches per level row, no shared memory and no barrier. Each
+// output is the vertical B-spline of the four sums and its one write. A workgroup 16 wide and 2
+// high puts two adjacent rows in each subgroup of 32, so a store can fill whole 32-byte sectors of
+// a 2D tiling whose sectors span two rows (NVIDIA's block-linear layout, as open drivers describe
+// it) where one row fills halves: on the H100, 16x2 against 64x1 took the 2x upsample from 75 to 69
+// us and the 8x one from 59 to 46 us at 3840x2160, bands of 16 rows both (docs/BLUR.md).
+// blur_upsample.comp instead loads a tile's footprint into shared memory and waits at two barriers
+// per tile; this kernel runs where the host picks it (src/blur/blur_steps.cpp, upsample_step).
 layout(local_size_x_id = 0, local_size_y_id = 1) in;
 
 layout(binding = 0) uniform texture2D src;
@@ -25,25 +26,10 @@ DST_LAYOUT(1) uniform writeonly image2D dst;
 layout(push_constant) uniform Push { BlurPush p; };
 #include "blur.glsl"
 
-// The horizontal B-spline (weights w) of texels t0 .. t3, as blur_upsample.comp's step 2.
-vec4 weigh(vec4 w, vec4 t0, vec4 t1, vec4 t2, vec4 t3) {
-  return w.x * t0 + w.y * t1 + w.z * t2 + w.w * t3;
-}
-
-// Level row j's horizontal sum from texel c on, with weights w.
+// Level row j's horizontal B-spline sum from texel c on, with weights w.
 vec4 row_sum(int j, int c, vec4 w) {
-  return weigh(w, src_texel(ivec2(c, j)), src_texel(ivec2(c + 1, j)), src_texel(ivec2(c + 2, j)),
-               src_texel(ivec2(c + 3, j)));
-}
-
-// The vertical B-spline (weights w) of rows r0 .. r3, as blur_upsample.comp's step 3.
-vec4 column(vec4 w, vec4 r0, vec4 r1, vec4 r2, vec4 r3) {
-  vec4 sum = vec4(0.0);
-  sum += w.x * r0;
-  sum += w.y * r1;
-  sum += w.z * r2;
-  sum += w.w * r3;
-  return sum;
+  return bspline_row(w, src_texel(ivec2(c, j)), src_texel(ivec2(c + 1, j)), src_texel(ivec2(c + 2, j)),
+                     src_texel(ivec2(c + 3, j)));
 }
 
 void main() {
@@ -71,6 +57,6 @@ void main() {
       h0 = h1, h1 = h2, h2 = h3;
       h3 = row_sum(f + 2, c, wx);
     }
-    imageStore(dst, ivec2(x, y), column(bspline_weights(qy - fy), h0, h1, h2, h3));
+    imageStore(dst, ivec2(x, y), bspline_column(bspline_weights(qy - fy), h0, h1, h2, h3));
   }
 }
