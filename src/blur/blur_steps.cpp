@@ -270,6 +270,7 @@ Step fused_step(StepProgram& prog, const DeviceInfo& info, int src, int dst, VkE
     for (uint32_t t = 0; t <= radius; ++t) s.push.weights[t] = static_cast<float>(w[t]);
     s.invocations_x = (dst_size.width + 3) / 4;                        // RUN columns per invocation
     s.invocations_y = (dst_size.height + band - 1) / band * stream.y;  // a workgroup row of stream.y a band
+    s.rows = 0;  // its invocation rows are the steps of a walk, not output rows (Step::rows)
     return s;
   }
   // Prefetching the load step (shaders/blur_level.comp, PREFETCH) pays on GPUs only.
@@ -300,9 +301,9 @@ Step tiled_step(StepProgram& prog, const char* kernel, FusedShape shape, int src
 Step upsample_step(StepProgram& prog, const DeviceInfo& info, int src, int dst, VkExtent2D src_size,
                    VkExtent2D dst_size, VkFormat dst_format, float max_value, std::string label,
                    SeparableKernel kernel) {
-  // Both kernels rely on a magnification of 2 or more: the tiled one's shared footprint holds a
-  // tile's source texels, and the streamed one's level rows move by at most one for each of its
-  // invocation's rows (kUpWorkgroup.y = 2 output rows apart).
+  // The tiled kernel needs a magnification of 2 or more: its shared footprint holds a tile's
+  // source texels. The streamed one is right at any (it advances its level rows in a loop), and at
+  // 2 or more they move by at most one for each of an invocation's rows, 2 output rows apart.
   if (2 * src_size.width > dst_size.width || 2 * src_size.height > dst_size.height) {
     throw Error(ErrorCode::invalid_argument, concat("upsample_step: ", src_size.width, "x", src_size.height, " -> ",
                                                     dst_size.width, "x", dst_size.height, " magnifies less than 2x"));
@@ -311,7 +312,6 @@ Step upsample_step(StepProgram& prog, const DeviceInfo& info, int src, int dst, 
     // The kUpWorkgroup.y invocations of a column share a band of kUpBandRows rows, each taking every
     // kUpWorkgroup.y-th row; no shared memory, so it fits every device. 16x2 and bands of 64 rows
     // were the fastest of the shapes measured on the H100 (docs/BLUR.md "pyramid").
-    static_assert(kUpWorkgroup.y == 2, "level rows move by at most one a step at a magnification of 2");
     static_assert(kUpBandRows % kUpWorkgroup.y == 0, "the band's rows divide among the workgroup's rows");
     const detail::ComputePipeline& pipeline =
         prog.pipeline("blur_upsample_stream", dst_format, kUpWorkgroup, {},

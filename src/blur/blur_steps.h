@@ -62,9 +62,12 @@ struct Step {
   BlurPush push{};
   uint32_t invocations_x = 0;  // dispatch covers these (the pipeline divides by its workgroup)
   uint32_t invocations_y = 0;
-  uint32_t rows = 1;                          // output rows per invocation: invocations_y = ceil(rows of output / this)
-  bool sampler = false;                       // binding 0 is a combined image sampler
-  bool streamed = false;                      // runs the streamed kernel (blur_stream.comp)
+  // Output rows per invocation row of the dispatch: invocations_y = ceil(rows of output / this); 0
+  // where that does not hold (the separable streamed kernel's invocation rows walk its bands).
+  uint32_t rows = 1;
+  bool sampler = false;  // binding 0 is a combined image sampler
+  // Runs a streamed kernel (blur_stream.comp, blur_down_stream.comp, blur_upsample_stream.comp).
+  bool streamed = false;
   const detail::OwnedBuffer* taps = nullptr;  // binding 2
   std::string label;
 };

@@ -114,6 +114,10 @@ void read_padded_input(Step& s, VkExtent2D input, const blur_plan::Padding& pad)
 // A padded chain's last step: it writes only the input's extent of the virtual padded output,
 // texel xy of the caller's output being the virtual texel xy + pad.
 void write_padded_output(Step& s, VkExtent2D output, const blur_plan::Padding& pad) {
+  if (s.rows == 0) {
+    throw Error(ErrorCode::invalid_argument,
+                concat("write_padded_output: step '", s.label, "' has no rows per invocation to size its dispatch"));
+  }
   s.push.dst_width = static_cast<int32_t>(output.width);
   s.push.dst_height = static_cast<int32_t>(output.height);
   s.push.dst_origin_x = static_cast<int32_t>(pad.pad_x);

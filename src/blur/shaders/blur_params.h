@@ -32,7 +32,7 @@ struct BlurPush {
   GLINT_INT dst_origin_y;
   GLINT_FLOAT ratio_x;
   GLINT_FLOAT ratio_y;
-  GLINT_INT band_rows;   // streamed kernel (blur_stream.comp): rows each workgroup writes
+  GLINT_INT band_rows;   // streamed kernels (blur_*stream.comp): rows each workgroup walks
 };
 
 #endif

@@ -9,10 +9,11 @@
 // one of its rows moves its four level rows by at most one (the host's workgroups are 2 high), so
 // the invocation keeps the four rows' horizontal B-spline sums in registers and, when the rows
 // move, forms the new row's sum: four fetches per level row, no shared memory and no barrier. Each
-// output is the vertical B-spline of the four sums and its one write. A workgroup 16 wide and 2
-// high puts two adjacent rows in each subgroup of 32, so a store can fill whole 32-byte sectors of
-// a 2D tiling whose sectors span two rows (NVIDIA's block-linear layout, as open drivers describe
-// it) where one row fills halves: on the H100, 16x2 against 64x1 took the 2x upsample from 75 to 69
+// output is the vertical B-spline of the four sums and its one write. Where subgroups take
+// consecutive invocations, as NVIDIA's 32-wide ones do, a workgroup 16 wide and 2 high puts two
+// adjacent rows in each subgroup, so a store can fill whole 32-byte sectors of a 2D tiling whose
+// sectors span two rows (NVIDIA's block-linear layout, as open drivers describe it) where one row
+// fills halves: on the H100, 16x2 against 64x1 took the 2x upsample from 75 to 69
 // us and the 8x one from 59 to 46 us at 3840x2160, bands of 16 rows both (docs/BLUR.md).
 // blur_upsample.comp instead loads a tile's footprint into shared memory and waits at two barriers
 // per tile; this kernel runs where the host picks it (src/blur/blur_steps.cpp, upsample_step).
