@@ -39,12 +39,12 @@ Work separable_work(uint32_t radius, uint32_t width, uint32_t height, bool linea
 
 // Pyramid on the padded chain: every D and the B-spline up counted as the 16 texel-taps of their
 // direct forms (four bilinear reads; 4x4 texels) per output, level k's blur taps from shared
-// memory. The kernels now do less (shaders/blur_down.comp and blur_upsample.comp run separably
-// through shared memory), but with features describing that (4.6 fetches and 13 shared taps per
-// D output, 8 shared taps per upsampled one) the fit of the calibration's twelve runs ranked the
-// dual above a faster pyramid on lavapipe at 10 of the 40 BM_BlurAutoVsBest points (worst
-// 1.87x); these proxies kept it at 1 (docs/PERF.md). The first D reads the padded extent of the
-// input (clamped reads).
+// memory. The kernels now do less (the downsamples and the upsample run separably, walking bands:
+// shaders/blur_down_stream.comp and blur_upsample_stream.comp), but with features describing the
+// tiled forms before them (4.6 fetches and 13 shared taps per D output, 8 shared taps per upsampled
+// one) the fit of the calibration's twelve runs ranked the dual above a faster pyramid on lavapipe
+// at 10 of the 40 BM_BlurAutoVsBest points (worst 1.87x); these proxies kept it at 1
+// (docs/PERF.md). The first D reads the padded extent of the input (clamped reads).
 Work pyramid_work(uint32_t levels, uint32_t level_radius, uint32_t width, uint32_t height, const Padding& padding,
                   bool fp32_shared) {
   Work w;
