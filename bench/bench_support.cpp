@@ -55,6 +55,17 @@ double median_frame_ms(const Context& context, Profiler& profiler, int frames,
   return median_of(ms);
 }
 
+std::vector<Profiler::Stage> stage_marks(const Context& context, uint32_t capacity,
+                                         const std::function<void(VkCommandBuffer, Profiler*)>& record_frame) {
+  Profiler stages(context, capacity);
+  context.run_once([&](VkCommandBuffer cmd) {
+    stages.reset(cmd);
+    stages.mark(cmd, "start");
+    record_frame(cmd, &stages);
+  });
+  return stages.results();
+}
+
 double median_of(std::vector<double> v) {
   if (v.empty()) return 0.0;
   std::sort(v.begin(), v.end());

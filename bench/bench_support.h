@@ -43,4 +43,10 @@ detail::OwnedImage depth_image(const Context& context, const reference::DepthIma
 double median_frame_ms(const Context& context, Profiler& profiler, int frames,
                        const std::function<void(VkCommandBuffer)>& record_frame);
 
+/// Records one frame with `record_frame` given a profiler (its own marks after each step, at most
+/// `capacity` - 1 of them), runs it, and returns the time between consecutive marks. The marks
+/// serialise the dispatches, so the stages add up to more than an unmarked frame.
+std::vector<Profiler::Stage> stage_marks(const Context& context, uint32_t capacity,
+                                         const std::function<void(VkCommandBuffer, Profiler*)>& record_frame);
+
 }  // namespace glint::bench

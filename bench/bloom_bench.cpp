@@ -68,16 +68,12 @@ void BM_Bloom(benchmark::State& state) {
     state.SetIterationTime(median * 1e-3);
   }
   // Stage breakdown of one more frame (bloom's own profiler marks), for docs/PERF.md.
-  Profiler stages(ctx, 8);
-  ctx.run_once([&](VkCommandBuffer cmd) {
-    stages.reset(cmd);
-    stages.mark(cmd, "start");
-    bloom.record(cmd, in.state, out.state, &stages);
-  });
+  const std::vector<Profiler::Stage> stages =
+      stage_marks(ctx, 8, [&](VkCommandBuffer cmd, Profiler* p) { bloom.record(cmd, in.state, out.state, p); });
   // Every stage's key is reported (0 when the path has no such stage), so rows of different paths compare.
   for (const char* key : {"us_prefilter_down0", "us_down", "us_small_levels", "us_up", "us_composite"})
     state.counters[key] = 0.0;
-  for (const auto& s : stages.results()) {
+  for (const auto& s : stages) {
     const std::string& l = s.label;
     const char* key = l.find("bright") != std::string::npos         ? "us_prefilter_down0"
                       : l.find("downsample") != std::string::npos   ? "us_down"

@@ -123,16 +123,8 @@ std::string stage_key(const std::string& label) {
 
 // Stage breakdown of one more frame (a timestamp after each dispatch, which serialises them, so
 // the stages add up to more than the frame), for docs/PERF.md: one counter per step.
-template <typename Record>
-void add_stage_counters(benchmark::State& state, Record record) {
-  const Context& ctx = context();
-  Profiler stages(ctx, 16);
-  ctx.run_once([&](VkCommandBuffer cmd) {
-    stages.reset(cmd);
-    stages.mark(cmd, "start");
-    record(cmd, &stages);
-  });
-  for (const auto& st : stages.results()) state.counters[stage_key(st.label)] += st.ms * 1e3;
+void add_stage_counters(benchmark::State& state, const std::function<void(VkCommandBuffer, Profiler*)>& record) {
+  for (const auto& st : stage_marks(context(), 16, record)) state.counters[stage_key(st.label)] += st.ms * 1e3;
 }
 
 void run_gauss_benchmark(benchmark::State& state, BlurMethod method, bool linear) {

@@ -78,12 +78,9 @@ void BM_FlareEndToEnd(benchmark::State& state) {
   }
 
   // One more frame with the parts' marks, and its statistics.
-  Profiler stages(ctx, 8);
   detail::OwnedBuffer readback(ctx, sizeof(GlintFlareStats), VK_BUFFER_USAGE_TRANSFER_DST_BIT, true);
-  ctx.run_once([&](VkCommandBuffer cmd) {
-    stages.reset(cmd);
-    stages.mark(cmd, "start");
-    frame(cmd, &stages);
+  const std::vector<Profiler::Stage> stages = stage_marks(ctx, 8, [&](VkCommandBuffer cmd, Profiler* p) {
+    frame(cmd, p);
     detail::Barriers b;
     b.use(pass.stats(), VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
     b.flush(cmd);
@@ -97,7 +94,7 @@ void BM_FlareEndToEnd(benchmark::State& state) {
   GlintFlareStats st;
   std::memcpy(&st, readback.mapped(), sizeof st);
   double hiz_us = 0, cull_us = 0, draw_us = 0;
-  for (const auto& s : stages.results()) {
+  for (const auto& s : stages) {
     if (s.label == "hi-z") {
       hiz_us += s.ms * 1e3;
     } else if (s.label.find("cull") != std::string::npos) {
