@@ -296,6 +296,27 @@ Step tiled_step(StepProgram& prog, const char* kernel, FusedShape shape, int src
   return make_step(pipeline, src, dst, src_size, dst_size, flags, max_value, shape.rows, std::move(label));
 }
 
+// Whether blur_down_stream.comp's shuffle variants can run (they gather each row's taps through
+// subgroup shuffles): the device shuffles and broadcasts in compute, and every subgroup size it may
+// pick divides the kernel's 64-wide workgroups, so that under SPIR-V 1.6 its subgroups are full
+// (the Vulkan spec, SubgroupLocalInvocationId) and tile the workgroup's columns.
+const char* down_shuffles(const Context& context) {
+  VkPhysicalDeviceVulkan13Properties p13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_PROPERTIES};
+  VkPhysicalDeviceSubgroupProperties sub{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES};
+  sub.pNext = &p13;
+  VkPhysicalDeviceProperties2 props2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
+  props2.pNext = &sub;
+  vkGetPhysicalDeviceProperties2(context.physical_device(), &props2);
+  const uint32_t lo = p13.minSubgroupSize != 0 ? p13.minSubgroupSize : sub.subgroupSize;
+  const uint32_t hi = p13.maxSubgroupSize != 0 ? p13.maxSubgroupSize : sub.subgroupSize;
+  if (lo < 2 || hi > 64 || (sub.supportedStages & VK_SHADER_STAGE_COMPUTE_BIT) == 0) return nullptr;
+  // Broadcast is in the ballot set (the Vulkan spec, VkSubgroupFeatureFlagBits).
+  const VkSubgroupFeatureFlags need =
+      VK_SUBGROUP_FEATURE_BASIC_BIT | VK_SUBGROUP_FEATURE_SHUFFLE_BIT | VK_SUBGROUP_FEATURE_BALLOT_BIT;
+  if ((sub.supportedOperations & need) != need) return nullptr;
+  return "blur_down_stream_shuffle";
+}
+
 }  // namespace
 
 Step upsample_step(StepProgram& prog, const DeviceInfo& info, int src, int dst, VkExtent2D src_size,
@@ -341,8 +362,9 @@ Step down_step(StepProgram& prog, const DeviceInfo& info, int src, int dst, VkEx
   }
   if (kernel != SeparableKernel::tiles) {
     // 64 columns by one band of rows a workgroup; no shared memory, so it fits every device.
+    const char* shuffled = kernel == SeparableKernel::device ? down_shuffles(*prog.context) : nullptr;
     const detail::ComputePipeline& pipeline =
-        prog.pipeline("blur_down_stream", dst_format, {64, 1}, {},
+        prog.pipeline(shuffled ? shuffled : "blur_down_stream", dst_format, {64, 1}, {},
                       {VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
     return make_step(pipeline, src, dst, src_size, dst_size, flags, max_value, kDownBandRows, std::move(label),
                      kDownBandRows);

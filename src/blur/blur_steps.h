@@ -120,7 +120,10 @@ VkExtent2D half_extent(VkExtent2D e);
 /// memory and, on GPUs, the image makes at least kStreamMinGroups workgroups
 /// (stream_fills_device()); else the tiles. `stream` drops the second condition and `tiles` forces
 /// the tiled kernel (tests and benchmarks, through detail::BlurAccess). The pyramid's downsamples
-/// (down_step) take the same choice: streamed unless `tiles`.
+/// (down_step) and upsample (upsample_step) take the same choice: streamed unless `tiles`; under
+/// `device` the downsamples fetch each row in copy order and gather their taps through subgroup
+/// shuffles where the device has them (blur_down_stream.comp's shuffle variants), and `stream`
+/// keeps their four fetches a row, so that the tests run both forms on every device that shuffles.
 enum class SeparableKernel : uint32_t { device, stream, tiles };
 
 /// The streamed kernel's workgroup (STRIP_W / 4 invocations across, STEP rows) of the widest strip
@@ -163,7 +166,8 @@ inline constexpr detail::Workgroup2D kUpWorkgroup{16, 2};
 inline constexpr uint32_t kUpBandRows = 64;
 // The pyramid's binomial downsample of an exact 2:1 step from `src` to `dst`: the streamed kernel
 // (src/blur/shaders/blur_down_stream.comp: one destination column and kDownBandRows rows per
-// invocation, marked Step::streamed) unless `kernel` is tiles, which forces the tiled one
+// invocation, marked Step::streamed; with subgroup shuffles under `device`, as SeparableKernel
+// says) unless `kernel` is tiles, which forces the tiled one
 // (src/blur/shaders/blur_down.comp, its tile shape from the device as upsample_step's) for the
 // tests and benchmarks that compare them.
 Step down_step(StepProgram& prog, const DeviceInfo& info, int src, int dst, VkExtent2D src_size, VkExtent2D dst_size,

@@ -33,6 +33,8 @@ set(GLINT_EFFECT_KERNELS
   "shaders/blur_down|noformat|"
   "shaders/blur_down_stream|rgba16f|DST_FORMAT=rgba16f"
   "shaders/blur_down_stream|rgba32f|DST_FORMAT=rgba32f"
+  "shaders/blur_down_stream|shuffle_rgba16f|DST_FORMAT=rgba16f+SHUFFLE=1"
+  "shaders/blur_down_stream|shuffle_rgba32f|DST_FORMAT=rgba32f+SHUFFLE=1"
   "shaders/blur_dual_down|rgba16f|DST_FORMAT=rgba16f"
   "shaders/blur_dual_down|rgba32f|DST_FORMAT=rgba32f"
   "shaders/blur_dual_down|r11f_g11f_b10f|DST_FORMAT=r11f_g11f_b10f"
