@@ -173,7 +173,11 @@ inline constexpr uint32_t kUpBandRows = 64;
 Step down_step(StepProgram& prog, const DeviceInfo& info, int src, int dst, VkExtent2D src_size, VkExtent2D dst_size,
                VkFormat dst_format, uint32_t flags, float max_value, std::string label,
                SeparableKernel kernel = SeparableKernel::device);
-inline constexpr uint32_t kDownBandRows = 8;
+// Bands of 4 rows: on the H100 the shuffled pyramid took 156.8 / 123.0 / 140.2 us at sigma 4 / 16 /
+// 64 with them, 159.4 / 125.9 / 143.4 with 8, 162.7 / 138.0 / 161.6 with 16 and 158.2 / 150.0 /
+// 195.5 with 32 (one device call; docs/perf/blur_down_stream_ab.txt): shorter bands re-read 2 of
+// every 2 kDownBandRows + 2 source rows but make more workgroups for the small levels.
+inline constexpr uint32_t kDownBandRows = 4;
 // A plain per-texel step (dual down/up) with 2D workgroups.
 Step simple_step(StepProgram& prog, const char* kernel, int src, int dst, VkExtent2D src_size, VkExtent2D dst_size,
                  VkFormat dst_format, uint32_t flags, float max_value, std::string label,
