@@ -320,12 +320,11 @@ TEST_F(BlurTest, EveryMethodSanitizesNanAndInfinity) {
 // of 8 rows longer than the 2 RADIUS lag), 5 and 12 (the largest), the pyramid's same-size level
 // blur (radius 8), fp32 and fp16; with them the pyramid's downsamples and upsample on either of
 // their kernels (blur_down.comp and blur_upsample.comp tile; blur_down_stream.comp walks bands of
-// kDownBandRows rows, with its four fetches a row under `stream` and its taps gathered by subgroup
-// shuffles under `device` where the device can, blur_upsample_stream.comp bands of kUpBandRows
-// rows, every other row an invocation), one level at sigma 4 (2x) and several at sigma 16. The sizes cross the
-// streamed kernels' strips of 64 (or fewer) columns and bands of 32 and 64 rows by one texel or
-// part of one, and hold rows and columns shorter than its apron; NaN (and in fp16 Inf) texels check
-// that its loads sanitize.
+// kDownBandRows rows with its four fetches a row under `stream`, and of kDownShuffleBandRows with
+// its taps gathered by subgroup shuffles under `device` where the device can, blur_upsample_stream.comp bands of
+// kUpBandRows rows, every other row an invocation), one level at sigma 4 (2x) and several at sigma 16. The sizes cross
+// the streamed kernels' strips of 64 (or fewer) columns and bands of 32 and 64 rows by one texel or part of one, and
+// hold rows and columns shorter than its apron; NaN (and in fp16 Inf) texels check that its loads sanitize.
 TEST_F(BlurTest, StreamedAndTiledSeparableKernelsMatchTheReference) {
   const std::pair<uint32_t, uint32_t> sizes[] = {{83, 57}, {129, 65}, {300, 97}, {1, 40}, {40, 1}, {5, 3}};
   const MethodCase cases[] = {{BlurMethod::separable, false, 0.5f},

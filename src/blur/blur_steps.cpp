@@ -366,8 +366,8 @@ Step down_step(StepProgram& prog, const DeviceInfo& info, int src, int dst, VkEx
     const detail::ComputePipeline& pipeline =
         prog.pipeline(shuffled ? shuffled : "blur_down_stream", dst_format, {64, 1}, {},
                       {VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
-    return make_step(pipeline, src, dst, src_size, dst_size, flags, max_value, kDownBandRows, std::move(label),
-                     kDownBandRows);
+    const uint32_t band = shuffled ? kDownShuffleBandRows : kDownBandRows;
+    return make_step(pipeline, src, dst, src_size, dst_size, flags, max_value, band, std::move(label), band);
   }
   // Output tiles of 32x8 on GPUs (a source block of 66x18), 16x8 on CPU devices. Shared memory:
   // the block (2 TW + 2) x (2 TH + 2) and its rows summed along x, (2 TH + 2) x TW, 16 bytes each.

@@ -166,18 +166,20 @@ inline constexpr detail::Workgroup2D kUpWorkgroup{16, 2};
 inline constexpr uint32_t kUpBandRows = 64;
 // The pyramid's binomial downsample of an exact 2:1 step from `src` to `dst`: the streamed kernel
 // (src/blur/shaders/blur_down_stream.comp: one destination column and kDownBandRows rows per
-// invocation, marked Step::streamed; with subgroup shuffles under `device`, as SeparableKernel
-// says) unless `kernel` is tiles, which forces the tiled one
+// invocation, marked Step::streamed; with subgroup shuffles and kDownShuffleBandRows rows under
+// `device`, as SeparableKernel says) unless `kernel` is tiles, which forces the tiled one
 // (src/blur/shaders/blur_down.comp, its tile shape from the device as upsample_step's) for the
 // tests and benchmarks that compare them.
 Step down_step(StepProgram& prog, const DeviceInfo& info, int src, int dst, VkExtent2D src_size, VkExtent2D dst_size,
                VkFormat dst_format, uint32_t flags, float max_value, std::string label,
                SeparableKernel kernel = SeparableKernel::device);
-// Bands of 4 rows: on the H100 the shuffled pyramid took 156.8 / 123.0 / 140.2 us at sigma 4 / 16 /
-// 64 with them, 159.4 / 125.9 / 143.4 with 8, 162.7 / 138.0 / 161.6 with 16 and 158.2 / 150.0 /
-// 195.5 with 32 (one device call; docs/perf/blur_down_stream_ab.txt): shorter bands re-read 2 of
-// every 2 kDownBandRows + 2 source rows but make more workgroups for the small levels.
-inline constexpr uint32_t kDownBandRows = 4;
+// Rows of a band, each form measured on the H100 in one device call (docs/perf/blur_down_stream_ab.txt):
+// the shuffled form took 156.8 / 123.0 / 140.2 us for the sigma 4 / 16 / 64 pyramid with bands of
+// 4, 159.4 / 125.9 / 143.4 with 8, 162.7 / 138.0 / 161.6 with 16 and 158.2 / 150.0 / 195.5 with 32
+// (shorter bands re-read 2 of each band's 2 n + 2 source rows but make more workgroups for the
+// small levels); the four-fetch form's first downsample 80.9 us with 8, 87.8 with 4.
+inline constexpr uint32_t kDownBandRows = 8;
+inline constexpr uint32_t kDownShuffleBandRows = 4;
 // A plain per-texel step (dual down/up) with 2D workgroups.
 Step simple_step(StepProgram& prog, const char* kernel, int src, int dst, VkExtent2D src_size, VkExtent2D dst_size,
                  VkFormat dst_format, uint32_t flags, float max_value, std::string label,
