@@ -173,11 +173,12 @@ inline constexpr uint32_t kUpBandRows = 64;
 Step down_step(StepProgram& prog, const DeviceInfo& info, int src, int dst, VkExtent2D src_size, VkExtent2D dst_size,
                VkFormat dst_format, uint32_t flags, float max_value, std::string label,
                SeparableKernel kernel = SeparableKernel::device);
-// Rows of a band, each form measured on the H100 in one device call (docs/perf/blur_down_stream_ab.txt):
-// the shuffled form took 156.8 / 123.0 / 140.2 us for the sigma 4 / 16 / 64 pyramid with bands of
-// 4, 159.4 / 125.9 / 143.4 with 8, 162.7 / 138.0 / 161.6 with 16 and 158.2 / 150.0 / 195.5 with 32
+// Rows of a band, measured on the H100 (docs/perf/blur_down_stream_ab.txt): in one device call the
+// shuffled form took 156.8 / 123.0 / 140.2 us for the sigma 4 / 16 / 64 pyramid with bands of 4,
+// 159.4 / 125.9 / 143.4 with 8, 162.7 / 138.0 / 161.6 with 16 and 158.2 / 150.0 / 195.5 with 32
 // (shorter bands re-read 2 of each band's 2 n + 2 source rows but make more workgroups for the
-// small levels); the four-fetch form's first downsample 80.9 us with 8, 87.8 with 4.
+// small levels); the four-fetch form's first downsample at sigma 4 took 80.9 us with 8 and 87.8
+// with 4, in two calls.
 inline constexpr uint32_t kDownBandRows = 8;
 inline constexpr uint32_t kDownShuffleBandRows = 4;
 // A plain per-texel step (dual down/up) with 2D workgroups.
