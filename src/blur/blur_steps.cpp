@@ -301,20 +301,12 @@ Step tiled_step(StepProgram& prog, const char* kernel, FusedShape shape, int src
 // pick divides the kernel's 64-wide workgroups, so that under SPIR-V 1.6 its subgroups are full
 // (the Vulkan spec, SubgroupLocalInvocationId) and tile the workgroup's columns.
 const char* down_shuffles(const Context& context) {
-  VkPhysicalDeviceVulkan13Properties p13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_PROPERTIES};
-  VkPhysicalDeviceSubgroupProperties sub{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES};
-  sub.pNext = &p13;
-  VkPhysicalDeviceProperties2 props2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
-  props2.pNext = &sub;
-  vkGetPhysicalDeviceProperties2(context.physical_device(), &props2);
-  const uint32_t lo = p13.minSubgroupSize != 0 ? p13.minSubgroupSize : sub.subgroupSize;
-  const uint32_t hi = p13.maxSubgroupSize != 0 ? p13.maxSubgroupSize : sub.subgroupSize;
-  if (lo < 2 || hi > 64 || (sub.supportedStages & VK_SHADER_STAGE_COMPUTE_BIT) == 0) return nullptr;
+  const detail::ContextState& s = context.state();  // read once by fill_info()
+  if (s.min_subgroup_size < 2 || s.max_subgroup_size > 64) return nullptr;
   // Broadcast is in the ballot set (the Vulkan spec, VkSubgroupFeatureFlagBits).
   const VkSubgroupFeatureFlags need =
       VK_SUBGROUP_FEATURE_BASIC_BIT | VK_SUBGROUP_FEATURE_SHUFFLE_BIT | VK_SUBGROUP_FEATURE_BALLOT_BIT;
-  if ((sub.supportedOperations & need) != need) return nullptr;
-  return "blur_down_stream_shuffle";
+  return (s.compute_subgroup_operations & need) == need ? "blur_down_stream_shuffle" : nullptr;
 }
 
 }  // namespace

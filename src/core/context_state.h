@@ -48,6 +48,12 @@ struct ContextState {
   // (Context::kernel_statistics(), core/pipeline.cpp).
   bool executable_properties_supported = false;
   bool kernel_statistics = false;
+  // The subgroup sizes a compute dispatch may get (VkPhysicalDeviceVulkan13Properties; the one
+  // subgroupSize where those are 0) and the subgroup operations compute shaders have (0 where the
+  // compute stage has none), read once by fill_info() for kernels with subgroup variants.
+  uint32_t min_subgroup_size = 0;
+  uint32_t max_subgroup_size = 0;
+  VkSubgroupFeatureFlags compute_subgroup_operations = 0;
 
   // Standalone helpers for run_once(). The pool, the fence and the queue need external
   // synchronization (Vulkan, "Threading Behavior"): run_once() holds submit_mutex from allocating

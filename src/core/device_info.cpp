@@ -12,8 +12,10 @@ namespace glint::detail {
 
 void fill_info(ContextState& s) {
   VkPhysicalDevicePushDescriptorPropertiesKHR push{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PUSH_DESCRIPTOR_PROPERTIES_KHR};
+  VkPhysicalDeviceVulkan13Properties p13{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_PROPERTIES};
+  p13.pNext = &push;  // filled only if the device has the extension (checked below)
   VkPhysicalDeviceSubgroupProperties subgroup{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES};
-  subgroup.pNext = &push;  // filled only if the device has the extension (checked below)
+  subgroup.pNext = &p13;
   VkPhysicalDeviceProperties2 props{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
   props.pNext = &subgroup;
   vkGetPhysicalDeviceProperties2(s.physical_device, &props);
@@ -21,6 +23,10 @@ void fill_info(ContextState& s) {
   s.info.name = p.deviceName;
   s.info.type = p.deviceType;
   s.info.subgroup_size = subgroup.subgroupSize;
+  s.min_subgroup_size = p13.minSubgroupSize != 0 ? p13.minSubgroupSize : subgroup.subgroupSize;
+  s.max_subgroup_size = p13.maxSubgroupSize != 0 ? p13.maxSubgroupSize : subgroup.subgroupSize;
+  s.compute_subgroup_operations =
+      (subgroup.supportedStages & VK_SHADER_STAGE_COMPUTE_BIT) != 0 ? subgroup.supportedOperations : 0;
   s.info.max_shared_memory_bytes = p.limits.maxComputeSharedMemorySize;
   s.info.sub_texel_precision_bits = p.limits.subTexelPrecisionBits;
   s.info.max_workgroup_invocations = p.limits.maxComputeWorkGroupInvocations;
