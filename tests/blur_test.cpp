@@ -321,7 +321,8 @@ TEST_F(BlurTest, EveryMethodSanitizesNanAndInfinity) {
 // blur (radius 8), fp32 and fp16; with them the pyramid's downsamples and upsample on either of
 // their kernels (blur_down.comp and blur_upsample.comp tile; blur_down_stream.comp walks bands of
 // kDownBandRows rows with its four fetches a row under `stream`, and of kDownShuffleBandRows with
-// its taps gathered by subgroup shuffles under `device` where the device can, blur_upsample_stream.comp bands of
+// its taps gathered by subgroup shuffles under `shuffle`, and `device` on GPUs, where the device
+// can (the test counts those steps), blur_upsample_stream.comp bands of
 // kUpBandRows rows, every other row an invocation), one level at sigma 4 (2x) and several at sigma 16. The sizes cross
 // the streamed kernels' strips of 64 (or fewer) columns and bands of 32 and 64 rows by one texel or part of one, and
 // hold rows and columns shorter than its apron; NaN (and in fp16 Inf) texels check that its loads sanitize.
@@ -333,7 +334,10 @@ TEST_F(BlurTest, StreamedAndTiledSeparableKernelsMatchTheReference) {
                               {BlurMethod::pyramid, false, 4.0f},    // one level: its blur is same-size
                               {BlurMethod::pyramid, false, 16.0f}};  // levels downsampled on either kernel
   using blur_steps::SeparableKernel;
-  for (SeparableKernel kernel : {SeparableKernel::device, SeparableKernel::stream, SeparableKernel::tiles}) {
+  const bool shuffles = blur_steps::down_shuffles_supported(context());
+  const bool gpu = context().info().type != VK_PHYSICAL_DEVICE_TYPE_CPU;
+  for (SeparableKernel kernel :
+       {SeparableKernel::device, SeparableKernel::stream, SeparableKernel::tiles, SeparableKernel::shuffle}) {
     for (const MethodCase& c : cases) {
       for (Precision precision : {Precision::fp32, Precision::fp16}) {
         GaussianBlur blur(context(), config_of(c, precision));
@@ -341,9 +345,10 @@ TEST_F(BlurTest, StreamedAndTiledSeparableKernelsMatchTheReference) {
         const VkFormat format = precision == Precision::fp16 ? kF16 : kF32;
         for (auto [w, h] : sizes) {
           const std::string where = describe(c) +
-                                    (kernel == SeparableKernel::device   ? " device"
-                                     : kernel == SeparableKernel::stream ? " stream"
-                                                                         : " tiles") +
+                                    (kernel == SeparableKernel::device    ? " device"
+                                     : kernel == SeparableKernel::stream  ? " stream"
+                                     : kernel == SeparableKernel::shuffle ? " shuffle"
+                                                                          : " tiles") +
                                     (precision == Precision::fp16 ? " fp16 " : " fp32 ") + std::to_string(w) + "x" +
                                     std::to_string(h);
           SCOPED_TRACE(where);
@@ -366,6 +371,12 @@ TEST_F(BlurTest, StreamedAndTiledSeparableKernelsMatchTheReference) {
           } else {
             EXPECT_GE(streamed, pyramid_steps);
           }
+          // The downsamples gather their taps where the selection asks for it and the device can:
+          // `shuffle` everywhere, `device` on GPUs.
+          const bool gathered =
+              shuffles && (kernel == SeparableKernel::shuffle || (kernel == SeparableKernel::device && gpu));
+          EXPECT_EQ(detail::BlurAccess::shuffled(blur),
+                    gathered && c.method == BlurMethod::pyramid ? blur.choice().levels : 0u);
           ASSERT_TRUE(all_finite(out)) << "unwritten or non-finite texels";
           EXPECT_LT(reference::rgba_relative_l2(out, reference_of(blur, stored)),
                     precision == Precision::fp16 ? kTolFp16 : kTolFp32);

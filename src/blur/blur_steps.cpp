@@ -156,6 +156,19 @@ const detail::ComputePipeline& StepProgram::pipeline(const std::string& kernel, 
   return pipelines->emplace(key, detail::ComputePipeline(*context, d)).first->second;
 }
 
+bool down_shuffles_supported(const Context& context) {
+  const detail::ContextState& s = context.state();  // read once by fill_info()
+  if (s.min_subgroup_size < 2 || s.max_subgroup_size > 64) return false;
+  // Broadcast is in the ballot set (the Vulkan spec, VkSubgroupFeatureFlagBits).
+  const VkSubgroupFeatureFlags need =
+      VK_SUBGROUP_FEATURE_BASIC_BIT | VK_SUBGROUP_FEATURE_SHUFFLE_BIT | VK_SUBGROUP_FEATURE_BALLOT_BIT;
+  return (s.compute_subgroup_operations & need) == need;
+}
+
+uint32_t StepProgram::shuffled_steps() const {
+  return static_cast<uint32_t>(std::count_if(steps.begin(), steps.end(), [](const Step& s) { return s.shuffled; }));
+}
+
 uint32_t StepProgram::streamed_steps() const {
   return static_cast<uint32_t>(std::count_if(steps.begin(), steps.end(), [](const Step& s) { return s.streamed; }));
 }
@@ -296,19 +309,6 @@ Step tiled_step(StepProgram& prog, const char* kernel, FusedShape shape, int src
   return make_step(pipeline, src, dst, src_size, dst_size, flags, max_value, shape.rows, std::move(label));
 }
 
-// Whether blur_down_stream.comp's shuffle variants can run (they gather each row's taps through
-// subgroup shuffles): the device shuffles and broadcasts in compute, and every subgroup size it may
-// pick divides the kernel's 64-wide workgroups, so that under SPIR-V 1.6 its subgroups are full
-// (the Vulkan spec, SubgroupLocalInvocationId) and tile the workgroup's columns.
-const char* down_shuffles(const Context& context) {
-  const detail::ContextState& s = context.state();  // read once by fill_info()
-  if (s.min_subgroup_size < 2 || s.max_subgroup_size > 64) return nullptr;
-  // Broadcast is in the ballot set (the Vulkan spec, VkSubgroupFeatureFlagBits).
-  const VkSubgroupFeatureFlags need =
-      VK_SUBGROUP_FEATURE_BASIC_BIT | VK_SUBGROUP_FEATURE_SHUFFLE_BIT | VK_SUBGROUP_FEATURE_BALLOT_BIT;
-  return (s.compute_subgroup_operations & need) == need ? "blur_down_stream_shuffle" : nullptr;
-}
-
 }  // namespace
 
 Step upsample_step(StepProgram& prog, const DeviceInfo& info, int src, int dst, VkExtent2D src_size,
@@ -354,12 +354,16 @@ Step down_step(StepProgram& prog, const DeviceInfo& info, int src, int dst, VkEx
   }
   if (kernel != SeparableKernel::tiles) {
     // 64 columns by one band of rows a workgroup; no shared memory, so it fits every device.
-    const char* shuffled = kernel == SeparableKernel::device ? down_shuffles(*prog.context) : nullptr;
+    const bool shuffled = (kernel == SeparableKernel::shuffle ||
+                           (kernel == SeparableKernel::device && info.type != VK_PHYSICAL_DEVICE_TYPE_CPU)) &&
+                          down_shuffles_supported(*prog.context);
     const detail::ComputePipeline& pipeline =
-        prog.pipeline(shuffled ? shuffled : "blur_down_stream", dst_format, {64, 1}, {},
+        prog.pipeline(shuffled ? "blur_down_stream_shuffle" : "blur_down_stream", dst_format, {64, 1}, {},
                       {VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
     const uint32_t band = shuffled ? kDownShuffleBandRows : kDownBandRows;
-    return make_step(pipeline, src, dst, src_size, dst_size, flags, max_value, band, std::move(label), band);
+    Step step = make_step(pipeline, src, dst, src_size, dst_size, flags, max_value, band, std::move(label), band);
+    step.shuffled = shuffled;
+    return step;
   }
   // Output tiles of 32x8 on GPUs (a source block of 66x18), 16x8 on CPU devices. Shared memory:
   // the block (2 TW + 2) x (2 TH + 2) and its rows summed along x, (2 TH + 2) x TW, 16 bytes each.

@@ -68,6 +68,8 @@ struct Step {
   bool sampler = false;  // binding 0 is a combined image sampler
   // Runs a streamed kernel (blur_stream.comp, blur_down_stream.comp, blur_upsample_stream.comp).
   bool streamed = false;
+  // Runs blur_down_stream.comp's shuffle variant (the taps gathered through subgroup shuffles).
+  bool shuffled = false;
   const detail::OwnedBuffer* taps = nullptr;  // binding 2
   std::string label;
 };
@@ -92,6 +94,8 @@ struct StepProgram {
 
   /// Steps that run a streamed kernel (blur_stream.comp, blur_down_stream.comp, blur_upsample_stream.comp).
   uint32_t streamed_steps() const;
+  /// Steps that run blur_down_stream.comp's shuffle variant.
+  uint32_t shuffled_steps() const;
 
   // Owned images can also be copied from (BlurPyramid hands its levels to the caller).
   int add_image(VkExtent2D e, VkFormat f);
@@ -121,10 +125,19 @@ VkExtent2D half_extent(VkExtent2D e);
 /// (stream_fills_device()); else the tiles. `stream` drops the second condition and `tiles` forces
 /// the tiled kernel (tests and benchmarks, through detail::BlurAccess). The pyramid's downsamples
 /// (down_step) and upsample (upsample_step) take the same choice: streamed unless `tiles`; under
-/// `device` the downsamples fetch each row in copy order and gather their taps through subgroup
-/// shuffles where the device has them (blur_down_stream.comp's shuffle variants), and `stream`
-/// keeps their four fetches a row, so that the tests run both forms on every device that shuffles.
-enum class SeparableKernel : uint32_t { device, stream, tiles };
+/// `device` the downsamples of a GPU fetch each row in copy order and gather their taps through
+/// subgroup shuffles where it has them (blur_down_stream.comp's shuffle variants, which
+/// down_shuffles_supported() checks), while CPU devices keep four fetches a row (there the
+/// gathered form measured slower: docs/perf/blur_down_stream_ab.txt). `shuffle` is `device` with
+/// the gathered downsamples wherever they can run, CPU devices included, and `stream` keeps the
+/// four fetches everywhere, so that the tests run both forms on every device that shuffles.
+enum class SeparableKernel : uint32_t { device, stream, tiles, shuffle };
+
+/// Whether `context`'s device can run blur_down_stream.comp's shuffle variants: it shuffles and
+/// broadcasts in compute, and every subgroup size it may pick divides the kernel's 64-wide
+/// workgroups, so that under SPIR-V 1.6 its subgroups are full (the Vulkan spec,
+/// SubgroupLocalInvocationId) and tile the workgroup's columns.
+bool down_shuffles_supported(const Context& context);
 
 /// The streamed kernel's workgroup (STRIP_W / 4 invocations across, STEP rows) of the widest strip
 /// whose shared memory and invocations fit the device, or none (false) where no strip fits.
@@ -166,9 +179,9 @@ inline constexpr detail::Workgroup2D kUpWorkgroup{16, 2};
 inline constexpr uint32_t kUpBandRows = 64;
 // The pyramid's binomial downsample of an exact 2:1 step from `src` to `dst`: the streamed kernel
 // (src/blur/shaders/blur_down_stream.comp: one destination column and kDownBandRows rows per
-// invocation, marked Step::streamed; with subgroup shuffles and kDownShuffleBandRows rows under
-// `device`, as SeparableKernel says) unless `kernel` is tiles, which forces the tiled one
-// (src/blur/shaders/blur_down.comp, its tile shape from the device as upsample_step's) for the
+// invocation, marked Step::streamed; with subgroup shuffles and kDownShuffleBandRows rows, marked
+// Step::shuffled, under `device` on GPUs and under `shuffle`, as SeparableKernel says) unless `kernel` is tiles, which
+// forces the tiled one (src/blur/shaders/blur_down.comp, its tile shape from the device as upsample_step's) for the
 // tests and benchmarks that compare them.
 Step down_step(StepProgram& prog, const DeviceInfo& info, int src, int dst, VkExtent2D src_size, VkExtent2D dst_size,
                VkFormat dst_format, uint32_t flags, float max_value, std::string label,
@@ -202,6 +215,8 @@ struct BlurAccess {
   /// level blur's or the downsample's).
   static uint32_t streamed(const GaussianBlur& blur);
   static uint32_t streamed(const BlurPyramid& pyramid);
+  /// How many of those steps are downsamples that gather their taps through subgroup shuffles.
+  static uint32_t shuffled(const GaussianBlur& blur);
 };
 
 }  // namespace glint::detail

@@ -401,6 +401,10 @@ uint32_t detail::BlurAccess::streamed(const GaussianBlur& blur) {
   return blur.impl_->cur ? blur.impl_->cur->prog.streamed_steps() : 0;
 }
 
+uint32_t detail::BlurAccess::shuffled(const GaussianBlur& blur) {
+  return blur.impl_->cur ? blur.impl_->cur->prog.shuffled_steps() : 0;
+}
+
 void GaussianBlur::release_unused() { impl_->cache.release_unused(impl_->cur); }
 uint32_t GaussianBlur::cached_sizes() const { return impl_->cache.size(); }
 
