@@ -30,13 +30,14 @@ uint32_t fused_shared_bytes(FusedShape s, uint32_t radius, bool half_shared) {
   return (half_shared ? 8 : 16) * (padded(w + 2 * radius) * (h + 2 * radius) + padded(w) * (h + 2 * radius));
 }
 
-// Shared memory of src/blur/shaders/blur_stream.comp: a step's source rows and the ring of
-// STEP + 2 RADIUS filtered rows, each row skewed by one element every 2^SKEW (16 elements of 8
-// bytes in fp16, 8 of 16 in fp32), plus the unused arrays' one element each (two fp32 elements of
-// 16 bytes with fp16 copies, two packed ones of 8 with fp32 copies).
-uint32_t stream_shared_bytes(detail::Workgroup2D wg, uint32_t radius, bool half_shared) {
+// Shared memory of src/blur/shaders/blur_stream.comp: a step's source rows (two values a texel for
+// the 2:1 mean, mode 1: HALVES) and the ring of STEP + 2 RADIUS filtered rows, each row skewed by
+// one element every 2^SKEW (16 elements of 8 bytes in fp16, 8 of 16 in fp32), plus the unused
+// arrays' one element each (two fp32 elements of 16 bytes with fp16 copies, two packed ones of 8
+// with fp32 copies).
+uint32_t stream_shared_bytes(detail::Workgroup2D wg, uint32_t radius, bool half_shared, uint32_t mode) {
   const uint32_t strip = 4 * wg.x, step = wg.y, skew = half_shared ? 4 : 3;
-  const uint32_t load_w = strip + 2 * radius;
+  const uint32_t load_w = (strip + 2 * radius) * (mode == 1 ? 2 : 1);
   const uint32_t load_s = load_w + ((load_w - 1) >> skew), row_s = strip + ((strip - 1) >> skew);
   return (half_shared ? 8 : 16) * (load_s * step + row_s * (step + 2 * radius)) + (half_shared ? 32 : 16);
 }
@@ -84,13 +85,14 @@ FusedShape fused_shape(const DeviceInfo& info, uint32_t radius, bool half_shared
       concat("blur radius ", radius));
 }
 
-bool stream_shape(const DeviceInfo& info, uint32_t radius, bool half_shared, detail::Workgroup2D& workgroup) {
+bool stream_shape(const DeviceInfo& info, uint32_t radius, bool half_shared, uint32_t mode,
+                  detail::Workgroup2D& workgroup) {
   // Strips of 64 columns walked 8 rows a step (128 invocations), then shorter and narrower ones for
   // large radii in fp32. Of the shapes measured on the H100 this one was the fastest (docs/BLUR.md
   // "Streamed separable").
   for (detail::Workgroup2D wg : {detail::Workgroup2D{16, 8}, {16, 4}, {8, 4}}) {
     if (wg.x * wg.y <= info.max_workgroup_invocations &&
-        stream_shared_bytes(wg, radius, half_shared) <= info.max_shared_memory_bytes) {
+        stream_shared_bytes(wg, radius, half_shared, mode) <= info.max_shared_memory_bytes) {
       workgroup = wg;
       return true;
     }
@@ -269,7 +271,7 @@ Step fused_step(StepProgram& prog, const DeviceInfo& info, int src, int dst, VkE
   const bool exact_half = src_size.width == 2 * dst_size.width && src_size.height == 2 * dst_size.height;
   const uint32_t mode = same ? 0u : exact_half ? 1u : 2u;
   detail::Workgroup2D stream;
-  if (mode <= 1 && kernel != SeparableKernel::tiles && stream_shape(info, radius, half_shared, stream) &&
+  if (mode <= 1 && kernel != SeparableKernel::tiles && stream_shape(info, radius, half_shared, mode, stream) &&
       (kernel == SeparableKernel::stream || stream_fills_device(info, dst_size, 4 * stream.x))) {
     // Two steps' rows in flight for a same-size read; one for the 2:1 mean, whose four fetches a
     // texel fill the registers (H100, 3-level BlurPyramid at 3840x2160: 94.0 us with one, 96.8 with

@@ -140,8 +140,10 @@ enum class SeparableKernel : uint32_t { device, stream, tiles, shuffle };
 bool down_shuffles_supported(const Context& context);
 
 /// The streamed kernel's workgroup (STRIP_W / 4 invocations across, STEP rows) of the widest strip
-/// whose shared memory and invocations fit the device, or none (false) where no strip fits.
-bool stream_shape(const DeviceInfo& info, uint32_t radius, bool half_shared, detail::Workgroup2D& workgroup);
+/// whose shared memory (for its source read `mode`: 0 same size, 1 the exact 2:1 mean) and
+/// invocations fit the device, or none (false) where no strip fits.
+bool stream_shape(const DeviceInfo& info, uint32_t radius, bool half_shared, uint32_t mode,
+                  detail::Workgroup2D& workgroup);
 
 /// Rows each workgroup of the streamed kernel writes for an image `width` x `height` with strips
 /// of `strip_width` columns: bands of at least kStreamMinBand rows (at most 2 RADIUS / band of the

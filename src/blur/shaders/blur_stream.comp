@@ -40,12 +40,17 @@ const int STRIP_W = int(gl_WorkGroupSize.x) * RUN;
 const int STEP = int(gl_WorkGroupSize.y);  // a multiple of RUN
 const int GROUP_SIZE = int(gl_WorkGroupSize.x) * int(gl_WorkGroupSize.y);
 const int LOAD_W = STRIP_W + 2 * RADIUS;
-const int LOADS = (LOAD_W * STEP + GROUP_SIZE - 1) / GROUP_SIZE;  // source texels per invocation and step
+// Loaded values per texel of a step's rows: MODE 1 loads the two columns of each 2x2 source box
+// separately, each the sum of its two rows, so that consecutive invocations fetch consecutive
+// source texels (the order of a copy) and the horizontal pass adds the two halves.
+const int HALVES = MODE == 1 ? 2 : 1;
+const int LOAD_V = LOAD_W * HALVES;                               // loaded values of a row
+const int LOADS = (LOAD_V * STEP + GROUP_SIZE - 1) / GROUP_SIZE;  // per invocation and step
 const int RING = STEP + 2 * RADIUS;
 const int WINDOW = RUN + 2 * RADIUS;
 const int SKEW = HALF_SHARED ? 4 : 3;
 int skew(int e) { return e + (e >> SKEW); }
-const int LOAD_S = LOAD_W + ((LOAD_W - 1) >> SKEW);
+const int LOAD_S = LOAD_V + ((LOAD_V - 1) >> SKEW);
 const int ROW_S = STRIP_W + ((STRIP_W - 1) >> SKEW);
 // fp32 or packed fp16 storage, selected by HALF_SHARED (the unused array is sized 1).
 const int SRC_F32 = HALF_SHARED ? 1 : LOAD_S * STEP;
@@ -74,20 +79,26 @@ ivec2 size;
 int x0, band, band_end, local_index, steps, ring_base, hx, hrow, vx, vrow;
 bool column_in;
 
-// Texel q of the destination grid (clamped to it) read from the source.
-vec4 load_source(ivec2 q) {
-  q = clamp(q, ivec2(0), size - 1);
-  if (MODE == 0) return src_texel(q);
-  ivec2 s = 2 * q;
-  return 0.25 * (src_texel(s) + src_texel(s + ivec2(1, 0)) + src_texel(s + ivec2(0, 1)) + src_texel(s + ivec2(1, 1)));
+// Loaded value i of the STEP rows from image row `row0` (row i / LOAD_V), for destination texel
+// q = (x0 - RADIUS + c, row) clamped to the destination grid: MODE 0's value c is q's source
+// texel; MODE 1's value 2 c + h is column h of q's 2x2 source box, summed over its two rows, and
+// 0.25 times the sum of q's two values is the box's mean (step_texel()).
+vec4 load_value(int i, int row0) {
+  const int c = i % LOAD_V, r = row0 + i / LOAD_V;
+  if (MODE != 1) return src_texel(clamp(ivec2(x0 - RADIUS + c, r), ivec2(0), size - 1));
+  const ivec2 s = 2 * clamp(ivec2(x0 - RADIUS + c / 2, r), ivec2(0), size - 1) + ivec2(c & 1, 0);
+  return src_texel(s) + src_texel(s + ivec2(0, 1));
 }
 
-// The source texels of the STEP rows from image row `row0`, each invocation's LOADS of them.
+// The loaded values of the STEP rows from image row `row0`, each invocation's LOADS of them.
 void fetch(out vec4 fetched[LOADS], int row0) {
-  [[unroll]] for (int n = 0; n < LOADS; ++n) {
-    int i = min(local_index + n * GROUP_SIZE, LOAD_W * STEP - 1);
-    fetched[n] = load_source(ivec2(x0 - RADIUS + i % LOAD_W, row0 + i / LOAD_W));
-  }
+  [[unroll]] for (int n = 0; n < LOADS; ++n) fetched[n] = load_value(min(local_index + n * GROUP_SIZE, LOAD_V * STEP - 1), row0);
+}
+
+// The horizontal pass's texel e of row `row` of the step's source rows.
+vec4 step_texel(int row, int e) {
+  if (MODE != 1) return get_src(row * LOAD_S + skew(e));
+  return 0.25 * (get_src(row * LOAD_S + skew(2 * e)) + get_src(row * LOAD_S + skew(2 * e + 1)));
 }
 
 // Step k: store its fetched rows, fetch those of step k + 2 into the same registers, filter the
@@ -96,7 +107,7 @@ void walk_step(int k, inout vec4 fetched[LOADS]) {
   const int hy = band - RADIUS + k * STEP;  // first row filtered along x in this step
   [[unroll]] for (int n = 0; n < LOADS; ++n) {
     int i = local_index + n * GROUP_SIZE;
-    if (i < LOAD_W * STEP) put_src((i / LOAD_W) * LOAD_S + skew(i % LOAD_W), fetched[n]);
+    if (i < LOAD_V * STEP) put_src((i / LOAD_V) * LOAD_S + skew(i % LOAD_V), fetched[n]);
   }
   barrier();  // also orders the previous step's vertical reads before this step's ring writes
   if (k + AHEAD < steps) fetch(fetched, hy + AHEAD * STEP);
@@ -104,7 +115,7 @@ void walk_step(int k, inout vec4 fetched[LOADS]) {
   // Horizontal pass: RUN outputs of row hy + hrow into its ring slot.
   {
     vec4 window[WINDOW];
-    [[unroll]] for (int t = 0; t < WINDOW; ++t) window[t] = get_src(hrow * LOAD_S + skew(hx + t));
+    [[unroll]] for (int t = 0; t < WINDOW; ++t) window[t] = step_texel(hrow, hx + t);
     const int slot = (hy + hrow + ring_base) % RING;
     [[unroll]] for (int r = 0; r < RUN; ++r) {
       vec4 sum = p.weights[0] * window[r + RADIUS];
