@@ -41,7 +41,7 @@ const int STEP = int(gl_WorkGroupSize.y);  // a multiple of RUN
 const int GROUP_SIZE = int(gl_WorkGroupSize.x) * int(gl_WorkGroupSize.y);
 const int LOAD_W = STRIP_W + 2 * RADIUS;
 // Loaded values per texel of a step's rows: MODE 1 loads the two columns of each 2x2 source box
-// separately, each the sum of its two rows, so that consecutive invocations fetch consecutive
+// separately, each the mean of its two rows, so that consecutive invocations fetch consecutive
 // source texels (the order of a copy) and the horizontal pass adds the two halves.
 const int HALVES = MODE == 1 ? 2 : 1;
 const int LOAD_V = LOAD_W * HALVES;                               // loaded values of a row
@@ -81,13 +81,15 @@ bool column_in;
 
 // Loaded value i of the STEP rows from image row `row0` (row i / LOAD_V), for destination texel
 // q = (x0 - RADIUS + c, row) clamped to the destination grid: MODE 0's value c is q's source
-// texel; MODE 1's value 2 c + h is column h of q's 2x2 source box, summed over its two rows, and
-// 0.25 times the sum of q's two values is the box's mean (step_texel()).
+// texel; MODE 1's value 2 c + h is column h of q's 2x2 source box averaged over its two rows, and
+// the mean of q's two values is the box's mean (step_texel()). Means, not sums, so that a value
+// never exceeds the largest texel (the fp16 shared copies hold the level's range; the scaling by
+// 0.5 is exact).
 vec4 load_value(int i, int row0) {
   const int c = i % LOAD_V, r = row0 + i / LOAD_V;
   if (MODE != 1) return src_texel(clamp(ivec2(x0 - RADIUS + c, r), ivec2(0), size - 1));
   const ivec2 s = 2 * clamp(ivec2(x0 - RADIUS + c / 2, r), ivec2(0), size - 1) + ivec2(c & 1, 0);
-  return src_texel(s) + src_texel(s + ivec2(0, 1));
+  return 0.5 * (src_texel(s) + src_texel(s + ivec2(0, 1)));
 }
 
 // The loaded values of the STEP rows from image row `row0`, each invocation's LOADS of them.
@@ -98,7 +100,7 @@ void fetch(out vec4 fetched[LOADS], int row0) {
 // The horizontal pass's texel e of row `row` of the step's source rows.
 vec4 step_texel(int row, int e) {
   if (MODE != 1) return get_src(row * LOAD_S + skew(e));
-  return 0.25 * (get_src(row * LOAD_S + skew(2 * e)) + get_src(row * LOAD_S + skew(2 * e + 1)));
+  return 0.5 * (get_src(row * LOAD_S + skew(2 * e)) + get_src(row * LOAD_S + skew(2 * e + 1)));
 }
 
 // Step k: store its fetched rows, fetch those of step k + 2 into the same registers, filter the
