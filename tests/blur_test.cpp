@@ -104,9 +104,11 @@ TEST_F(BlurTest, PyramidMatchesReferenceOnRandomInput) {
 // device: at 200x136 every level halves exactly (100x68, 50x34, 25x17), so each reads its source
 // as the exact 2:1 mean, which the streamed kernel takes (100 columns are two strips, 68 rows three
 // bands); at 97x61 only 48x30 -> 24x15 does, and the tiles run the other levels' any-ratio mean.
+// The streamed kernel loads the mean in four fetches a texel under `stream` and as two column
+// means under `gpu_order` (the test counts those steps).
 TEST_F(BlurTest, PyramidLevelsOnBothKernelsMatchTheReference) {
   using blur_steps::SeparableKernel;
-  for (SeparableKernel kernel : {SeparableKernel::stream, SeparableKernel::tiles}) {
+  for (SeparableKernel kernel : {SeparableKernel::stream, SeparableKernel::tiles, SeparableKernel::gpu_order}) {
     for (Precision precision : {Precision::fp32, Precision::fp16}) {
       BlurPyramidConfig config;
       config.sigma_texels = {1.2f, 0.8f, 2.0f};
@@ -116,16 +118,25 @@ TEST_F(BlurTest, PyramidLevelsOnBothKernelsMatchTheReference) {
       for (auto [w, h] : {std::pair<uint32_t, uint32_t>{200, 136}, {97, 61}}) {
         CpuImage input = random_hdr(w, h, w + h);
         input.at(w / 3, h / 2)[2] = std::nanf("");
+        // A 2x2 box of fp16's largest finite values: a sum of two of them would not fit an fp16
+        // shared copy (the column means must stay means).
+        for (uint32_t y : {2u, 3u})
+          for (uint32_t x : {4u, 5u})
+            for (int c = 0; c < 3; ++c) input.at(x, y)[c] = 65504.0f;
         const auto levels = run_pyramid(pyramid, input, precision == Precision::fp16 ? kF16 : kF32);
         uint32_t exact = 0;  // levels whose size is exactly half the one above
         for (uint32_t k = 1, pw = w, ph = h; k <= 3;
              pw = pyramid.level_size(k).width, ph = pyramid.level_size(k).height, ++k)
           exact += pw == 2 * pyramid.level_size(k).width && ph == 2 * pyramid.level_size(k).height;
-        EXPECT_EQ(detail::BlurAccess::streamed(pyramid), kernel == SeparableKernel::stream ? exact : 0u);
+        EXPECT_EQ(detail::BlurAccess::streamed(pyramid), kernel == SeparableKernel::tiles ? 0u : exact);
+        EXPECT_EQ(detail::BlurAccess::gpu_ordered(pyramid), kernel == SeparableKernel::gpu_order ? exact : 0u);
         const auto ref = reference::blur_pyramid(input, sigmas_of(config));
         for (int k = 0; k < 3; ++k) {
-          SCOPED_TRACE(testing::Message() << (kernel == SeparableKernel::stream ? "stream " : "tiles ") << w << "x" << h
-                                          << " level " << k + 1 << (precision == Precision::fp16 ? " fp16" : " fp32"));
+          SCOPED_TRACE(testing::Message()
+                       << (kernel == SeparableKernel::stream  ? "stream "
+                           : kernel == SeparableKernel::tiles ? "tiles "
+                                                              : "gpu_order ")
+                       << w << "x" << h << " level " << k + 1 << (precision == Precision::fp16 ? " fp16" : " fp32"));
           ASSERT_TRUE(all_finite(levels[k]));
           EXPECT_LT(reference::rgba_relative_l2(levels[k], ref[k]), precision == Precision::fp16 ? kTolFp16 : kTolFp32);
         }
@@ -337,7 +348,7 @@ TEST_F(BlurTest, StreamedAndTiledSeparableKernelsMatchTheReference) {
   const bool shuffles = blur_steps::down_shuffles_supported(context());
   const bool gpu = context().info().type != VK_PHYSICAL_DEVICE_TYPE_CPU;
   for (SeparableKernel kernel :
-       {SeparableKernel::device, SeparableKernel::stream, SeparableKernel::tiles, SeparableKernel::shuffle}) {
+       {SeparableKernel::device, SeparableKernel::stream, SeparableKernel::tiles, SeparableKernel::gpu_order}) {
     for (const MethodCase& c : cases) {
       for (Precision precision : {Precision::fp32, Precision::fp16}) {
         GaussianBlur blur(context(), config_of(c, precision));
@@ -345,10 +356,10 @@ TEST_F(BlurTest, StreamedAndTiledSeparableKernelsMatchTheReference) {
         const VkFormat format = precision == Precision::fp16 ? kF16 : kF32;
         for (auto [w, h] : sizes) {
           const std::string where = describe(c) +
-                                    (kernel == SeparableKernel::device    ? " device"
-                                     : kernel == SeparableKernel::stream  ? " stream"
-                                     : kernel == SeparableKernel::shuffle ? " shuffle"
-                                                                          : " tiles") +
+                                    (kernel == SeparableKernel::device      ? " device"
+                                     : kernel == SeparableKernel::stream    ? " stream"
+                                     : kernel == SeparableKernel::gpu_order ? " gpu_order"
+                                                                            : " tiles") +
                                     (precision == Precision::fp16 ? " fp16 " : " fp32 ") + std::to_string(w) + "x" +
                                     std::to_string(h);
           SCOPED_TRACE(where);
@@ -372,10 +383,11 @@ TEST_F(BlurTest, StreamedAndTiledSeparableKernelsMatchTheReference) {
             EXPECT_GE(streamed, pyramid_steps);
           }
           // The downsamples gather their taps where the selection asks for it and the device can:
-          // `shuffle` everywhere, `device` on GPUs.
+          // `gpu_order` everywhere, `device` on GPUs (GaussianBlur's level blurs read same-size
+          // sources, which have one load order).
           const bool gathered =
-              shuffles && (kernel == SeparableKernel::shuffle || (kernel == SeparableKernel::device && gpu));
-          EXPECT_EQ(detail::BlurAccess::shuffled(blur),
+              shuffles && (kernel == SeparableKernel::gpu_order || (kernel == SeparableKernel::device && gpu));
+          EXPECT_EQ(detail::BlurAccess::gpu_ordered(blur),
                     gathered && c.method == BlurMethod::pyramid ? blur.choice().levels : 0u);
           ASSERT_TRUE(all_finite(out)) << "unwritten or non-finite texels";
           EXPECT_LT(reference::rgba_relative_l2(out, reference_of(blur, stored)),

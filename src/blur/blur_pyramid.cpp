@@ -97,6 +97,10 @@ uint32_t detail::BlurAccess::streamed(const BlurPyramid& pyramid) {
   return pyramid.impl_->cur ? pyramid.impl_->cur->prog.streamed_steps() : 0;
 }
 
+uint32_t detail::BlurAccess::gpu_ordered(const BlurPyramid& pyramid) {
+  return pyramid.impl_->cur ? pyramid.impl_->cur->prog.gpu_order_steps() : 0;
+}
+
 void BlurPyramid::set_config(const BlurPyramidConfig& config) {
   config.validate();
   impl_->config = config;

@@ -35,9 +35,9 @@ uint32_t fused_shared_bytes(FusedShape s, uint32_t radius, bool half_shared) {
 // one element every 2^SKEW (16 elements of 8 bytes in fp16, 8 of 16 in fp32), plus the unused
 // arrays' one element each (two fp32 elements of 16 bytes with fp16 copies, two packed ones of 8
 // with fp32 copies).
-uint32_t stream_shared_bytes(detail::Workgroup2D wg, uint32_t radius, bool half_shared, uint32_t mode) {
+uint32_t stream_shared_bytes(detail::Workgroup2D wg, uint32_t radius, bool half_shared, bool split_mean) {
   const uint32_t strip = 4 * wg.x, step = wg.y, skew = half_shared ? 4 : 3;
-  const uint32_t load_w = (strip + 2 * radius) * (mode == 1 ? 2 : 1);
+  const uint32_t load_w = (strip + 2 * radius) * (split_mean ? 2 : 1);
   const uint32_t load_s = load_w + ((load_w - 1) >> skew), row_s = strip + ((strip - 1) >> skew);
   return (half_shared ? 8 : 16) * (load_s * step + row_s * (step + 2 * radius)) + (half_shared ? 32 : 16);
 }
@@ -85,14 +85,14 @@ FusedShape fused_shape(const DeviceInfo& info, uint32_t radius, bool half_shared
       concat("blur radius ", radius));
 }
 
-bool stream_shape(const DeviceInfo& info, uint32_t radius, bool half_shared, uint32_t mode,
+bool stream_shape(const DeviceInfo& info, uint32_t radius, bool half_shared, bool split_mean,
                   detail::Workgroup2D& workgroup) {
   // Strips of 64 columns walked 8 rows a step (128 invocations), then shorter and narrower ones for
   // large radii in fp32. Of the shapes measured on the H100 this one was the fastest (docs/BLUR.md
   // "Streamed separable").
   for (detail::Workgroup2D wg : {detail::Workgroup2D{16, 8}, {16, 4}, {8, 4}}) {
     if (wg.x * wg.y <= info.max_workgroup_invocations &&
-        stream_shared_bytes(wg, radius, half_shared, mode) <= info.max_shared_memory_bytes) {
+        stream_shared_bytes(wg, radius, half_shared, split_mean) <= info.max_shared_memory_bytes) {
       workgroup = wg;
       return true;
     }
@@ -167,8 +167,13 @@ bool down_shuffles_supported(const Context& context) {
   return (s.compute_subgroup_operations & need) == need;
 }
 
-uint32_t StepProgram::shuffled_steps() const {
-  return static_cast<uint32_t>(std::count_if(steps.begin(), steps.end(), [](const Step& s) { return s.shuffled; }));
+uint32_t StepProgram::gpu_order_steps() const {
+  return static_cast<uint32_t>(std::count_if(steps.begin(), steps.end(), [](const Step& s) { return s.gpu_order; }));
+}
+
+bool gpu_order(const DeviceInfo& info, SeparableKernel kernel) {
+  return kernel == SeparableKernel::gpu_order ||
+         (kernel == SeparableKernel::device && info.type != VK_PHYSICAL_DEVICE_TYPE_CPU);
 }
 
 uint32_t StepProgram::streamed_steps() const {
@@ -270,19 +275,25 @@ Step fused_step(StepProgram& prog, const DeviceInfo& info, int src, int dst, VkE
   const bool same = src_size.width == dst_size.width && src_size.height == dst_size.height;
   const bool exact_half = src_size.width == 2 * dst_size.width && src_size.height == 2 * dst_size.height;
   const uint32_t mode = same ? 0u : exact_half ? 1u : 2u;
+  // The 2:1 mean loaded as two column means in copy order (blur_stream.comp, SPLIT_MEAN) where the
+  // loads are ordered for GPUs (SeparableKernel): on lavapipe it made the 3-level BlurPyramid about
+  // a third slower.
+  const bool split_mean = mode == 1 && gpu_order(info, kernel);
   detail::Workgroup2D stream;
-  if (mode <= 1 && kernel != SeparableKernel::tiles && stream_shape(info, radius, half_shared, mode, stream) &&
-      (kernel == SeparableKernel::stream || stream_fills_device(info, dst_size, 4 * stream.x))) {
+  if (mode <= 1 && kernel != SeparableKernel::tiles && stream_shape(info, radius, half_shared, split_mean, stream) &&
+      (kernel == SeparableKernel::stream || kernel == SeparableKernel::gpu_order ||
+       stream_fills_device(info, dst_size, 4 * stream.x))) {
     // Two steps' rows in flight for a same-size read; one for the 2:1 mean, whose four fetches a
     // texel fill the registers (H100, 3-level BlurPyramid at 3840x2160: 94.0 us with one, 96.8 with
     // two, 124.7 with the tiles).
     const uint32_t ahead = mode == 0 ? 2u : 1u;
-    const detail::ComputePipeline& pipeline =
-        prog.pipeline("blur_stream", dst_format, stream, {radius, half_shared ? 1u : 0u, mode, ahead},
-                      {VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
+    const detail::ComputePipeline& pipeline = prog.pipeline(
+        "blur_stream", dst_format, stream, {radius, half_shared ? 1u : 0u, mode, ahead, split_mean ? 1u : 0u},
+        {VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
     const uint32_t band = stream_band_rows(dst_size.width, dst_size.height, 4 * stream.x);
     Step s = make_step(pipeline, src, dst, src_size, dst_size, flags, max_value, 1, std::move(label), band);
     for (uint32_t t = 0; t <= radius; ++t) s.push.weights[t] = static_cast<float>(w[t]);
+    s.gpu_order = split_mean;
     s.invocations_x = (dst_size.width + 3) / 4;                        // RUN columns per invocation
     s.invocations_y = (dst_size.height + band - 1) / band * stream.y;  // a workgroup row of stream.y a band
     s.rows = 0;  // its invocation rows are the steps of a walk, not output rows (Step::rows)
@@ -356,15 +367,13 @@ Step down_step(StepProgram& prog, const DeviceInfo& info, int src, int dst, VkEx
   }
   if (kernel != SeparableKernel::tiles) {
     // 64 columns by one band of rows a workgroup; no shared memory, so it fits every device.
-    const bool shuffled = (kernel == SeparableKernel::shuffle ||
-                           (kernel == SeparableKernel::device && info.type != VK_PHYSICAL_DEVICE_TYPE_CPU)) &&
-                          down_shuffles_supported(*prog.context);
+    const bool shuffled = gpu_order(info, kernel) && down_shuffles_supported(*prog.context);
     const detail::ComputePipeline& pipeline =
         prog.pipeline(shuffled ? "blur_down_stream_shuffle" : "blur_down_stream", dst_format, {64, 1}, {},
                       {VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE});
     const uint32_t band = shuffled ? kDownShuffleBandRows : kDownBandRows;
     Step step = make_step(pipeline, src, dst, src_size, dst_size, flags, max_value, band, std::move(label), band);
-    step.shuffled = shuffled;
+    step.gpu_order = shuffled;
     return step;
   }
   // Output tiles of 32x8 on GPUs (a source block of 66x18), 16x8 on CPU devices. Shared memory:

@@ -68,8 +68,9 @@ struct Step {
   bool sampler = false;  // binding 0 is a combined image sampler
   // Runs a streamed kernel (blur_stream.comp, blur_down_stream.comp, blur_upsample_stream.comp).
   bool streamed = false;
-  // Runs blur_down_stream.comp's shuffle variant (the taps gathered through subgroup shuffles).
-  bool shuffled = false;
+  // Loads in the order chosen for GPUs (gpu_order()): blur_down_stream.comp's shuffle variant (the
+  // taps gathered through subgroup shuffles) or blur_stream.comp's 2:1 mean as column means.
+  bool gpu_order = false;
   const detail::OwnedBuffer* taps = nullptr;  // binding 2
   std::string label;
 };
@@ -94,8 +95,8 @@ struct StepProgram {
 
   /// Steps that run a streamed kernel (blur_stream.comp, blur_down_stream.comp, blur_upsample_stream.comp).
   uint32_t streamed_steps() const;
-  /// Steps that run blur_down_stream.comp's shuffle variant.
-  uint32_t shuffled_steps() const;
+  /// Steps marked Step::gpu_order.
+  uint32_t gpu_order_steps() const;
 
   // Owned images can also be copied from (BlurPyramid hands its levels to the caller).
   int add_image(VkExtent2D e, VkFormat f);
@@ -125,13 +126,19 @@ VkExtent2D half_extent(VkExtent2D e);
 /// (stream_fills_device()); else the tiles. `stream` drops the second condition and `tiles` forces
 /// the tiled kernel (tests and benchmarks, through detail::BlurAccess). The pyramid's downsamples
 /// (down_step) and upsample (upsample_step) take the same choice: streamed unless `tiles`; under
-/// `device` the downsamples of a GPU fetch each row in copy order and gather their taps through
-/// subgroup shuffles where it has them (blur_down_stream.comp's shuffle variants, which
-/// down_shuffles_supported() checks), while CPU devices keep four fetches a row (there the
-/// gathered form measured slower: docs/perf/blur_down_stream_ab.txt). `shuffle` is `device` with
-/// the gathered downsamples wherever they can run, CPU devices included, and `stream` keeps the
-/// four fetches everywhere, so that the tests run both forms on every device that shuffles.
-enum class SeparableKernel : uint32_t { device, stream, tiles, shuffle };
+/// `device` a GPU's loads take the order of a copy (gpu_order()): the downsamples fetch each row
+/// in copy order and gather their taps through subgroup shuffles where it has them
+/// (blur_down_stream.comp's shuffle variants, which down_shuffles_supported() checks), and the
+/// streamed level blur loads a 2:1 mean as two column means (blur_stream.comp, SPLIT_MEAN); CPU
+/// devices keep four fetches a texel, where the other orders measured slower
+/// (docs/perf/blur_down_stream_ab.txt). `gpu_order` is `stream` with those loads on every device,
+/// CPU devices included, and `stream` keeps the four fetches everywhere, so that the tests run
+/// both forms on every device.
+enum class SeparableKernel : uint32_t { device, stream, tiles, gpu_order };
+
+/// Whether a step under `kernel` on `info`'s device takes the loads ordered for GPUs: `gpu_order`,
+/// or `device` on a device that is not a CPU.
+bool gpu_order(const DeviceInfo& info, SeparableKernel kernel);
 
 /// Whether `context`'s device can run blur_down_stream.comp's shuffle variants: it shuffles and
 /// broadcasts in compute, and every subgroup size it may pick divides the kernel's 64-wide
@@ -140,9 +147,9 @@ enum class SeparableKernel : uint32_t { device, stream, tiles, shuffle };
 bool down_shuffles_supported(const Context& context);
 
 /// The streamed kernel's workgroup (STRIP_W / 4 invocations across, STEP rows) of the widest strip
-/// whose shared memory (for its source read `mode`: 0 same size, 1 the exact 2:1 mean) and
-/// invocations fit the device, or none (false) where no strip fits.
-bool stream_shape(const DeviceInfo& info, uint32_t radius, bool half_shared, uint32_t mode,
+/// whose shared memory (twice the source rows where the 2:1 mean is loaded as column means,
+/// `split_mean`) and invocations fit the device, or none (false) where no strip fits.
+bool stream_shape(const DeviceInfo& info, uint32_t radius, bool half_shared, bool split_mean,
                   detail::Workgroup2D& workgroup);
 
 /// Rows each workgroup of the streamed kernel writes for an image `width` x `height` with strips
@@ -182,9 +189,9 @@ inline constexpr uint32_t kUpBandRows = 64;
 // The pyramid's binomial downsample of an exact 2:1 step from `src` to `dst`: the streamed kernel
 // (src/blur/shaders/blur_down_stream.comp: one destination column and kDownBandRows rows per
 // invocation, marked Step::streamed; with subgroup shuffles and kDownShuffleBandRows rows, marked
-// Step::shuffled, under `device` on GPUs and under `shuffle`, as SeparableKernel says) unless `kernel` is tiles, which
-// forces the tiled one (src/blur/shaders/blur_down.comp, its tile shape from the device as upsample_step's) for the
-// tests and benchmarks that compare them.
+// Step::gpu_order, under `device` on GPUs and under `gpu_order`, as SeparableKernel says) unless `kernel` is tiles,
+// which forces the tiled one (src/blur/shaders/blur_down.comp, its tile shape from the device as upsample_step's) for
+// the tests and benchmarks that compare them.
 Step down_step(StepProgram& prog, const DeviceInfo& info, int src, int dst, VkExtent2D src_size, VkExtent2D dst_size,
                VkFormat dst_format, uint32_t flags, float max_value, std::string label,
                SeparableKernel kernel = SeparableKernel::device);
@@ -217,8 +224,9 @@ struct BlurAccess {
   /// level blur's or the downsample's).
   static uint32_t streamed(const GaussianBlur& blur);
   static uint32_t streamed(const BlurPyramid& pyramid);
-  /// How many of those steps are downsamples that gather their taps through subgroup shuffles.
-  static uint32_t shuffled(const GaussianBlur& blur);
+  /// How many steps load in the order chosen for GPUs (Step::gpu_order).
+  static uint32_t gpu_ordered(const GaussianBlur& blur);
+  static uint32_t gpu_ordered(const BlurPyramid& pyramid);
 };
 
 }  // namespace glint::detail

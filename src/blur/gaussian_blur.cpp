@@ -401,8 +401,8 @@ uint32_t detail::BlurAccess::streamed(const GaussianBlur& blur) {
   return blur.impl_->cur ? blur.impl_->cur->prog.streamed_steps() : 0;
 }
 
-uint32_t detail::BlurAccess::shuffled(const GaussianBlur& blur) {
-  return blur.impl_->cur ? blur.impl_->cur->prog.shuffled_steps() : 0;
+uint32_t detail::BlurAccess::gpu_ordered(const GaussianBlur& blur) {
+  return blur.impl_->cur ? blur.impl_->cur->prog.gpu_order_steps() : 0;
 }
 
 void GaussianBlur::release_unused() { impl_->cache.release_unused(impl_->cur); }

@@ -26,6 +26,9 @@ layout(constant_id = 2) const int RADIUS = 4;        // taps 2 * RADIUS + 1
 layout(constant_id = 3) const bool HALF_SHARED = false;  // shared copies as packed fp16
 layout(constant_id = 4) const int MODE = 0;   // source read: 0 same size, 1 exact 2:1 area (2x2 mean)
 layout(constant_id = 5) const int AHEAD = 2;  // steps whose source rows are in flight (1 or 2)
+// MODE 1: load each 2x2 box as two column means in the order of a copy (GPUs) instead of four
+// fetches per invocation (CPU devices, where the extra shared traffic made it slower).
+layout(constant_id = 6) const bool SPLIT_MEAN = false;
 
 layout(binding = 0) uniform texture2D src;
 #include "dst_image.glsl"
@@ -40,10 +43,10 @@ const int STRIP_W = int(gl_WorkGroupSize.x) * RUN;
 const int STEP = int(gl_WorkGroupSize.y);  // a multiple of RUN
 const int GROUP_SIZE = int(gl_WorkGroupSize.x) * int(gl_WorkGroupSize.y);
 const int LOAD_W = STRIP_W + 2 * RADIUS;
-// Loaded values per texel of a step's rows: MODE 1 loads the two columns of each 2x2 source box
-// separately, each the mean of its two rows, so that consecutive invocations fetch consecutive
-// source texels (the order of a copy) and the horizontal pass adds the two halves.
-const int HALVES = MODE == 1 ? 2 : 1;
+// Loaded values per texel of a step's rows: with SPLIT_MEAN, MODE 1 loads the two columns of each
+// 2x2 source box separately, each the mean of its two rows, so that consecutive invocations fetch
+// consecutive source texels (the order of a copy) and the horizontal pass averages the two.
+const int HALVES = MODE == 1 && SPLIT_MEAN ? 2 : 1;
 const int LOAD_V = LOAD_W * HALVES;                               // loaded values of a row
 const int LOADS = (LOAD_V * STEP + GROUP_SIZE - 1) / GROUP_SIZE;  // per invocation and step
 const int RING = STEP + 2 * RADIUS;
@@ -81,13 +84,19 @@ bool column_in;
 
 // Loaded value i of the STEP rows from image row `row0` (row i / LOAD_V), for destination texel
 // q = (x0 - RADIUS + c, row) clamped to the destination grid: MODE 0's value c is q's source
-// texel; MODE 1's value 2 c + h is column h of q's 2x2 source box averaged over its two rows, and
+// texel, MODE 1's the mean of its 2x2 source box; with SPLIT_MEAN, MODE 1's value 2 c + h is
+// column h of q's 2x2 source box averaged over its two rows, and
 // the mean of q's two values is the box's mean (step_texel()). Means, not sums, so that a value
 // never exceeds the largest texel (the fp16 shared copies hold the level's range; the scaling by
 // 0.5 is exact).
 vec4 load_value(int i, int row0) {
   const int c = i % LOAD_V, r = row0 + i / LOAD_V;
-  if (MODE != 1) return src_texel(clamp(ivec2(x0 - RADIUS + c, r), ivec2(0), size - 1));
+  if (HALVES == 1) {
+    const ivec2 q = clamp(ivec2(x0 - RADIUS + c, r), ivec2(0), size - 1);
+    if (MODE == 0) return src_texel(q);
+    const ivec2 s = 2 * q;  // MODE 1 in four fetches
+    return 0.25 * (src_texel(s) + src_texel(s + ivec2(1, 0)) + src_texel(s + ivec2(0, 1)) + src_texel(s + ivec2(1, 1)));
+  }
   const ivec2 s = 2 * clamp(ivec2(x0 - RADIUS + c / 2, r), ivec2(0), size - 1) + ivec2(c & 1, 0);
   return 0.5 * (src_texel(s) + src_texel(s + ivec2(0, 1)));
 }
@@ -99,7 +108,7 @@ void fetch(out vec4 fetched[LOADS], int row0) {
 
 // The horizontal pass's texel e of row `row` of the step's source rows.
 vec4 step_texel(int row, int e) {
-  if (MODE != 1) return get_src(row * LOAD_S + skew(e));
+  if (HALVES == 1) return get_src(row * LOAD_S + skew(e));
   return 0.5 * (get_src(row * LOAD_S + skew(2 * e)) + get_src(row * LOAD_S + skew(2 * e + 1)));
 }
 
