@@ -11,7 +11,10 @@ with --cpu the cell says so and "met" stays blank). Times of 10 ms or more print
         --peer bloom=bloom_torch.json --peer blur=blur_torch.json --peer occlusion=occlusion_torch.json \
         --peer object_cull=object_cull_torch.json
 
-Peer files are those bench/peers/*.py write; a missing peer leaves its column blank.
+Peer files are those bench/peers/*.py write; a missing peer leaves its column blank. --glint may be
+given once per glint_bench run (a device call's time limit can split the rows over several runs):
+a row takes its time and its copy from the first run that holds it. --not-h100 marks a GPU other
+than the H100 the targets were set on (the target cell names the H100, "met" stays blank).
 
 CPU devices (lavapipe) take some rows at a smaller size (CPU_SIZES: a row whose run would take
 minutes per repetition there); --cpu selects that row set, and the label names the size run.
@@ -151,11 +154,15 @@ def fmt_us(t):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--glint", help="glint_bench JSON")
+    ap.add_argument("--glint", action="append", default=[],
+                    help="glint_bench JSON; several runs may be given (each row's copy comes from its own run)")
     ap.add_argument("--peer", action="append", default=[], help="KIND=FILE, KIND one of bloom, blur, occlusion, "
                     "object_cull")
     ap.add_argument("--commit")
     ap.add_argument("--cpu", action="store_true", help="the CPU-device row set (CPU_SIZES)")
+    ap.add_argument("--not-h100", action="store_true",
+                    help="a GPU other than the H100 the targets were set on: the target cell names the H100 and "
+                    "\"met\" stays blank")
     ap.add_argument("--filter", action="store_true", help="print the rows' --benchmark_filter and exit")
     args = ap.parse_args()
     rows = sized_rows(args.cpu)
@@ -164,7 +171,15 @@ def main():
         return
     if not args.glint or not args.commit:
         ap.error("--glint and --commit are required (or --filter)")
-    g, ctx, errors = glint_medians(args.glint)
+    # Each run's medians, in order; a row takes its time and its copy from the first run that holds it.
+    runs = [glint_medians(path) for path in args.glint]
+    ctx = runs[0][1] if runs else {}
+    errors = {k: v for r in runs for k, v in r[2].items()}
+    g, run_of = {}, {}
+    for i, (medians, _, _) in enumerate(runs):
+        for k, v in medians.items():
+            if k not in g:
+                g[k], run_of[k] = v, i
     peers = peer_medians(args.peer)
     print("| job | glint median | copy of the same image | glint / copy | best peer | peer / glint | commit | target "
           "| met |")
@@ -175,11 +190,13 @@ def main():
             missing.append((label, name))
             continue
         t = g[name]
-        f = g.get(f"BM_CopyFloor/w:{floor.split('x')[0]}/h:{floor.split('x')[1]}") if floor else None
+        copy = f"BM_CopyFloor/w:{floor.split('x')[0]}/h:{floor.split('x')[1]}" if floor else None
+        f = runs[run_of[name]][0].get(copy) if copy else None
         p = peers.get(peer) if peer else None
-        # Targets are the H100's: on a CPU device the cell says so and "met" stays blank.
-        tcell = (f"{target} us on an H100" if args.cpu else f"{target} us") if target else ""
-        met = ("yes" if t <= target else "no") if target and not args.cpu else ""
+        # Targets are the H100's: on another device the cell says so and "met" stays blank.
+        other = args.cpu or args.not_h100
+        tcell = (f"{target} us on an H100" if other else f"{target} us") if target else ""
+        met = ("yes" if t <= target else "no") if target and not other else ""
         cells = [label, fmt_us(t), fmt_us(f) if f else "", f"{t / f:.1f}x" if f else "",
                  f"{p[1]}: {p[0]:.0f} us" if p else "", f"{p[0] / t:.1f}x" if p else "", args.commit, tcell, met]
         print("| " + " | ".join(cells) + " |")
