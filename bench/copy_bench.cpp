@@ -1,7 +1,10 @@
 // The copy-bandwidth floor, measured in the same run as the effects: a compute kernel that reads
 // one RGBA16F image and writes another (src/bloom/shaders/image_copy.comp), timed with timestamps. Effects
-// quote their time as a ratio to this (docs/PERF.md).
+// quote their time as a ratio to this (docs/PERF.md, "The floor").
 #include <benchmark/benchmark.h>
+
+#include <string>
+#include <vector>
 
 #include "bench_support.h"
 #include "bloom/shaders/bloom_params.h"
@@ -13,43 +16,77 @@
 namespace glint::bench {
 namespace {
 
-void BM_CopyFloor(benchmark::State& state) {
-  const auto width = static_cast<uint32_t>(state.range(0));
-  const auto height = static_cast<uint32_t>(state.range(1));
-  const Context& ctx = context();
-  auto [src, dst] = rgba16f_pair(ctx, {width, height}, 7);
+constexpr int kCopies = 16;
+
+detail::ComputePipeline copy_pipeline(const Context& ctx, detail::Workgroup2D workgroup) {
   detail::PipelineDesc desc;
   desc.kernel_id = "image_copy_rgba16f";
   desc.bindings = {VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE};
   desc.push_constant_bytes = sizeof(BloomPush);
-  desc.workgroup = detail::choose_workgroup_2d(ctx);
-  detail::ComputePipeline copy(ctx, desc);
+  desc.workgroup = workgroup;
+  return detail::ComputePipeline(ctx, desc);
+}
+
+// Records one copy of `src` into `dst` (both width x height) with the image_copy kernel.
+void record_copy(VkCommandBuffer cmd, ImagePair& images, const detail::ComputePipeline& copy, uint32_t width,
+                 uint32_t height) {
+  detail::Barriers b;
+  b.use(images.src.state, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+        VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
+  b.use(images.dst.state, VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+        VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+  b.flush(cmd);
   BloomPush push{};
   push.dst_width = static_cast<int32_t>(width);
   push.dst_height = static_cast<int32_t>(height);
-  constexpr int kCopies = 16;
-  Profiler profiler(ctx, kCopies + 1);
-  std::vector<double> all;
-  for (auto _ : state) {
-    const double m = median_frame_ms(ctx, profiler, kCopies, [&](VkCommandBuffer cmd) {
-      detail::Barriers b;
-      b.use(src.state, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-            VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
-      b.use(dst.state, VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-            VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
-      b.flush(cmd);
-      copy.dispatch(
-          cmd, {{src.state.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL}, {dst.state.view, VK_IMAGE_LAYOUT_GENERAL}},
-          push, width, height);
-    });
-    all.push_back(m);
-    state.SetIterationTime(m * 1e-3);
-  }
+  copy.dispatch(cmd,
+                {{images.src.state.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL},
+                 {images.dst.state.view, VK_IMAGE_LAYOUT_GENERAL}},
+                push, width, height);
+}
+
+void set_copy_counters(benchmark::State& state, uint32_t width, uint32_t height, const std::vector<double>& ms) {
   const double bytes = double(width) * height * 16.0;  // 8 bytes read + 8 written per texel
   state.counters["bytes_per_second"] = benchmark::Counter(bytes, benchmark::Counter::kIsIterationInvariantRate);
-  state.counters["median_us"] = median_of(all) * 1e3;
+  state.counters["median_us"] = median_of(ms) * 1e3;
   state.counters["floor_bytes"] = bytes;
-  state.SetLabel("RGBA16F image copy on " + ctx.info().name);
+}
+
+// The floor is the fastest copy the kernel makes: each iteration times it in the device's 2D
+// workgroup (the shape glint's simple 2D kernels run in) and in 32x8 and 64x4, and keeps the
+// fastest shape's median. On the H200 32x8 copied 3840x2160 in 43.4 us against 48.1 in 16x8, and
+// 1920x1080 in 10.0 against 14.2 (docs/PERF.md, "The floor"); counters workgroup_x/y name the
+// shape that won the last iteration.
+void BM_CopyFloor(benchmark::State& state) {
+  const auto width = static_cast<uint32_t>(state.range(0));
+  const auto height = static_cast<uint32_t>(state.range(1));
+  const Context& ctx = context();
+  auto images = rgba16f_pair(ctx, {width, height}, 7);
+  std::vector<detail::Workgroup2D> shapes = {detail::choose_workgroup_2d(ctx)};
+  for (detail::Workgroup2D s : {detail::Workgroup2D{32, 8}, detail::Workgroup2D{64, 4}}) {
+    const bool listed = s.x == shapes[0].x && s.y == shapes[0].y;
+    if (!listed && s.x * s.y <= ctx.info().max_workgroup_invocations) shapes.push_back(s);
+  }
+  std::vector<detail::ComputePipeline> copies;
+  for (detail::Workgroup2D s : shapes) copies.push_back(copy_pipeline(ctx, s));
+  Profiler profiler(ctx, kCopies + 1);
+  std::vector<double> all;
+  detail::Workgroup2D won = shapes[0];
+  for (auto _ : state) {
+    double best = 0;
+    for (size_t i = 0; i < copies.size(); ++i) {
+      const double m = median_frame_ms(
+          ctx, profiler, kCopies, [&](VkCommandBuffer cmd) { record_copy(cmd, images, copies[i], width, height); });
+      if (i == 0 || m < best) best = m, won = shapes[i];
+    }
+    all.push_back(best);
+    state.SetIterationTime(best * 1e-3);
+  }
+  set_copy_counters(state, width, height, all);
+  state.counters["workgroup_x"] = won.x;
+  state.counters["workgroup_y"] = won.y;
+  state.SetLabel("RGBA16F image copy (" + std::to_string(won.x) + "x" + std::to_string(won.y) + ") on " +
+                 ctx.info().name);
 }
 
 BENCHMARK(BM_CopyFloor)
@@ -62,63 +99,48 @@ BENCHMARK(BM_CopyFloor)
     ->Unit(benchmark::kMicrosecond);
 
 // The same bytes moved other ways, so that the floor above can be judged against the device's
-// other copy paths (docs/PERF.md, "The floor"): method 0 is BM_CopyFloor's kernel (the 2D
-// workgroup the device gets), 1 and 2 the same kernel in 8x8 and 32x8 workgroups, 3
-// vkCmdCopyImage between the two images, 4 vkCmdCopyBuffer of 8 bytes a texel between buffers.
+// other copy paths (docs/PERF.md, "The floor"): the image_copy kernel in the device's 2D workgroup
+// (method 0), in 8x8 (1) and in 32x8 (2); vkCmdCopyImage between the two images (3);
+// vkCmdCopyBuffer of 8 bytes a texel between two buffers (4).
 void BM_CopyFloorMethods(benchmark::State& state) {
   const auto method = static_cast<int>(state.range(0));
   const auto width = static_cast<uint32_t>(state.range(1));
   const auto height = static_cast<uint32_t>(state.range(2));
   const Context& ctx = context();
-  auto [src, dst] = rgba16f_pair(ctx, {width, height}, 7);
+  auto images = rgba16f_pair(ctx, {width, height}, 7);
   const VkDeviceSize bytes_each = VkDeviceSize(width) * height * 8;
+  constexpr VkBufferUsageFlags kSrcUsage = VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
   detail::OwnedBuffer src_buffer, dst_buffer;
   Buffer src_use, dst_use;
   if (method == 4) {
-    src_buffer = detail::OwnedBuffer(ctx, bytes_each,
-                                     VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT, false);
+    src_buffer = detail::OwnedBuffer(ctx, bytes_each, kSrcUsage, false);
     dst_buffer = detail::OwnedBuffer(ctx, bytes_each, VK_BUFFER_USAGE_TRANSFER_DST_BIT, false);
-    src_use = {src_buffer.buffer(), 0, bytes_each, VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT};
+    src_use = {src_buffer.buffer(), 0, bytes_each, kSrcUsage};
     dst_use = {dst_buffer.buffer(), 0, bytes_each, VK_BUFFER_USAGE_TRANSFER_DST_BIT};
   }
-  detail::PipelineDesc desc;
-  desc.kernel_id = "image_copy_rgba16f";
-  desc.bindings = {VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE};
-  desc.push_constant_bytes = sizeof(BloomPush);
-  desc.workgroup = method == 1   ? detail::Workgroup2D{8, 8}
-                   : method == 2 ? detail::Workgroup2D{32, 8}
-                                 : detail::choose_workgroup_2d(ctx);
-  detail::ComputePipeline copy(ctx, desc);
-  BloomPush push{};
-  push.dst_width = static_cast<int32_t>(width);
-  push.dst_height = static_cast<int32_t>(height);
-  constexpr int kCopies = 16;
+  const detail::ComputePipeline copy = copy_pipeline(ctx, method == 1   ? detail::Workgroup2D{8, 8}
+                                                          : method == 2 ? detail::Workgroup2D{32, 8}
+                                                                        : detail::choose_workgroup_2d(ctx));
   Profiler profiler(ctx, kCopies + 1);
   std::vector<double> all;
   for (auto _ : state) {
     const double m = median_frame_ms(ctx, profiler, kCopies, [&](VkCommandBuffer cmd) {
-      detail::Barriers b;
       if (method <= 2) {
-        b.use(src.state, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-              VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
-        b.use(dst.state, VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-              VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
-        b.flush(cmd);
-        copy.dispatch(
-            cmd,
-            {{src.state.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL}, {dst.state.view, VK_IMAGE_LAYOUT_GENERAL}},
-            push, width, height);
-      } else if (method == 3) {
-        b.use(src.state, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_PIPELINE_STAGE_2_COPY_BIT,
+        record_copy(cmd, images, copy, width, height);
+        return;
+      }
+      detail::Barriers b;
+      if (method == 3) {
+        b.use(images.src.state, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_PIPELINE_STAGE_2_COPY_BIT,
               VK_ACCESS_2_TRANSFER_READ_BIT);
-        b.use(dst.state, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_PIPELINE_STAGE_2_COPY_BIT,
+        b.use(images.dst.state, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_PIPELINE_STAGE_2_COPY_BIT,
               VK_ACCESS_2_TRANSFER_WRITE_BIT);
         b.flush(cmd);
         VkImageCopy region{};
         region.srcSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
         region.dstSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
         region.extent = {width, height, 1};
-        vkCmdCopyImage(cmd, src.state.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, dst.state.image,
+        vkCmdCopyImage(cmd, images.src.state.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, images.dst.state.image,
                        VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
       } else {
         b.use(src_use, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
@@ -131,10 +153,7 @@ void BM_CopyFloorMethods(benchmark::State& state) {
     all.push_back(m);
     state.SetIterationTime(m * 1e-3);
   }
-  const double bytes = double(width) * height * 16.0;  // 8 bytes read + 8 written per texel
-  state.counters["bytes_per_second"] = benchmark::Counter(bytes, benchmark::Counter::kIsIterationInvariantRate);
-  state.counters["median_us"] = median_of(all) * 1e3;
-  state.counters["floor_bytes"] = bytes;
+  set_copy_counters(state, width, height, all);
   static const char* const kNames[] = {"image_copy kernel, device workgroup", "image_copy kernel, 8x8",
                                        "image_copy kernel, 32x8", "vkCmdCopyImage", "vkCmdCopyBuffer"};
   state.SetLabel(std::string(kNames[method]) + " on " + ctx.info().name);
