@@ -277,7 +277,8 @@ Step fused_step(StepProgram& prog, const DeviceInfo& info, int src, int dst, VkE
   const uint32_t mode = same ? 0u : exact_half ? 1u : 2u;
   // The 2:1 mean loaded as two column means in copy order (blur_stream.comp, SPLIT_MEAN) where the
   // loads are ordered for GPUs (SeparableKernel): on lavapipe it made the 3-level BlurPyramid about
-  // a third slower.
+  // a third slower (docs/BLUR.md, "Streamed separable"). The one step in flight below was measured
+  // with the four fetches, on the H100.
   const bool split_mean = mode == 1 && gpu_order(info, kernel);
   detail::Workgroup2D stream;
   if (mode <= 1 && kernel != SeparableKernel::tiles && stream_shape(info, radius, half_shared, split_mean, stream) &&

@@ -27,7 +27,7 @@ layout(constant_id = 3) const bool HALF_SHARED = false;  // shared copies as pac
 layout(constant_id = 4) const int MODE = 0;   // source read: 0 same size, 1 exact 2:1 area (2x2 mean)
 layout(constant_id = 5) const int AHEAD = 2;  // steps whose source rows are in flight (1 or 2)
 // MODE 1: load each 2x2 box as two column means in the order of a copy (GPUs) instead of four
-// fetches per invocation (CPU devices, where the extra shared traffic made it slower).
+// fetches per invocation (CPU devices, where it measured slower: docs/BLUR.md).
 layout(constant_id = 6) const bool SPLIT_MEAN = false;
 
 layout(binding = 0) uniform texture2D src;
@@ -82,11 +82,12 @@ ivec2 size;
 int x0, band, band_end, local_index, steps, ring_base, hx, hrow, vx, vrow;
 bool column_in;
 
-// Loaded value i of the STEP rows from image row `row0` (row i / LOAD_V), for destination texel
-// q = (x0 - RADIUS + c, row) clamped to the destination grid: MODE 0's value c is q's source
-// texel, MODE 1's the mean of its 2x2 source box; with SPLIT_MEAN, MODE 1's value 2 c + h is
-// column h of q's 2x2 source box averaged over its two rows, and
-// the mean of q's two values is the box's mean (step_texel()). Means, not sums, so that a value
+// Loaded value i of the STEP rows from image row `row0` (row i / LOAD_V; c = i % LOAD_V), clamped
+// to the destination grid: MODE 0's value c is the source texel of destination texel
+// q = (x0 - RADIUS + c, row), MODE 1's the mean of q's 2x2 source box; with SPLIT_MEAN each
+// destination texel has two values: value c is column c & 1 of the 2x2 source box of
+// q = (x0 - RADIUS + c / 2, row), averaged over its two rows, and the mean of q's two values is
+// the box's mean (step_texel()). Means, not sums, so that a value
 // never exceeds the largest texel (the fp16 shared copies hold the level's range; the scaling by
 // 0.5 is exact).
 vec4 load_value(int i, int row0) {
