@@ -204,17 +204,22 @@ BENCHMARK(BM_BlurDual)->Apply(all_sigmas);
 BENCHMARK(BM_BlurAuto)->Apply(all_sigmas);
 
 // The two kernels of a level-blur step (docs/BLUR.md "Streamed separable"), forced through
-// detail::BlurAccess: the tiled one (kernel 1) and the streamed one (kernel 2, wherever a strip
-// fits); a GaussianBlur pyramid's downsamples take the same choice (blur_down.comp or
+// detail::BlurAccess: the tiled one (kernel 1), the streamed one (kernel 2, wherever a strip
+// fits; four fetches for a 2:1 mean) and the streamed one with the GPUs' load orders on any
+// device (kernel 3, SeparableKernel::gpu_order: column means, gathered downsample taps); a
+// GaussianBlur pyramid's downsamples take the same choice (blur_down.comp or
 // blur_down_stream.comp), and its rows report each step's time (us_<step> counters). Method 1:
 // GaussianBlur separable (sigma 1.2, radius 5; sigma 3, radius 12, the largest); method 2:
 // GaussianBlur pyramid, one level (sigma 4: its level blur reads at the same size); method 3:
 // BlurPyramid, every level sigma_texels = sigma (1.2: the default), whose levels read the exact
 // 2:1 mean where the sizes halve exactly. RGBA16F. 3840x2160 and 1920x1080 for GPUs, 960x540 for
 // CPU devices. Args: kernel, method, sigma x 10, width, height. Counters: median_us, streamed (the
-// steps that ran a streamed kernel), taps (GaussianBlur).
+// steps that ran a streamed kernel), gpu_ordered (those that loaded in the GPUs' orders), taps
+// (GaussianBlur).
 void BM_BlurLevelKernel(benchmark::State& state) {
-  const auto kernel = state.range(0) == 1 ? blur_steps::SeparableKernel::tiles : blur_steps::SeparableKernel::stream;
+  const auto kernel = state.range(0) == 1   ? blur_steps::SeparableKernel::tiles
+                      : state.range(0) == 3 ? blur_steps::SeparableKernel::gpu_order
+                                            : blur_steps::SeparableKernel::stream;
   const auto sigma = static_cast<float>(state.range(2) / 10.0);
   const auto width = static_cast<uint32_t>(state.range(3));
   const auto height = static_cast<uint32_t>(state.range(4));
@@ -231,6 +236,7 @@ void BM_BlurLevelKernel(benchmark::State& state) {
     pyramid.prepare({width, height});
     frame_ms = time_frames(state, [&](VkCommandBuffer cmd) { pyramid.record(cmd, in.state); });
     streamed = detail::BlurAccess::streamed(pyramid);
+    state.counters["gpu_ordered"] = detail::BlurAccess::gpu_ordered(pyramid);
     label = "BlurPyramid";
   } else {
     GaussianBlurConfig config;
@@ -242,6 +248,7 @@ void BM_BlurLevelKernel(benchmark::State& state) {
     frame_ms = time_frames(state, [&](VkCommandBuffer cmd) { blur.record(cmd, in.state, dst.state); });
     add_stage_counters(state, [&](VkCommandBuffer cmd, Profiler* p) { blur.record(cmd, in.state, dst.state, p); });
     streamed = detail::BlurAccess::streamed(blur);
+    state.counters["gpu_ordered"] = detail::BlurAccess::gpu_ordered(blur);
     state.counters["taps"] = 2.0 * blur.choice().radius + 1.0;
     label = blur_method_name(blur.choice().method);
   }
@@ -253,10 +260,10 @@ BENCHMARK(BM_BlurLevelKernel)
     ->ArgsProduct({{1, 2}, {1}, {12, 30}, {3840}, {2160}})
     ->ArgsProduct({{1, 2}, {1}, {12}, {1920}, {1080}})
     ->ArgsProduct({{1, 2}, {2}, {40}, {3840}, {2160}})
-    ->ArgsProduct({{1, 2}, {3}, {12}, {3840}, {2160}})
-    ->ArgsProduct({{1, 2}, {3}, {12}, {1920}, {1080}})
+    ->ArgsProduct({{1, 2, 3}, {3}, {12}, {3840}, {2160}})
+    ->ArgsProduct({{1, 2, 3}, {3}, {12}, {1920}, {1080}})
     ->ArgsProduct({{1, 2}, {1}, {12, 30}, {960}, {540}})
-    ->ArgsProduct({{1, 2}, {2, 3}, {40}, {960}, {540}})
+    ->ArgsProduct({{1, 2, 3}, {2, 3}, {40}, {960}, {540}})
     ->ArgNames({"kernel", "method", "sigma10", "w", "h"})
     ->UseManualTime()
     ->Unit(benchmark::kMicrosecond);
