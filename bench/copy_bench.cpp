@@ -27,15 +27,20 @@ detail::ComputePipeline copy_pipeline(const Context& ctx, detail::Workgroup2D wo
   return detail::ComputePipeline(ctx, desc);
 }
 
+// Records the barriers that make `images.src` readable and `images.dst` writable by `stage`.
+void prepare_pair(VkCommandBuffer cmd, ImagePair& images, VkPipelineStageFlags2 stage, VkImageLayout src_layout,
+                  VkAccessFlags2 src_access, VkImageLayout dst_layout, VkAccessFlags2 dst_access) {
+  detail::Barriers b;
+  b.use(images.src.state, src_layout, stage, src_access);
+  b.use(images.dst.state, dst_layout, stage, dst_access);
+  b.flush(cmd);
+}
+
 // Records one copy of `src` into `dst` (both width x height) with the image_copy kernel.
 void record_copy(VkCommandBuffer cmd, ImagePair& images, const detail::ComputePipeline& copy, uint32_t width,
                  uint32_t height) {
-  detail::Barriers b;
-  b.use(images.src.state, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-        VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
-  b.use(images.dst.state, VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-        VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
-  b.flush(cmd);
+  prepare_pair(cmd, images, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+               VK_ACCESS_2_SHADER_SAMPLED_READ_BIT, VK_IMAGE_LAYOUT_GENERAL, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
   BloomPush push{};
   push.dst_width = static_cast<int32_t>(width);
   push.dst_height = static_cast<int32_t>(height);
@@ -139,13 +144,10 @@ void BM_CopyFloorMethods(benchmark::State& state) {
         record_copy(cmd, images, copy, width, height);
         return;
       }
-      detail::Barriers b;
       if (method == 3) {
-        b.use(images.src.state, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_PIPELINE_STAGE_2_COPY_BIT,
-              VK_ACCESS_2_TRANSFER_READ_BIT);
-        b.use(images.dst.state, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_PIPELINE_STAGE_2_COPY_BIT,
-              VK_ACCESS_2_TRANSFER_WRITE_BIT);
-        b.flush(cmd);
+        prepare_pair(cmd, images, VK_PIPELINE_STAGE_2_COPY_BIT, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                     VK_ACCESS_2_TRANSFER_READ_BIT, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                     VK_ACCESS_2_TRANSFER_WRITE_BIT);
         VkImageCopy region{};
         region.srcSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
         region.dstSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
@@ -153,6 +155,7 @@ void BM_CopyFloorMethods(benchmark::State& state) {
         vkCmdCopyImage(cmd, images.src.state.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, images.dst.state.image,
                        VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
       } else {
+        detail::Barriers b;
         b.use(src_use, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
         b.use(dst_use, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);
         b.flush(cmd);
