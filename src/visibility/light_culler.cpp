@@ -42,6 +42,15 @@ namespace {
 
 constexpr uint32_t kCullGroup = GLINT_CULL_GROUP;  // lights per workgroup: one 64-bit visibility mask
 static_assert(kCullGroup == 64, "light_cull.comp keeps a workgroup's visibility in two 32-bit words");
+// light_cull.comp and light_cull_scatter.comp read lights and write instances as three 16-byte words:
+// (position, intensity), (colour, size_px), (element, enabled, ...) and (centre, size_px,
+// fraction), (colour, intensity), (light_index, element, ndc_depth, reserved).
+static_assert(sizeof(GlintFlareLight) == 48 && offsetof(GlintFlareLight, intensity) == 12 &&
+              offsetof(GlintFlareLight, size_px) == 28 && offsetof(GlintFlareLight, element) == 32 &&
+              offsetof(GlintFlareLight, enabled) == 36);
+static_assert(sizeof(GlintFlareInstance) == 48 && offsetof(GlintFlareInstance, visible_fraction) == 12 &&
+              offsetof(GlintFlareInstance, intensity) == 28 && offsetof(GlintFlareInstance, light_index) == 32 &&
+              offsetof(GlintFlareInstance, ndc_depth) == 40);
 constexpr uint32_t kMaxGroupsX = 65535;  // guaranteed maxComputeWorkGroupCount[0]
 
 }  // namespace

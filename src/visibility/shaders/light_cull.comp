@@ -31,7 +31,9 @@ layout(local_size_x_id = 0, local_size_y_id = 1) in;
 
 layout(binding = 0) uniform texture2D depth_tex;  // level 0
 layout(binding = 1) uniform texture2D hiz_tex;    // mip m = Hi-Z level m + 1
-layout(std430, binding = 2) readonly buffer Lights { GlintFlareLight lights[]; };
+// GlintFlareLight[] read as three vec4 per light (48 bytes): three 16-byte loads instead of twelve
+// 4-byte ones (the struct's members are 4-byte aligned, so its loads are not merged).
+layout(std430, binding = 2) readonly buffer Lights { vec4 light_words[]; };
 layout(std430, binding = 3) writeonly buffer Records { vec4 records[]; };  // centre.xy, fraction, ndc z
 layout(std430, binding = 4) writeonly buffer Results { GlintFlareLightResult results[]; };
 #define COMPACT_GROUPS_BINDING 5  // the compaction's group buffer: this writes the masks (x, y)
@@ -115,7 +117,20 @@ void main() {
   vec2 center = vec2(0.0);
   float ndc_z = 0.0;
   if (in_range) {
-    const GlintFlareLight light = lights[i];
+    const vec4 l0 = light_words[3u * i], l1 = light_words[3u * i + 1u], l2 = light_words[3u * i + 2u];
+    GlintFlareLight light;
+    light.position_x = l0.x;
+    light.position_y = l0.y;
+    light.position_z = l0.z;
+    light.intensity = l0.w;
+    light.color_r = l1.x;
+    light.color_g = l1.y;
+    light.color_b = l1.z;
+    light.size_px = l1.w;
+    light.element = floatBitsToUint(l2.x);
+    light.enabled = floatBitsToUint(l2.y);
+    light.reserved0 = floatBitsToUint(l2.z);
+    light.reserved1 = floatBitsToUint(l2.w);
     if (light.enabled != 0u && light_finite(light)) {
       const vec4 p = vec4(light.position_x, light.position_y, light.position_z, 1.0);
       const float m[16] = pc.view_proj;

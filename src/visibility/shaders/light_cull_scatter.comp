@@ -16,9 +16,11 @@ layout(local_size_x_id = 0, local_size_y_id = 1) in;
 #include "compact.glsl"
 #include "light_cull_params.h"
 
-layout(std430, binding = 1) readonly buffer Lights { GlintFlareLight lights[]; };
+// GlintFlareLight[] and GlintFlareInstance[] as vec4 words (48 bytes each, three words): 16-byte
+// loads and stores instead of 4-byte ones (the structs' members are 4-byte aligned).
+layout(std430, binding = 1) readonly buffer Lights { vec4 light_words[]; };
 layout(std430, binding = 2) readonly buffer Records { vec4 records[]; };  // centre.xy, fraction, ndc z
-layout(std430, binding = 3) writeonly buffer Instances { GlintFlareInstance instances[]; };
+layout(std430, binding = 3) writeonly buffer Instances { uvec4 instance_words[]; };  // integer words: bits stored as they are
 layout(std430, binding = 4) writeonly buffer Results { GlintFlareLightResult results[]; };
 layout(push_constant) uniform Push { GlintCullCompactPush pc; };
 
@@ -30,21 +32,15 @@ void main() {
   const vec4 record = records[i];
   uint state = GLINT_FLARE_VISIBLE;
   if (slot < pc.capacity) {
-    const GlintFlareLight light = lights[i];
-    GlintFlareInstance inst;
-    inst.center_x_px = record.x;
-    inst.center_y_px = record.y;
-    inst.size_px = light.size_px;
-    inst.visible_fraction = record.z;
-    inst.color_r = light.color_r;
-    inst.color_g = light.color_g;
-    inst.color_b = light.color_b;
-    inst.intensity = light.intensity;
-    inst.light_index = i;
-    inst.element = light.element;
-    inst.ndc_depth = record.w;
-    inst.reserved = 0u;
-    instances[slot] = inst;
+    // Light words: (position, intensity), (colour, size_px), (element, enabled, reserved x2).
+    const vec4 l1 = light_words[3u * i + 1u];
+    const float intensity = light_words[3u * i].w;
+    const uint element = floatBitsToUint(light_words[3u * i + 2u].x);
+    // GlintFlareInstance: (centre, size_px, fraction), (colour, intensity),
+    // (light_index, element, ndc_depth, reserved).
+    instance_words[3u * slot] = floatBitsToUint(vec4(record.xy, l1.w, record.z));
+    instance_words[3u * slot + 1u] = floatBitsToUint(vec4(l1.xyz, intensity));
+    instance_words[3u * slot + 2u] = uvec4(i, element, floatBitsToUint(record.w), 0u);
   } else {
     state = GLINT_FLARE_OVERFLOW;
   }
