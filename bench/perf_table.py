@@ -13,7 +13,8 @@ with --cpu the cell says so and "met" stays blank). Times of 10 ms or more print
 
 Peer files are those bench/peers/*.py write; a missing peer leaves its column blank. --glint may be
 given once per glint_bench run (a device call's time limit can split the rows over several runs):
-a row takes its time and its copy from the first run that holds it. --not-h100 marks a GPU other
+a row takes its time, its copy and its commit (the run's glint_commit context, unless --commit
+names one for all) from the first run that holds it. --not-h100 marks a GPU other
 than the H100 the targets were set on (the target cell names the H100, "met" stays blank).
 
 CPU devices (lavapipe) take some rows at a smaller size (CPU_SIZES: a row whose run would take
@@ -158,7 +159,7 @@ def main():
                     help="glint_bench JSON; several runs may be given (each row's copy comes from its own run)")
     ap.add_argument("--peer", action="append", default=[], help="KIND=FILE, KIND one of bloom, blur, occlusion, "
                     "object_cull")
-    ap.add_argument("--commit")
+    ap.add_argument("--commit", help="the glint commit of every row (default: each run's glint_commit context)")
     ap.add_argument("--cpu", action="store_true", help="the CPU-device row set (CPU_SIZES)")
     ap.add_argument("--not-h100", action="store_true",
                     help="a GPU other than the H100 the targets were set on: the target cell names the H100 and "
@@ -169,11 +170,10 @@ def main():
     if args.filter:
         print(benchmark_filter(rows))
         return
-    if not args.glint or not args.commit:
-        ap.error("--glint and --commit are required (or --filter)")
+    if not args.glint:
+        ap.error("--glint is required (or --filter)")
     # Each run's medians, in order; a row takes its time and its copy from the first run that holds it.
     runs = [glint_medians(path) for path in args.glint]
-    ctx = runs[0][1] if runs else {}
     errors = {k: v for r in runs for k, v in r[2].items()}
     g, run_of = {}, {}
     for i, (medians, _, _) in enumerate(runs):
@@ -181,6 +181,14 @@ def main():
             if k not in g:
                 g[k], run_of[k] = v, i
     peers = peer_medians(args.peer)
+
+    def commit_of(i):
+        """The commit a row of run i names: --commit, else the run's glint_commit context."""
+        c = args.commit or runs[i][1].get("glint_commit")
+        if not c:
+            raise SystemExit(f"{args.glint[i]} names no glint_commit in its context: give --commit")
+        return c
+
     print("| job | glint median | copy of the same image | glint / copy | best peer | peer / glint | commit | target "
           "| met |")
     print("| --- | ---: | ---: | ---: | --- | ---: | --- | ---: | --- |")
@@ -198,9 +206,12 @@ def main():
         tcell = (f"{target} us on an H100" if other else f"{target} us") if target else ""
         met = ("yes" if t <= target else "no") if target and not other else ""
         cells = [label, fmt_us(t), fmt_us(f) if f else "", f"{t / f:.1f}x" if f else "",
-                 f"{p[1]}: {p[0]:.0f} us" if p else "", f"{p[0] / t:.1f}x" if p else "", args.commit, tcell, met]
+                 f"{p[1]}: {p[0]:.0f} us" if p else "", f"{p[0] / t:.1f}x" if p else "", commit_of(run_of[name]),
+                 tcell, met]
         print("| " + " | ".join(cells) + " |")
-    print(f"\nglint at {args.commit}; {ctx.get('date', '')}")
+    for i, (path, (_, c, _)) in enumerate(zip(args.glint, runs)):
+        print(f"\n{path}: glint at {commit_of(i)}; {c.get('date', '')}", end="")
+    print()
     for label, name, floor, _, _ in rows:
         if name in g and floor and floor not in COPY_SIZES:
             print(f"- {label}: no BM_CopyFloor at {floor} (registered: {', '.join(COPY_SIZES)})")
