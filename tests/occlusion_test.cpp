@@ -447,6 +447,107 @@ TEST_F(OcclusionTest, CullReadsEveryDepthFormat) {
   }
 }
 
+// An occluder over the whole image, nearer than every light, with single far pixels ("holes"):
+// a light is seen only through a hole under one of its samples' windows, often at a window's or
+// the light's edge. The kernel skips the samples of a light whose windows all lie under coarser
+// texels nearer than it (docs/OCCLUSION.md, "whole-light early out"); a hole that window misses
+// would turn a visible light into an occluded one here. Both kinds must be common for this test
+// to mean something.
+TEST_F(OcclusionTest, CullSeesLightsThroughSinglePixelHoles) {
+  // Large lights over sparse holes, and lights of a few pixels (cells of one pixel or less, read
+  // at level 0) over dense ones.
+  struct HoleCase {
+    double max_size;
+    uint32_t hole_every;
+  };
+  uint32_t stream = 301;
+  for (const HoleCase c : {HoleCase{70, 409}, HoleCase{6, 23}}) {
+    for (bool reversed : {false, true}) {
+      for (uint32_t grid : {3u, 4u}) {
+        auto scene = reference::random_scene(257, 143, 600, stream++, reversed, c.max_size);
+        const float near = reversed ? 1.0f : 0.0f, far = reversed ? 0.0f : 1.0f;
+        uint32_t holes = 0;
+        for (uint32_t y = 0; y < scene.depth.height; ++y) {
+          for (uint32_t x = 0; x < scene.depth.width; ++x) {
+            const uint32_t h = (x * 73856093u) ^ (y * 19349663u) ^ (grid * 83492791u);
+            const bool hole = h % c.hole_every == 0u;
+            scene.depth.depth[size_t(y) * scene.depth.width + x] = hole ? far : near;
+            holes += hole;
+          }
+        }
+        ASSERT_GT(holes, 50u);
+        LightCullConfig config;
+        config.grid = grid;
+        config.capacity = 600;
+        float vp[16];
+        for (int i = 0; i < 16; ++i) vp[i] = static_cast<float>(scene.view_proj[i]);
+        const VkFormat format = reversed ? VK_FORMAT_R32_SFLOAT : VK_FORMAT_D32_SFLOAT;
+        const auto run = run_cull(scene.depth, format, reversed, scene.lights, vp, config);
+        const std::string what = "holes max size " + std::to_string(int(c.max_size)) + " N=" + std::to_string(grid) +
+                                 (reversed ? " reversed" : " standard");
+        expect_cull_matches(run, scene, config, reversed, 8, what);
+        EXPECT_GT(run.stats.visible, 40u) << what << ": " << run.stats.occluded << " occluded";
+        EXPECT_GT(run.stats.occluded, 40u) << what << ": " << run.stats.visible << " visible";
+      }
+    }
+  }
+}
+
+// One light per 64-pixel tile, hidden by an occluder except through one pixel: the first pixel of
+// the first texel of its top-left sample's window, or the last pixel of the last texel of its
+// bottom-right sample's window (the extremes of the union of its windows; multi-jittered
+// footprints reach (N - 1) / (2N) cell past the light there). Every light is then visible. The
+// whole-light early out tests that union at a coarser level; a coarse window that missed its
+// first or last pixel would hide the light. Sizes of 1 to 8 pixels, read at levels 0 to 2, at
+// random sub-pixel positions, so the union's ends fall at every offset within the coarse texels.
+TEST_F(OcclusionTest, CullSeesALightThroughOnePixelAtTheEndOfItsWindows) {
+  const uint32_t tile = 64, w = 2048, h = 1024;
+  std::mt19937 rng(4242);
+  std::uniform_real_distribution<double> offset(-3.0, 3.0), size_px(1.0, 8.0);
+  for (uint32_t grid : {3u, 4u}) {
+    reference::DepthImage depth{w, h, std::vector<float>(size_t(w) * h, 0.2f)};
+    std::vector<GlintFlareLight> lights;
+    const double n = grid;
+    for (uint32_t ty = 0; ty < h / tile; ++ty) {
+      for (uint32_t tx = 0; tx < w / tile; ++tx) {
+        const double cx = tx * tile + 32.0 + offset(rng), cy = ty * tile + 32.0 + offset(rng), size = size_px(rng);
+        // The kernel's footprint arithmetic (light_cull.comp, sample_span and texel_range).
+        const double cell = size / n, unit = size / (2.0 * n * n);
+        const int k = cell <= 1.0 ? 0 : static_cast<int>(std::ceil(std::log2(cell)));
+        const bool last = (tx + ty) % 2 != 0;
+        const double ext = last ? 2.0 * n * n + 2.0 * n - 2.0 : 2.0 - 2.0 * n;
+        uint32_t hole[2];
+        for (int axis = 0; axis < 2; ++axis) {
+          const double edge = (axis == 0 ? cx : cy) - 0.5 * size + ext * unit;
+          const int p = last ? static_cast<int>(std::ceil(edge)) - 1 : static_cast<int>(std::floor(edge));
+          hole[axis] = last ? static_cast<uint32_t>((((p >> k) + 1) << k) - 1) : static_cast<uint32_t>((p >> k) << k);
+        }
+        depth.depth[size_t(hole[1]) * w + hole[0]] = 0.9f;
+        GlintFlareLight l{};
+        l.position_x = static_cast<float>(cx / w * 2.0 - 1.0);
+        l.position_y = static_cast<float>(cy / h * 2.0 - 1.0);
+        l.position_z = 0.5f;
+        l.size_px = static_cast<float>(size);
+        l.enabled = 1;
+        lights.push_back(l);
+      }
+    }
+    LightCullConfig config;
+    config.grid = grid;
+    config.capacity = static_cast<uint32_t>(lights.size());
+    const float vp[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+    const auto run = run_cull(depth, VK_FORMAT_D32_SFLOAT, false, lights, vp, config);
+    reference::Scene scene;
+    scene.depth = depth;
+    scene.lights = lights;
+    std::copy(vp, vp + 16, scene.view_proj);
+    const std::string what = "one hole N=" + std::to_string(grid);
+    expect_cull_matches(run, scene, config, false, 11, what);
+    // The construction puts each hole in a window: (nearly) every light is visible.
+    EXPECT_GE(run.stats.visible, lights.size() - lights.size() / 50) << what;
+  }
+}
+
 // A shallow pyramid (max_cell_px) and a depth bias: still exact against the reference.
 TEST_F(OcclusionTest, CullWithCappedPyramidAndBias) {
   const auto scene = reference::random_scene(190, 130, 400, 77, false, 150);
