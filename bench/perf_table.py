@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-r"""The speed table of docs/PERF.md, from one glint_bench JSON and the peers' JSON of the same run.
+r"""The speed table of docs/PERF.md, from glint_bench JSON runs and the peers' JSON of the same calls.
 
 Each row is one job of the speed targets: glint's median GPU time, the time of a copy of the same
 image measured in the same run (BM_CopyFloor; a blank where the job has no image of that size),
@@ -172,7 +172,8 @@ def main():
         return
     if not args.glint:
         ap.error("--glint is required (or --filter)")
-    # Each run's medians, in order; a row takes its time and its copy from the first run that holds it.
+    # Each run's medians, in order; a row takes its time, its copy and its commit from the first run that
+    # holds it.
     runs = [glint_medians(path) for path in args.glint]
     errors = {k: v for r in runs for k, v in r[2].items()}
     g, run_of = {}, {}
@@ -189,6 +190,8 @@ def main():
             raise SystemExit(f"{args.glint[i]} names no glint_commit in its context: give --commit")
         return c
 
+    for i in sorted(set(run_of.values())):
+        commit_of(i)  # every run a row comes from names its commit, before anything is printed
     print("| job | glint median | copy of the same image | glint / copy | best peer | peer / glint | commit | target "
           "| met |")
     print("| --- | ---: | ---: | ---: | --- | ---: | --- | ---: | --- |")

@@ -454,8 +454,8 @@ TEST_F(OcclusionTest, CullReadsEveryDepthFormat) {
 // would turn a visible light into an occluded one here. Both kinds must be common for this test
 // to mean something.
 TEST_F(OcclusionTest, CullSeesLightsThroughSinglePixelHoles) {
-  // Large lights over sparse holes, and lights of a few pixels (cells of one pixel or less, read
-  // at level 0) over dense ones.
+  // Large lights over sparse holes, and lights of a few pixels (cells of up to 2 pixels, read at
+  // levels 0 and 1) over dense ones.
   struct HoleCase {
     double max_size;
     uint32_t hole_every;
@@ -496,10 +496,13 @@ TEST_F(OcclusionTest, CullSeesLightsThroughSinglePixelHoles) {
 // One light per 64-pixel tile, hidden by an occluder except through one pixel: the first pixel of
 // the first texel of its top-left sample's window, or the last pixel of the last texel of its
 // bottom-right sample's window (the extremes of the union of its windows; multi-jittered
-// footprints reach (N - 1) / (2N) cell past the light there). Every light is then visible. The
+// footprints reach (N - 1) / N cell past the light's edge there). Every light is then visible
+// (the count leaves 2 % for lights whose window ends lie within rounding of a pixel edge). The
 // whole-light early out tests that union at a coarser level; a coarse window that missed its
 // first or last pixel would hide the light. Sizes of 1 to 8 pixels, read at levels 0 to 2, at
-// random sub-pixel positions, so the union's ends fall at every offset within the coarse texels.
+// random sub-pixel positions, so the union's ends fall at every offset within the coarse texels;
+// at these sizes the border's reach is within the early out's one-pixel margin, which
+// CullSeesLightsThroughSinglePixelHoles covers with lights up to 70 pixels.
 TEST_F(OcclusionTest, CullSeesALightThroughOnePixelAtTheEndOfItsWindows) {
   const uint32_t tile = 64, w = 2048, h = 1024;
   std::mt19937 rng(4242);
@@ -546,6 +549,39 @@ TEST_F(OcclusionTest, CullSeesALightThroughOnePixelAtTheEndOfItsWindows) {
     // The construction puts each hole in a window: (nearly) every light is visible.
     EXPECT_GE(run.stats.visible, lights.size() - lights.size() / 50) << what;
   }
+}
+
+// Lights just past the bottom-right corner of an odd-sized image, read at level 1, whose last
+// texel of each axis is 3 pixels wide (it reaches the edge): only the corner pixel is far. The
+// samples' windows clamp into that texel; the whole-light early out must take its pixel range up
+// to the edge (a range that stopped at 2 texels' worth would fit level 0 and miss the pixel).
+TEST_F(OcclusionTest, CullSeesALightPastTheCornerThroughTheLastPixel) {
+  const uint32_t w = 97, h = 61;
+  reference::DepthImage depth{w, h, std::vector<float>(size_t(w) * h, 0.2f)};
+  depth.depth[size_t(h - 1) * w + (w - 1)] = 0.9f;
+  std::mt19937 rng(97);
+  std::uniform_real_distribution<double> past(0.5, 2.0), size_px(2.05, 4.0);
+  std::vector<GlintFlareLight> lights;
+  for (int i = 0; i < 200; ++i) {
+    GlintFlareLight l{};
+    l.position_x = static_cast<float>((w + past(rng)) / w * 2.0 - 1.0);
+    l.position_y = static_cast<float>((h + past(rng)) / h * 2.0 - 1.0);
+    l.position_z = 0.5f;
+    l.size_px = static_cast<float>(size_px(rng));  // cells of 1 to 2 pixels: level 1
+    l.enabled = 1;
+    lights.push_back(l);
+  }
+  LightCullConfig config;
+  config.grid = 2;
+  config.capacity = static_cast<uint32_t>(lights.size());
+  const float vp[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+  const auto run = run_cull(depth, VK_FORMAT_D32_SFLOAT, false, lights, vp, config);
+  reference::Scene scene;
+  scene.depth = depth;
+  scene.lights = lights;
+  std::copy(vp, vp + 16, scene.view_proj);
+  expect_cull_matches(run, scene, config, false, 6, "past the corner");
+  EXPECT_EQ(run.stats.visible, lights.size());
 }
 
 // A shallow pyramid (max_cell_px) and a depth bias: still exact against the reference.

@@ -43,14 +43,21 @@ namespace {
 constexpr uint32_t kCullGroup = GLINT_CULL_GROUP;  // lights per workgroup: one 64-bit visibility mask
 static_assert(kCullGroup == 64, "light_cull.comp keeps a workgroup's visibility in two 32-bit words");
 // light_cull.comp and light_cull_scatter.comp read lights and write instances as three 16-byte words:
-// (position, intensity), (colour, size_px), (element, enabled, ...) and (centre, size_px,
-// fraction), (colour, intensity), (light_index, element, ndc_depth, reserved).
-static_assert(sizeof(GlintFlareLight) == 48 && offsetof(GlintFlareLight, intensity) == 12 &&
-              offsetof(GlintFlareLight, size_px) == 28 && offsetof(GlintFlareLight, element) == 32 &&
-              offsetof(GlintFlareLight, enabled) == 36);
-static_assert(sizeof(GlintFlareInstance) == 48 && offsetof(GlintFlareInstance, visible_fraction) == 12 &&
-              offsetof(GlintFlareInstance, intensity) == 28 && offsetof(GlintFlareInstance, light_index) == 32 &&
-              offsetof(GlintFlareInstance, ndc_depth) == 40);
+// (position, intensity), (colour, size_px), (element, enabled, reserved x2) and (centre, size_px,
+// fraction), (colour, intensity), (light_index, element, ndc_depth, reserved). Every member's offset
+// (flare_types.h asserts the sizes and some offsets; these are the ones the words rely on).
+static_assert(offsetof(GlintFlareLight, position_x) == 0 && offsetof(GlintFlareLight, position_y) == 4 &&
+              offsetof(GlintFlareLight, position_z) == 8 && offsetof(GlintFlareLight, intensity) == 12 &&
+              offsetof(GlintFlareLight, color_r) == 16 && offsetof(GlintFlareLight, color_g) == 20 &&
+              offsetof(GlintFlareLight, color_b) == 24 && offsetof(GlintFlareLight, size_px) == 28 &&
+              offsetof(GlintFlareLight, element) == 32 && offsetof(GlintFlareLight, enabled) == 36 &&
+              offsetof(GlintFlareLight, reserved0) == 40 && offsetof(GlintFlareLight, reserved1) == 44);
+static_assert(offsetof(GlintFlareInstance, center_x_px) == 0 && offsetof(GlintFlareInstance, center_y_px) == 4 &&
+              offsetof(GlintFlareInstance, size_px) == 8 && offsetof(GlintFlareInstance, visible_fraction) == 12 &&
+              offsetof(GlintFlareInstance, color_r) == 16 && offsetof(GlintFlareInstance, color_g) == 20 &&
+              offsetof(GlintFlareInstance, color_b) == 24 && offsetof(GlintFlareInstance, intensity) == 28 &&
+              offsetof(GlintFlareInstance, light_index) == 32 && offsetof(GlintFlareInstance, element) == 36 &&
+              offsetof(GlintFlareInstance, ndc_depth) == 40 && offsetof(GlintFlareInstance, reserved) == 44);
 constexpr uint32_t kMaxGroupsX = 65535;  // guaranteed maxComputeWorkGroupCount[0]
 
 }  // namespace

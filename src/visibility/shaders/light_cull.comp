@@ -73,9 +73,12 @@ ivec2 sample_span(int i, int j, int n, bool regular) {
 // the union of the footprints (sample_span's extremes: the first and last samples of a row or
 // column), widened here by one pixel each side against the rounding of the footprint edges; the
 // fine texels they touch at level k cover pixels p_lo .. p_hi (the last texel of a level reaches
-// the edge); level kc is the first whose texels put that range in at most 2 per axis. A coarse
-// texel holds the farthest depth of its pixels, so a coarse texel nearer than the light means
-// every fine texel under it is too (NaN compares false: no early out). The caller checks that
+// the edge); level kc is the first at which any span of that many pixels lies in at most 2 texels
+// per axis (an aligned range may fit one level lower). A coarse texel holds the farthest depth of
+// its pixels, so a coarse texel nearer than the light means every fine texel under it is too:
+// exact for depth without NaN. A NaN level-kc texel compares false (no early out); whether a NaN pixel reaches level kc is the
+// pyramid's max / min reduction's choice (GLSL.std.450 FMax / FMin may return either operand),
+// as it is for the sample loop's texels above level 0. The caller checks that
 // the level k the samples read was not capped by the pyramid's depth (so that no sample's window
 // exceeds GLINT_CULL_MAX_WINDOW_TEXELS and counts as visible without reading).
 bool whole_light_hidden(vec2 origin, float unit, int n, bool regular, int k, ivec2 lsize, float zt, bool reversed) {
