@@ -447,6 +447,24 @@ TEST_F(OcclusionTest, CullReadsEveryDepthFormat) {
   }
 }
 
+// Lights given in NDC (an identity view-projection) over a D32 depth image with a full pyramid,
+// grid N, multi-jittered: the run, compared light by light with the references.
+CullRun cull_ndc_lights(const reference::DepthImage& depth, const std::vector<GlintFlareLight>& lights, uint32_t grid,
+                        const std::string& what) {
+  LightCullConfig config;
+  config.grid = grid;
+  config.capacity = static_cast<uint32_t>(lights.size());
+  const float vp[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+  CullRun run = run_cull(depth, VK_FORMAT_D32_SFLOAT, false, lights, vp, config);
+  reference::Scene scene;
+  scene.depth = depth;
+  scene.lights = lights;
+  std::copy(vp, vp + 16, scene.view_proj);
+  const auto levels = static_cast<uint32_t>(std::floor(std::log2(double(std::max(depth.width, depth.height)))));
+  expect_cull_matches(run, scene, config, false, levels, what);
+  return run;
+}
+
 // An occluder over the whole image, nearer than every light, with single far pixels ("holes"):
 // a light is seen only through a hole under one of its samples' windows, often at a window's or
 // the light's edge. The kernel skips the samples of a light whose windows all lie under coarser
@@ -535,17 +553,8 @@ TEST_F(OcclusionTest, CullSeesALightThroughOnePixelAtTheEndOfItsWindows) {
         lights.push_back(l);
       }
     }
-    LightCullConfig config;
-    config.grid = grid;
-    config.capacity = static_cast<uint32_t>(lights.size());
-    const float vp[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
-    const auto run = run_cull(depth, VK_FORMAT_D32_SFLOAT, false, lights, vp, config);
-    reference::Scene scene;
-    scene.depth = depth;
-    scene.lights = lights;
-    std::copy(vp, vp + 16, scene.view_proj);
     const std::string what = "one hole N=" + std::to_string(grid);
-    expect_cull_matches(run, scene, config, false, 11, what);
+    const CullRun run = cull_ndc_lights(depth, lights, grid, what);
     // The construction puts each hole in a window: (nearly) every light is visible.
     EXPECT_GE(run.stats.visible, lights.size() - lights.size() / 50) << what;
   }
@@ -571,16 +580,7 @@ TEST_F(OcclusionTest, CullSeesALightPastTheCornerThroughTheLastPixel) {
     l.enabled = 1;
     lights.push_back(l);
   }
-  LightCullConfig config;
-  config.grid = 2;
-  config.capacity = static_cast<uint32_t>(lights.size());
-  const float vp[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
-  const auto run = run_cull(depth, VK_FORMAT_D32_SFLOAT, false, lights, vp, config);
-  reference::Scene scene;
-  scene.depth = depth;
-  scene.lights = lights;
-  std::copy(vp, vp + 16, scene.view_proj);
-  expect_cull_matches(run, scene, config, false, 6, "past the corner");
+  const CullRun run = cull_ndc_lights(depth, lights, 2, "past the corner");
   EXPECT_EQ(run.stats.visible, lights.size());
 }
 
