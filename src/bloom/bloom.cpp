@@ -181,7 +181,7 @@ struct Bloom::Impl {
   detail::PipelineDesc desc_2x(const std::string& kernel, std::vector<VkDescriptorType> bindings) const {
     detail::PipelineDesc d = desc(kernel, std::move(bindings));
     using Order = detail::BloomPath::CopyOrder;
-    const bool on = path.copy_order_2x == Order::device ? context->info().type != VK_PHYSICAL_DEVICE_TYPE_CPU
+    const bool on = path.copy_order_2x == Order::device ? detail::copy_order_by_default(context->info())
                                                         : path.copy_order_2x == Order::on;
     d.specialization.push_back(on ? 1u : 0u);
     return d;

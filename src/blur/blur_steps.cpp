@@ -173,7 +173,7 @@ uint32_t StepProgram::gpu_order_steps() const {
 
 bool gpu_order(const DeviceInfo& info, SeparableKernel kernel) {
   return kernel == SeparableKernel::gpu_order ||
-         (kernel == SeparableKernel::device && info.type != VK_PHYSICAL_DEVICE_TYPE_CPU);
+         (kernel == SeparableKernel::device && detail::copy_order_by_default(info));
 }
 
 uint32_t StepProgram::streamed_steps() const {

@@ -29,6 +29,8 @@ Workgroup2D choose_workgroup_2d(const Context& context) {
   return {8, 8};
 }
 
+bool copy_order_by_default(const DeviceInfo& info) { return info.type != VK_PHYSICAL_DEVICE_TYPE_CPU; }
+
 CompiledPipeline::~CompiledPipeline() {
   if (pipeline) vkDestroyPipeline(device, pipeline, nullptr);
   if (layout) vkDestroyPipelineLayout(device, layout, nullptr);

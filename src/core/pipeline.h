@@ -22,6 +22,13 @@ struct Workgroup2D {
 };
 Workgroup2D choose_workgroup_2d(const Context& context);
 
+/// Whether kernels that can order their image loads or stores as a copy does (consecutive
+/// invocations at consecutive texels) do so by default on this device: on GPUs, where the other
+/// orders measured slower, and not on CPU devices, where the copy orders did (lavapipe: bloom's 2:1
+/// upsample and composite, docs/BLOOM.md "Upsample and accumulate"; the blur's 2:1 means and downsample taps,
+/// docs/BLUR.md "Streamed separable"). Each kernel also has a way to force either order for tests.
+bool copy_order_by_default(const DeviceInfo& info);
+
 /// The most descriptors one dispatch pushes. VkPhysicalDevicePushDescriptorPropertiesKHR::
 /// maxPushDescriptors is at least 32 on every device with VK_KHR_push_descriptor (Vulkan spec,
 /// "Limits"); pipelines are checked against the device's own limit when they are made.
