@@ -16,6 +16,18 @@ float fetch_level(int k, ivec2 t) {
   return k == 0 ? texelFetch(depth_tex, t, 0).r : texelFetch(hiz_tex, t, k - 1).r;
 }
 
+// The corners of the window [t0, t1] of level k (at most 2x2 texels: a 1-texel side reads its
+// texel twice): (t0.x, t0.y), (t1.x, t0.y), (t0.x, t1.y), (t1.x, t1.y). Four fetches with no
+// dependence between them, so that their latencies overlap.
+vec4 hiz_corners(int k, ivec2 t0, ivec2 t1) {
+  if (k == 0) {
+    return vec4(texelFetch(depth_tex, t0, 0).r, texelFetch(depth_tex, ivec2(t1.x, t0.y), 0).r,
+                texelFetch(depth_tex, ivec2(t0.x, t1.y), 0).r, texelFetch(depth_tex, t1, 0).r);
+  }
+  return vec4(texelFetch(hiz_tex, t0, k - 1).r, texelFetch(hiz_tex, ivec2(t1.x, t0.y), k - 1).r,
+              texelFetch(hiz_tex, ivec2(t0.x, t1.y), k - 1).r, texelFetch(hiz_tex, t1, k - 1).r);
+}
+
 // Smallest k with 2^k >= s (s >= 1), exactly: s = m * 2^e with m in [0.5, 1).
 int ceil_log2(float s) {
   int e;

@@ -71,40 +71,43 @@ ivec2 sample_span(int i, int j, int n, bool regular) {
 // at most 2x2 texels of a coarser level: then every sample is occluded and the fraction is 0, as
 // the sample loop would find with up to 4 reads per sample (9 on the border). The windows lie in
 // the union of the footprints (sample_span's extremes: the first and last samples of a row or
-// column), widened here by one pixel each side against the rounding of the footprint edges; the
-// fine texels they touch at level k cover pixels p_lo .. p_hi (the last texel of a level reaches
-// the edge); level kc is the first at which any span of that many pixels lies in at most 2 texels
-// per axis (an aligned range may fit one level lower). A coarse texel holds the farthest depth of
-// its pixels, so a coarse texel nearer than the light means every fine texel under it is too:
-// exact for depth without NaN. A NaN level-kc texel compares false (no early out); whether a NaN pixel reaches level kc is the
-// pyramid's max / min reduction's choice (GLSL.std.450 FMax / FMin may return either operand),
-// as it is for the sample loop's texels above level 0. The caller checks that
-// the level k the samples read was not capped by the pyramid's depth (so that no sample's window
-// exceeds GLINT_CULL_MAX_WINDOW_TEXELS and counts as visible without reading).
+// column), widened here each side against the rounding of the footprint edges; the fine texels
+// they touch at level k cover pixels p_lo .. p_hi (the last texel of a level reaches the edge);
+// level kc is the first at which that range lies in at most 2 texels per axis. A coarse texel
+// holds the farthest depth of its pixels, so a coarse texel nearer than the light means every fine
+// texel under it is too: exact for depth without NaN. A NaN level-kc texel compares false (no
+// early out); whether a NaN pixel reaches level kc is the pyramid's max / min reduction's choice
+// (GLSL.std.450 FMax / FMin may return either operand), as it is for the sample loop's texels
+// above level 0. No sample's window then exceeds GLINT_CULL_MAX_WINDOW_TEXELS (which would count
+// it visible without reading): kc is at most the pyramid's depth, so where level k is capped there
+// (k = levels >= kc) the whole union, and every window, lies in at most 2x2 level-k texels.
 bool whole_light_hidden(vec2 origin, float unit, int n, bool regular, int k, ivec2 lsize, float zt, bool reversed) {
   const ivec2 ext = regular ? ivec2(0, 2 * n * n) : ivec2(2 - 2 * n, 2 * n * n + 2 * n - 2);
-  const ivec2 ux = texel_range(origin.x + float(ext.x) * unit - 1.0, origin.x + float(ext.y) * unit + 1.0, k,
-                               pc.width, lsize.x);
-  const ivec2 uy = texel_range(origin.y + float(ext.x) * unit - 1.0, origin.y + float(ext.y) * unit + 1.0, k,
-                               pc.height, lsize.y);
+  // The extreme samples' edges are origin + ext * unit, as the loop computes them, up to the
+  // compiler contracting either sum into an FMA or not (SPIR-V leaves it free): the two forms differ
+  // by a few units in the last place of the largest term, and the union is widened by 2^-18 of it
+  // (8 units in the last place and more).
+  const float a0 = float(ext.x) * unit, a1 = float(ext.y) * unit;
+  const vec2 widen = ldexp(abs(origin) + max(abs(a0), abs(a1)), ivec2(-18));
+  const ivec2 ux = texel_range(origin.x + a0 - widen.x, origin.x + a1 + widen.x, k, pc.width, lsize.x);
+  const ivec2 uy = texel_range(origin.y + a0 - widen.y, origin.y + a1 + widen.y, k, pc.height, lsize.y);
   const ivec2 pixels = ivec2(pc.width, pc.height);
   const ivec2 p_lo = ivec2(ux.x, uy.x) << k;
   const ivec2 p_hi = ivec2(ux.y == lsize.x - 1 ? pixels.x - 1 : ((ux.y + 1) << k) - 1,
                            uy.y == lsize.y - 1 ? pixels.y - 1 : ((uy.y + 1) << k) - 1);
-  // A span of s pixels touches at most 2 texels of level kc when s - 1 <= 2^kc.
+  // A span of s pixels touches at most 2 texels of level kc when s - 1 <= 2^kc, wherever it lies.
   const int span = max(p_hi.x - p_lo.x, p_hi.y - p_lo.y) + 1;
-  const int kc = span <= 2 ? 0 : findMSB(span - 2) + 1;
+  int kc = span <= 2 ? 0 : findMSB(span - 2) + 1;
+  // One level lower where the range happens to lie in 2 texels per axis there (it is aligned; the
+  // span rule holds for any placement): finer texels are nearer the light more often.
+  if (kc > 0) {
+    const ivec2 c1 = max(ivec2(1), pixels >> (kc - 1));
+    if (all(lessThanEqual(min(p_hi >> (kc - 1), c1 - 1) - min(p_lo >> (kc - 1), c1 - 1), ivec2(1)))) kc -= 1;
+  }
   if (kc > int(pc.levels)) return false;
   const ivec2 csize = max(ivec2(1), pixels >> kc);
   const ivec2 t0 = min(p_lo >> kc, csize - 1), t1 = min(p_hi >> kc, csize - 1);
-  vec4 d;  // four independent fetches: the corners of [t0, t1]
-  if (kc == 0) {
-    d = vec4(texelFetch(depth_tex, t0, 0).r, texelFetch(depth_tex, ivec2(t1.x, t0.y), 0).r,
-             texelFetch(depth_tex, ivec2(t0.x, t1.y), 0).r, texelFetch(depth_tex, t1, 0).r);
-  } else {
-    d = vec4(texelFetch(hiz_tex, t0, kc - 1).r, texelFetch(hiz_tex, ivec2(t1.x, t0.y), kc - 1).r,
-             texelFetch(hiz_tex, ivec2(t0.x, t1.y), kc - 1).r, texelFetch(hiz_tex, t1, kc - 1).r);
-  }
+  const vec4 d = hiz_corners(kc, t0, t1);
   return all(reversed ? greaterThan(d, vec4(zt)) : lessThan(d, vec4(zt)));
 }
 
@@ -114,13 +117,12 @@ float grid_test(vec2 center, float size, float z) {
   const bool regular = (pc.flags & GLINT_CULL_REGULAR_GRID) != 0u;
   const float cell = size / float(n);
   const float unit = size / float(2 * n * n);  // cell / (2n), the unit of sample_span
-  const int k_cell = cell <= 1.0 ? 0 : ceil_log2(cell);
-  const int k = min(k_cell, int(pc.levels));
+  const int k = min(cell <= 1.0 ? 0 : ceil_log2(cell), int(pc.levels));
   const ivec2 lsize = max(ivec2(1), ivec2(pc.width, pc.height) >> k);
   const bool reversed = (pc.flags & GLINT_CULL_REVERSED_Z) != 0u;
   const float zt = reversed ? z + pc.depth_bias : z - pc.depth_bias;
   const vec2 origin = center - 0.5 * size;
-  if (n > 1 && k_cell <= int(pc.levels) && whole_light_hidden(origin, unit, n, regular, k, lsize, zt, reversed)) {
+  if (n > 1 && whole_light_hidden(origin, unit, n, regular, k, lsize, zt, reversed)) {
     return 0.0;
   }
   int visible = 0;

@@ -209,14 +209,7 @@ uint hiz_test(vec2 x, vec2 y, float z, bool reversed) {
     // The usual window (the level was chosen for it): one pattern of 4 independent fetches, the
     // corners of [t0, t1] (a 1-texel side reads its texel twice), compared texel by texel (a NaN
     // texel passes no comparison, as in the loop below).
-    vec4 d;
-    if (k == 0) {
-      d = vec4(texelFetch(depth_tex, t0, 0).r, texelFetch(depth_tex, ivec2(t1.x, t0.y), 0).r,
-               texelFetch(depth_tex, ivec2(t0.x, t1.y), 0).r, texelFetch(depth_tex, t1, 0).r);
-    } else {
-      d = vec4(texelFetch(hiz_tex, t0, k - 1).r, texelFetch(hiz_tex, ivec2(t1.x, t0.y), k - 1).r,
-               texelFetch(hiz_tex, ivec2(t0.x, t1.y), k - 1).r, texelFetch(hiz_tex, t1, k - 1).r);
-    }
+    const vec4 d = hiz_corners(k, t0, t1);
     const bvec4 v = reversed ? lessThanEqual(d, vec4(z)) : greaterThanEqual(d, vec4(z));
     return any(v) ? GLINT_OBJECT_STATE_VISIBLE : GLINT_OBJECT_STATE_OCCLUDED;
   }
