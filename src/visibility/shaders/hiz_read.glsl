@@ -28,6 +28,10 @@ vec4 hiz_corners(int k, ivec2 t0, ivec2 t1) {
               texelFetch(hiz_tex, ivec2(t0.x, t1.y), k - 1).r, texelFetch(hiz_tex, t1, k - 1).r);
 }
 
+// The first level at which a span of `span` >= 1 pixels touches at most 2 texels, wherever it lies:
+// the smallest k with span - 1 <= 2^k (in integers, exactly).
+int hiz_span_level(int span) { return span <= 2 ? 0 : findMSB(span - 2) + 1; }
+
 // Smallest k with 2^k >= s (s >= 1), exactly: s = m * 2^e with m in [0.5, 1).
 int ceil_log2(float s) {
   int e;

@@ -141,9 +141,8 @@ uint hiz_test(vec2 x, vec2 y, float z, bool reversed) {
   const vec2 clo = clamp(lo, vec2(0.0), size), chi = clamp(hi, vec2(0.0), size);
   const ivec2 p0 = min(ivec2(floor(clo)), isize - 1);
   const ivec2 p1 = clamp(ivec2(ceil(chi)) - 1, p0, isize - 1);
-  // A span of s pixels touches at most 2 texels of level k when s - 1 <= 2^k.
   const int span = max(p1.x - p0.x, p1.y - p0.y) + 1;
-  const int k = min(span <= 2 ? 0 : findMSB(span - 2) + 1, int(pc.levels));
+  const int k = min(hiz_span_level(span), int(pc.levels));
   const ivec2 lsize = max(ivec2(1), isize >> k);
   const ivec2 t0 = min(p0 >> k, lsize - 1), t1 = min(p1 >> k, lsize - 1);
   // Visible where the stored (farthest) depth is not nearer than the object.
