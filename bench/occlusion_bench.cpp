@@ -22,6 +22,7 @@
 #include "reference/occlusion_reference.h"
 #include "support/transfer.h"
 #include "visibility/hiz_internal.h"
+#include "visibility/light_cull_internal.h"
 
 namespace glint::bench {
 namespace {
@@ -100,14 +101,11 @@ BENCHMARK(BM_HiZStreamPass)
     ->UseManualTime()
     ->Unit(benchmark::kMicrosecond);
 
-// Args: lights, grid N, per-light results (0/1), whether the Hi-Z build is timed with the cull
-// (0/1), and the sampling pattern (OcclusionPattern: 0 multi-jittered, the default; 1 regular).
-void BM_LightCull(benchmark::State& state) {
-  const auto n = static_cast<uint32_t>(state.range(0));
-  const auto grid = static_cast<uint32_t>(state.range(1));
-  const bool with_results = state.range(2) != 0;
-  const bool with_hiz = state.range(3) != 0;
-  const auto pattern = static_cast<OcclusionPattern>(state.range(4));
+// The light cull of `n` lights with an N = `grid` grid, timed; `path` forces the cull's path
+// (detail::LightCullPath; `device` lets the count choose). With `measure_error`, the error against
+// brute force as BM_LightCull reports it.
+void light_cull(benchmark::State& state, uint32_t n, uint32_t grid, bool with_results, bool with_hiz,
+                OcclusionPattern pattern, detail::LightCullPath path, bool measure_error) {
   const Context& ctx = context();
   const uint32_t w = 1920, h = 1080;
   // Flares of 8 to 128 pixels (the default flare size is 100).
@@ -122,6 +120,7 @@ void BM_LightCull(benchmark::State& state) {
   cc.pattern = pattern;
   cc.max_lights = std::max(n, 1u);
   LightCuller culler(ctx, cc);
+  detail::LightCullAccess::select_path(culler, path);
   const VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT;
   auto lights = device_buffer(ctx, scene.lights.data(), VkDeviceSize(n) * sizeof(GlintFlareLight), storage);
   auto instances = device_buffer(ctx, nullptr, VkDeviceSize(cc.capacity) * sizeof(GlintFlareInstance), storage);
@@ -184,7 +183,7 @@ void BM_LightCull(benchmark::State& state) {
   const auto pyramid = reference::hiz_pyramid(scene.depth, false, hiz.levels());
   double error_sum = 0.0;
   uint32_t tested = 0, broken = 0;
-  for (uint32_t i = 0; i < n && tested < 2000; ++i) {
+  for (uint32_t i = 0; measure_error && i < n && tested < 2000; ++i) {
     const auto ref = reference::cull_light(scene.lights[i], s, scene.depth, pyramid);
     if (ref.ambiguous || (ref.culled != GLINT_FLARE_VISIBLE && ref.culled != GLINT_FLARE_OCCLUDED)) continue;
     const double gpu = res[i].culled == GLINT_FLARE_VISIBLE ? res[i].visible_fraction : 0.0;
@@ -206,11 +205,24 @@ void BM_LightCull(benchmark::State& state) {
   state.counters["visible"] = st.visible;
   state.counters["occluded"] = st.occluded;
   state.counters["frustum_culled"] = st.frustum_culled;
-  state.counters["mean_abs_error_vs_brute_force"] = tested ? error_sum / tested : 0.0;
-  state.counters["bound_or_exactness_violations"] = broken;
-  state.SetLabel(std::string("ordered compaction") + (with_hiz ? " + Hi-Z" : "") +
+  if (measure_error) {
+    state.counters["mean_abs_error_vs_brute_force"] = tested ? error_sum / tested : 0.0;
+    state.counters["bound_or_exactness_violations"] = broken;
+  }
+  const bool one_group = path == detail::LightCullPath::one_group ||
+                         (path == detail::LightCullPath::device && n <= culler.one_group_lights());
+  state.counters["one_group"] = one_group ? 1 : 0;
+  state.SetLabel(std::string(one_group ? "one workgroup" : "ordered compaction") + (with_hiz ? " + Hi-Z" : "") +
                  (pattern == OcclusionPattern::regular ? ", regular grid" : ", multi-jittered") + " on " +
                  ctx.info().name);
+}
+
+// Args: lights, grid N, per-light results (0/1), whether the Hi-Z build is timed with the cull
+// (0/1), and the sampling pattern (OcclusionPattern: 0 multi-jittered, the default; 1 regular).
+// The path is the one the count chooses.
+void BM_LightCull(benchmark::State& state) {
+  light_cull(state, static_cast<uint32_t>(state.range(0)), static_cast<uint32_t>(state.range(1)), state.range(2) != 0,
+             state.range(3) != 0, static_cast<OcclusionPattern>(state.range(4)), detail::LightCullPath::device, true);
 }
 
 BENCHMARK(BM_LightCull)
@@ -229,6 +241,19 @@ BENCHMARK(BM_LightCull)
     ->Args({1000000, 4, 0, 0, 1})
     ->Args({1000, 4, 0, 0, 1})
     ->ArgNames({"n", "grid", "results", "hiz", "pattern"})
+    ->UseManualTime()
+    ->Unit(benchmark::kMicrosecond);
+
+// The two paths of the light cull on the same lights (detail::LightCullPath: 1 the four
+// dispatches, 2 one workgroup), to place LightCuller::one_group_lights() (docs/OCCLUSION.md).
+void BM_LightCullPath(benchmark::State& state) {
+  light_cull(state, static_cast<uint32_t>(state.range(0)), static_cast<uint32_t>(state.range(1)), false, false,
+             OcclusionPattern::multi_jittered, static_cast<detail::LightCullPath>(state.range(2)), false);
+}
+
+BENCHMARK(BM_LightCullPath)
+    ->ArgsProduct({{64, 128, 256, 512, 1024}, {4, 8, 16}, {1, 2}})
+    ->ArgNames({"n", "grid", "path"})
     ->UseManualTime()
     ->Unit(benchmark::kMicrosecond);
 

@@ -18,6 +18,7 @@
 #include "support/gpu_test.h"
 #include "support/transfer.h"
 #include "visibility/hiz_internal.h"
+#include "visibility/light_cull_internal.h"
 #include "visibility/shaders/light_cull_params.h"
 
 namespace glint::test {
@@ -234,7 +235,8 @@ struct CullRun {
 
 CullRun run_cull(const reference::DepthImage& depth, VkFormat format, bool reversed,
                  const std::vector<GlintFlareLight>& lights, const float view_proj[16], const LightCullConfig& config,
-                 uint32_t max_cell_px = 0, int frames = 1, uint32_t groups_per_instance = 3) {
+                 uint32_t max_cell_px = 0, int frames = 1, uint32_t groups_per_instance = 3,
+                 detail::LightCullPath path = detail::LightCullPath::device) {
   auto img = make_depth(depth, format);
   HiZConfig hc;
   hc.extent = {depth.width, depth.height};
@@ -243,6 +245,7 @@ CullRun run_cull(const reference::DepthImage& depth, VkFormat format, bool rever
   hc.max_cell_px = max_cell_px;
   HiZPyramid hiz(context(), hc);
   LightCuller culler(context(), config);
+  detail::LightCullAccess::select_path(culler, path);
   const uint32_t n = static_cast<uint32_t>(lights.size());
   HostBuffer lbuf(n * sizeof(GlintFlareLight));
   if (n) std::memcpy(lbuf.owned.mapped(), lights.data(), n * sizeof(GlintFlareLight));
@@ -392,26 +395,29 @@ TEST_F(OcclusionTest, CullMatchesReferenceOnRandomScenes) {
       // The regular pattern once per case (standard Z): it keeps grid >= brute force too.
       for (int variant : reversed ? std::vector<int>{0} : std::vector<int>{0, 2}) {
         const auto scene = reference::random_scene(c.w, c.h, c.lights, stream++, reversed, c.max_size);
-        LightCullConfig config;
-        config.grid = c.grid;
-        config.capacity = c.lights;
-        if (variant == 2) config.pattern = OcclusionPattern::regular;
-        float vp[16];
-        for (int i = 0; i < 16; ++i) vp[i] = static_cast<float>(scene.view_proj[i]);
-        const VkFormat format = reversed ? VK_FORMAT_R32_SFLOAT : VK_FORMAT_D32_SFLOAT;
-        const auto run = run_cull(scene.depth, format, reversed, scene.lights, vp, config);
-        const uint32_t levels = static_cast<uint32_t>(std::floor(std::log2(double(std::max(c.w, c.h)))));
-        const std::string what = std::to_string(c.w) + "x" + std::to_string(c.h) + " N=" + std::to_string(c.grid) +
-                                 (reversed ? " reversed" : " standard") + (variant == 2 ? " regular" : "");
-        expect_cull_matches(run, scene, config, reversed, levels, what);
-        // Enough of every kind in the larger scenes that the checks above mean something.
-        if (c.lights >= 300) {
-          EXPECT_GT(run.stats.visible, c.lights / 20) << what;
-          if (c.grid <= 4) {
-            EXPECT_GT(run.stats.occluded, 0u) << what;
+        for (detail::LightCullPath path : {detail::LightCullPath::groups, detail::LightCullPath::one_group}) {
+          LightCullConfig config;
+          config.grid = c.grid;
+          config.capacity = c.lights;
+          if (variant == 2) config.pattern = OcclusionPattern::regular;
+          float vp[16];
+          for (int i = 0; i < 16; ++i) vp[i] = static_cast<float>(scene.view_proj[i]);
+          const VkFormat format = reversed ? VK_FORMAT_R32_SFLOAT : VK_FORMAT_D32_SFLOAT;
+          const auto run = run_cull(scene.depth, format, reversed, scene.lights, vp, config, 0, 1, 3, path);
+          const uint32_t levels = static_cast<uint32_t>(std::floor(std::log2(double(std::max(c.w, c.h)))));
+          const std::string what = std::to_string(c.w) + "x" + std::to_string(c.h) + " N=" + std::to_string(c.grid) +
+                                   (reversed ? " reversed" : " standard") + (variant == 2 ? " regular" : "") +
+                                   (path == detail::LightCullPath::one_group ? ", one workgroup" : ", four dispatches");
+          expect_cull_matches(run, scene, config, reversed, levels, what);
+          // Enough of every kind in the larger scenes that the checks above mean something.
+          if (c.lights >= 300) {
+            EXPECT_GT(run.stats.visible, c.lights / 20) << what;
+            if (c.grid <= 4) {
+              EXPECT_GT(run.stats.occluded, 0u) << what;
+            }
+            EXPECT_GT(run.stats.frustum_culled, c.lights / 20) << what;
+            EXPECT_GT(run.stats.disabled, 0u) << what;
           }
-          EXPECT_GT(run.stats.frustum_culled, c.lights / 20) << what;
-          EXPECT_GT(run.stats.disabled, 0u) << what;
         }
       }
     }
@@ -601,16 +607,63 @@ TEST_F(OcclusionTest, CullWithCappedPyramidAndBias) {
 // Also two frames in one command buffer: the counters reset between them.
 TEST_F(OcclusionTest, CullOverflowAndRepeatedFrames) {
   const auto scene = reference::random_scene(150, 100, 500, 5, false, 40);
-  for (uint32_t capacity : {1u, 13u}) {
+  for (detail::LightCullPath path : {detail::LightCullPath::groups, detail::LightCullPath::one_group}) {
+    for (uint32_t capacity : {1u, 13u}) {
+      LightCullConfig config;
+      config.capacity = capacity;
+      float vp[16];
+      for (int i = 0; i < 16; ++i) vp[i] = static_cast<float>(scene.view_proj[i]);
+      const auto run = run_cull(scene.depth, VK_FORMAT_D32_SFLOAT, false, scene.lights, vp, config, 0, 2, 3, path);
+      ASSERT_GT(run.stats.visible, capacity);
+      EXPECT_EQ(run.indirect.instance_count, capacity);
+      EXPECT_EQ(run.stats.overflow, run.stats.visible - capacity);
+      expect_cull_matches(run, scene, config, false, 7,
+                          "overflow " + std::to_string(capacity) +
+                              (path == detail::LightCullPath::one_group ? ", one workgroup" : ", four dispatches"));
+    }
+  }
+}
+
+// The one-workgroup cull (few lights) and the four dispatches give the same bits: instances,
+// per-light results, arguments and statistics, with more lights than one chunk of the workgroup,
+// capacity overflow, and dispatch arguments split into rows (groups_per_instance at its largest).
+// The path the light count chooses is one_group up to one_group_lights(), the four dispatches above.
+TEST_F(OcclusionTest, OneWorkgroupCullGivesTheBitsOfTheFourDispatches) {
+  for (bool reversed : {false, true}) {
+    const auto scene = reference::random_scene(257, 143, 1500, 41 + reversed, reversed, 90);
     LightCullConfig config;
-    config.capacity = capacity;
+    config.capacity = 200;
+    config.grid = 3;
     float vp[16];
     for (int i = 0; i < 16; ++i) vp[i] = static_cast<float>(scene.view_proj[i]);
-    const auto run = run_cull(scene.depth, VK_FORMAT_D32_SFLOAT, false, scene.lights, vp, config, 0, 2);
-    ASSERT_GT(run.stats.visible, capacity);
-    EXPECT_EQ(run.indirect.instance_count, capacity);
-    EXPECT_EQ(run.stats.overflow, run.stats.visible - capacity);
-    expect_cull_matches(run, scene, config, false, 7, "overflow " + std::to_string(capacity));
+    const VkFormat format = reversed ? VK_FORMAT_R32_SFLOAT : VK_FORMAT_D32_SFLOAT;
+    LightCuller probe(context(), config);
+    const uint32_t most = probe.max_groups_per_instance();
+    ASSERT_GT(uint32_t(scene.lights.size()), probe.one_group_lights()) << "more than one chunk";
+    const auto a =
+        run_cull(scene.depth, format, reversed, scene.lights, vp, config, 0, 1, most, detail::LightCullPath::groups);
+    const auto b =
+        run_cull(scene.depth, format, reversed, scene.lights, vp, config, 0, 1, most, detail::LightCullPath::one_group);
+    const std::string what = reversed ? "reversed" : "standard";
+    ASSERT_GT(a.stats.overflow, 0u) << what;
+    EXPECT_EQ(std::memcmp(&a.indirect, &b.indirect, sizeof a.indirect), 0) << what;
+    EXPECT_EQ(std::memcmp(&a.stats, &b.stats, sizeof a.stats), 0) << what;
+    ASSERT_EQ(a.results.size(), b.results.size());
+    EXPECT_EQ(std::memcmp(a.results.data(), b.results.data(), a.results.size() * sizeof a.results[0]), 0) << what;
+    ASSERT_EQ(a.instances.size(), b.instances.size()) << what;
+    EXPECT_EQ(std::memcmp(a.instances.data(), b.instances.data(), a.instances.size() * sizeof a.instances[0]), 0)
+        << what;
+    EXPECT_TRUE(a.canary_intact && b.canary_intact) << what;
+    // The count chooses: one_group_lights() lights or fewer take one workgroup, more the groups.
+    const uint32_t n = probe.one_group_lights();
+    const std::vector<GlintFlareLight> few(scene.lights.begin(), scene.lights.begin() + n);
+    const auto c = run_cull(scene.depth, format, reversed, few, vp, config, 0, 1, 3);
+    const auto d = run_cull(scene.depth, format, reversed, few, vp, config, 0, 1, 3, detail::LightCullPath::groups);
+    EXPECT_EQ(std::memcmp(&c.stats, &d.stats, sizeof c.stats), 0) << what;
+    EXPECT_EQ(std::memcmp(c.results.data(), d.results.data(), c.results.size() * sizeof c.results[0]), 0) << what;
+    reference::Scene first = scene;
+    first.lights = few;
+    expect_cull_matches(c, first, config, reversed, 8, what + ", the count's path");
   }
 }
 
@@ -659,20 +712,74 @@ TEST_F(OcclusionTest, AMillionVisibleLightsGiveDispatchArgumentsEveryDeviceAccep
   }
 }
 
+// one_group_lights() is min(W, 16384 / N^2) (W: the workgroup, 64 on CPU devices), and the count
+// chooses the path by it: one dispatch (one profiler stage) up to it, four (three stages after the
+// cull's first) above it.
+TEST_F(OcclusionTest, TheLightCountChoosesOneWorkgroupUpToOneGroupLights) {
+  VkPhysicalDeviceProperties props;
+  vkGetPhysicalDeviceProperties(context().physical_device(), &props);
+  const uint32_t w =
+      context().info().type == VK_PHYSICAL_DEVICE_TYPE_CPU
+          ? 64u
+          : std::min({1024u, props.limits.maxComputeWorkGroupInvocations, props.limits.maxComputeWorkGroupSize[0]});
+  const auto scene = reference::random_scene(96, 64, 1100, 77, false, 30);
+  float vp[16];
+  for (int i = 0; i < 16; ++i) vp[i] = static_cast<float>(scene.view_proj[i]);
+  auto img = make_depth(scene.depth, VK_FORMAT_D32_SFLOAT);
+  HiZConfig hc;
+  hc.extent = {scene.depth.width, scene.depth.height};
+  HiZPyramid hiz(context(), hc);
+  HostBuffer lbuf(scene.lights.size() * sizeof(GlintFlareLight));
+  std::memcpy(lbuf.owned.mapped(), scene.lights.data(), scene.lights.size() * sizeof(GlintFlareLight));
+  lbuf.owned.flush();
+  for (uint32_t grid : {1u, 4u, 9u, 16u}) {
+    LightCullConfig config;
+    config.grid = grid;
+    config.capacity = 1100;
+    LightCuller culler(context(), config);
+    const uint32_t most = culler.one_group_lights();
+    EXPECT_EQ(most, std::min(w, std::max(1u, 16384u / (grid * grid)))) << "N = " << grid;
+    HostBuffer inst(config.capacity * sizeof(GlintFlareInstance)), indirect(sizeof(GlintFlareIndirect)),
+        stats(sizeof(GlintFlareStats));
+    LightCullOutputs out{inst.view, indirect.view, stats.view, {}};
+    LightCullFrame frame;
+    std::copy(vp, vp + 16, frame.view_proj);
+    for (uint32_t n : {most, most + 1}) {
+      if (n > scene.lights.size()) continue;
+      Profiler profiler(context(), 8);
+      context().run_once([&](VkCommandBuffer cmd) {
+        hiz.record(cmd, img.state);
+        profiler.reset(cmd);
+        profiler.mark(cmd, "start");
+        culler.record(cmd, hiz, img.state, lbuf.view, n, frame, out, &profiler);
+      });
+      std::vector<std::string> labels;
+      for (const auto& stage : profiler.results()) labels.push_back(stage.label);
+      if (labels.empty()) GTEST_SKIP() << "no timestamps on this device";
+      const std::vector<std::string> expected =
+          n <= most ? std::vector<std::string>{"light cull"}
+                    : std::vector<std::string>{"light cull", "cull scan", "cull scatter"};
+      EXPECT_EQ(labels, expected) << "N = " << grid << ", " << n << " lights";
+    }
+  }
+}
+
 TEST_F(OcclusionTest, ZeroLights) {
   reference::DepthImage d = random_depth(33, 17, 3);
   LightCullConfig config;
   config.capacity = 4;
   float vp[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
-  const auto run = run_cull(d, VK_FORMAT_D32_SFLOAT, false, {}, vp, config);
-  EXPECT_EQ(run.indirect.vertex_count, 6u);
-  EXPECT_EQ(run.indirect.instance_count, 0u);
-  EXPECT_EQ(run.indirect.group_count_x, 0u);
-  EXPECT_EQ(run.indirect.group_count_y, 1u);
-  EXPECT_EQ(run.stats.total, 0u);
-  EXPECT_EQ(run.stats.visible, 0u);
-  EXPECT_EQ(run.stats.frustum_culled + run.stats.occluded + run.stats.overflow + run.stats.disabled, 0u);
-  EXPECT_TRUE(run.canary_intact);
+  for (detail::LightCullPath path : {detail::LightCullPath::groups, detail::LightCullPath::one_group}) {
+    const auto run = run_cull(d, VK_FORMAT_D32_SFLOAT, false, {}, vp, config, 0, 1, 3, path);
+    EXPECT_EQ(run.indirect.vertex_count, 6u);
+    EXPECT_EQ(run.indirect.instance_count, 0u);
+    EXPECT_EQ(run.indirect.group_count_x, 0u);
+    EXPECT_EQ(run.indirect.group_count_y, 1u);
+    EXPECT_EQ(run.stats.total, 0u);
+    EXPECT_EQ(run.stats.visible, 0u);
+    EXPECT_EQ(run.stats.frustum_culled + run.stats.occluded + run.stats.overflow + run.stats.disabled, 0u);
+    EXPECT_TRUE(run.canary_intact);
+  }
 }
 
 // Texel size (pixels) of the Hi-Z level a light of `size` pixels reads with an N x N grid:

@@ -26,7 +26,8 @@
 namespace glint {
 
 namespace detail {
-struct HiZAccess;  // benchmarks' and tests' switch of the stream pass (src/visibility/hiz_internal.h)
+struct HiZAccess;        // benchmarks' and tests' switch of the stream pass (src/visibility/hiz_internal.h)
+struct LightCullAccess;  // benchmarks' and tests' switch of the cull's path (src/visibility/light_cull_internal.h)
 }  // namespace detail
 
 /// Creation-time settings of a Hi-Z pyramid. Checked by validate().
@@ -157,12 +158,14 @@ class LightCuller {
   ~LightCuller();
 
   /// Records the cull of `count` lights from `lights` (GlintFlareLight[count], STORAGE usage)
-  /// against `hiz` (built from `depth` earlier on this command buffer or before) into `outputs`:
-  /// three dispatches (the cull and grid test; a one-workgroup scan that gives every workgroup of
-  /// 64 lights its first instance slot, writes the indirect arguments and statistics and resets the
-  /// counters; the scatter of the visible lights into their slots). The outputs are the same bits
-  /// on every run. A light with enabled == 0 or a non-finite float field is GLINT_FLARE_DISABLED.
-  /// count == 0 is allowed (zero instances; only the scan runs). Afterwards the
+  /// against `hiz` (built from `depth` earlier on this command buffer or before) into `outputs`.
+  /// Up to one_group_lights() lights, one dispatch: one workgroup culls, tests and compacts
+  /// them. More lights, four dispatches: the cull and grid test in workgroups of 64 lights; the
+  /// two-level scan (the second, one workgroup, gives every workgroup its first instance slot,
+  /// writes the indirect arguments and statistics and resets the counters); the scatter of the
+  /// visible lights into their slots. Both give the same outputs, the same bits on every run.
+  /// A light with enabled == 0 or a non-finite float field is GLINT_FLARE_DISABLED.
+  /// count == 0 is allowed (zero instances). Afterwards the
   /// outputs were last written by the compute shader stage: a draw needs a barrier to
   /// DRAW_INDIRECT / INDIRECT_COMMAND_READ for `indirect` and to VERTEX_SHADER (or COMPUTE) /
   /// SHADER_STORAGE_READ for `instances`. The first record() clears the internal counters once.
@@ -179,9 +182,16 @@ class LightCuller {
   /// At least 1 for every capacity the config accepts. Composite effects check it at construction.
   uint32_t max_groups_per_instance() const;
 
+  /// The most lights record() culls in one dispatch of one workgroup: min(W, 16384 / N^2) for
+  /// an N x N grid, with W = min(1024, maxComputeWorkGroupInvocations, maxComputeWorkGroupSize[0])
+  /// on GPUs and 64 on CPU devices, which run a workgroup's invocations one after another and a
+  /// cull's workgroups in parallel (docs/OCCLUSION.md, "One workgroup for few lights").
+  uint32_t one_group_lights() const;
+
   struct Impl;
 
  private:
+  friend struct detail::LightCullAccess;
   std::unique_ptr<Impl> impl_;
 };
 

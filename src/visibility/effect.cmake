@@ -9,6 +9,7 @@ set(GLINT_EFFECT_KERNELS
   "shaders/hiz_build|main|"
   "shaders/compact_scan_tiles|main|"
   "shaders/light_cull|main|"
+  "shaders/light_cull|one_group|GLINT_CULL_ONE_GROUP=1"
   "shaders/light_cull_scan|main|"
   "shaders/light_cull_scatter|main|"
   "shaders/object_cull|main|"

@@ -18,6 +18,7 @@
 #include "core/formats.h"
 #include "core/pipeline.h"
 #include "core/resources.h"
+#include "visibility/light_cull_internal.h"
 #include "visibility/shaders/light_cull_params.h"  // push constants and buffer layouts shared with the kernels
 #include "visibility/visibility_util.h"
 
@@ -59,6 +60,11 @@ static_assert(offsetof(GlintFlareInstance, center_x_px) == 0 && offsetof(GlintFl
               offsetof(GlintFlareInstance, light_index) == 32 && offsetof(GlintFlareInstance, element) == 36 &&
               offsetof(GlintFlareInstance, ndc_depth) == 40 && offsetof(GlintFlareInstance, reserved) == 44);
 constexpr uint32_t kMaxGroupsX = 65535;  // guaranteed maxComputeWorkGroupCount[0]
+// Samples (lights x N^2) up to which the one-workgroup cull runs: on an NVIDIA H200 it won at
+// 1024 lights with N = 4 (22.9 against 28.4 us; 15.0 against 25.8 at 64 lights) and lost at
+// 1000 lights with N = 8 and 16 (65.7 against 61.9 us, 231.7 against 186.0), where one
+// multiprocessor's fetch rate holds it; fewer samples only shorten its work.
+constexpr uint32_t kOneGroupSamples = 16384;
 
 }  // namespace
 
@@ -85,6 +91,13 @@ struct LightCuller::Impl {
   // statistics), and light_cull_scatter.comp (instances in light order).
   detail::ComputePipeline cull;
   detail::Compaction compact;
+  // The whole cull in one workgroup of one_group_size invocations (light_cull.comp built with
+  // GLINT_CULL_ONE_GROUP), which the count chooses up to one_group_lights lights
+  // (detail::LightCullPath).
+  detail::ComputePipeline one_group;
+  uint32_t one_group_size = 64;
+  uint32_t one_group_lights = 64;
+  detail::LightCullPath path = detail::LightCullPath::device;
   // One vec4 record per light.
   detail::OwnedBuffer records;
   Buffer records_state;
@@ -110,6 +123,19 @@ LightCuller::LightCuller(const Context& context, const LightCullConfig& config) 
   d.push_constant_bytes = sizeof(GlintCullPush);
   d.workgroup = {kCullGroup, 1};
   m.cull = detail::ComputePipeline(context, d);
+  // One workgroup of up to 1024 invocations (32 mask words in light_cull.comp); 64 on CPU devices,
+  // where a larger workgroup runs on one core while the four-dispatch path spreads its workgroups.
+  m.one_group_size =
+      context.info().type == VK_PHYSICAL_DEVICE_TYPE_CPU
+          ? kCullGroup
+          : std::min({1024u, props.limits.maxComputeWorkGroupInvocations, props.limits.maxComputeWorkGroupSize[0]});
+  // Up to kOneGroupSamples samples (lights x N^2): one multiprocessor then tests the lights faster
+  // than the four dispatches launch and drain (docs/OCCLUSION.md, "One workgroup for few lights").
+  m.one_group_lights = std::min(m.one_group_size, std::max(1u, kOneGroupSamples / (config.grid * config.grid)));
+  d.kernel_id = "light_cull_one_group";
+  d.bindings = {S, S, B, B, B, B, B};
+  d.workgroup = {m.one_group_size, 1};
+  m.one_group = detail::ComputePipeline(context, d);
   detail::Compaction::Desc cd;
   cd.max_items = config.max_lights;
   cd.scan_kernel = "light_cull_scan_main";  // writes the indirect arguments and statistics
@@ -140,6 +166,8 @@ uint32_t LightCuller::max_groups_per_instance() const {
   const uint64_t total = std::min<uint64_t>(uint64_t(m.max_groups_x) * m.max_groups_y, (1ull << 32) - m.max_groups_x);
   return uint32_t(std::min<uint64_t>(65535, total / std::max(1u, m.config.capacity)));
 }
+
+uint32_t LightCuller::one_group_lights() const { return impl_->one_group_lights; }
 
 void LightCuller::record(VkCommandBuffer cmd, HiZPyramid& hiz, Image& depth, Buffer& lights, uint32_t count,
                          const LightCullFrame& frame, LightCullOutputs& out, Profiler* profiler) {
@@ -189,10 +217,49 @@ void LightCuller::record(VkCommandBuffer cmd, HiZPyramid& hiz, Image& depth, Buf
   }
   Buffer& results = want_results ? out.results : m.dummy_state;
 
-  Buffer& groups_state = m.compact.groups();
-  detail::Barriers b;
-  m.compact.record_clear_once(cmd, b);  // the scan kernel resets the counters every frame
   const uint32_t flags = want_results ? GLINT_CULL_WRITE_RESULTS : 0u;
+  GlintCullPush push{};
+  std::copy(frame.view_proj, frame.view_proj + 16, push.view_proj);
+  push.width = static_cast<int32_t>(hc.extent.width);
+  push.height = static_cast<int32_t>(hc.extent.height);
+  push.count = count;
+  push.grid = m.config.grid;
+  push.levels = hiz.levels();
+  push.flags = (hc.reversed_z ? GLINT_CULL_REVERSED_Z : 0u) | flags |
+               (m.config.pattern == OcclusionPattern::regular ? GLINT_CULL_REGULAR_GRID : 0u);
+  push.margin_ndc = m.config.margin_ndc;
+  push.depth_bias = m.config.depth_bias;
+  detail::Barriers b;
+  const bool one_group = m.path == detail::LightCullPath::one_group ||
+                         (m.path == detail::LightCullPath::device && count <= m.one_group_lights);
+  if (one_group) {
+    // One workgroup: cull, grid test, slots, instances, results, arguments and statistics.
+    b.use(depth, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, kCompute, kSampled);
+    b.use(hiz.image(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, kCompute, kSampled, std::max(1u, hiz.levels()));
+    b.use(lights, kCompute, kStorageRead);
+    b.use(out.instances, kCompute, kStorageWrite);
+    b.use(results, kCompute, kStorageWrite);
+    b.use(out.indirect, kCompute, kStorageWrite);
+    b.use(out.stats, kCompute, kStorageWrite);
+    b.flush(cmd);
+    push.capacity = m.config.capacity;
+    push.vertex_count = frame.vertex_count;
+    push.groups_per_instance = frame.groups_per_instance;
+    push.max_group_count_x = m.max_groups_x;
+    m.one_group.dispatch(cmd,
+                         {{depth.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL},
+                          {hiz.image().view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL},
+                          lights,
+                          out.instances,
+                          results,
+                          out.indirect,
+                          out.stats},
+                         push, m.one_group_size, 1);
+    if (profiler) profiler->mark(cmd, "light cull");
+    return;
+  }
+  Buffer& groups_state = m.compact.groups();
+  m.compact.record_clear_once(cmd, b);  // the scan kernel resets the counters every frame
   // 1. Cull + grid test: visibility masks and records, the other lights' results, the counters.
   b.use(depth, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, kCompute, kSampled);
   b.use(hiz.image(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, kCompute, kSampled, std::max(1u, hiz.levels()));
@@ -203,17 +270,6 @@ void LightCuller::record(VkCommandBuffer cmd, HiZPyramid& hiz, Image& depth, Buf
   b.use(out.instances, kCompute, kStorageWrite);  // written by the scatter; here after the last frame's reads
   b.flush(cmd);
   if (count > 0) {
-    GlintCullPush push{};
-    std::copy(frame.view_proj, frame.view_proj + 16, push.view_proj);
-    push.width = static_cast<int32_t>(hc.extent.width);
-    push.height = static_cast<int32_t>(hc.extent.height);
-    push.count = count;
-    push.grid = m.config.grid;
-    push.levels = hiz.levels();
-    push.flags = (hc.reversed_z ? GLINT_CULL_REVERSED_Z : 0u) | flags |
-                 (m.config.pattern == OcclusionPattern::regular ? GLINT_CULL_REGULAR_GRID : 0u);
-    push.margin_ndc = m.config.margin_ndc;
-    push.depth_bias = m.config.depth_bias;
     m.cull.dispatch(cmd,
                     {{depth.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL},
                      {hiz.image().view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL},
@@ -241,5 +297,11 @@ void LightCuller::record(VkCommandBuffer cmd, HiZPyramid& hiz, Image& depth, Buf
   m.compact.record_scatter(cmd, b, cp, {&lights, &m.records_state}, {&out.instances, &results});
   if (profiler) profiler->mark(cmd, "cull scatter");
 }
+
+namespace detail {
+
+void LightCullAccess::select_path(LightCuller& culler, LightCullPath path) { culler.impl_->path = path; }
+
+}  // namespace detail
 
 }  // namespace glint

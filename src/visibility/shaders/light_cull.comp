@@ -34,11 +34,21 @@ layout(binding = 1) uniform texture2D hiz_tex;    // mip m = Hi-Z level m + 1
 // GlintFlareLight[] read as three vec4 per light (48 bytes): three 16-byte loads instead of twelve
 // 4-byte ones (the struct's members are 4-byte aligned, so its loads are not merged).
 layout(std430, binding = 2) readonly buffer Lights { vec4 light_words[]; };
+#ifndef GLINT_CULL_ONE_GROUP
 layout(std430, binding = 3) writeonly buffer Records { vec4 records[]; };  // centre.xy, fraction, ndc z
 layout(std430, binding = 4) writeonly buffer Results { GlintFlareLightResult results[]; };
 #define COMPACT_GROUPS_BINDING 5  // the compaction's group buffer: this writes the masks (x, y)
 #define COMPACT_NO_SCAN
 #include "compact.glsl"
+#else
+// GlintFlareInstance[] as integer words (bits stored as they are), as light_cull_scatter.comp.
+layout(std430, binding = 3) writeonly buffer Instances { uvec4 instance_words[]; };
+layout(std430, binding = 4) writeonly buffer Results { GlintFlareLightResult results[]; };
+layout(std430, binding = 5) writeonly buffer Indirect { GlintFlareIndirect indirect; };
+layout(std430, binding = 6) writeonly buffer Stats { GlintFlareStats stats; };
+// The visible lights of the current chunk, one bit per invocation (at most 1024 invocations).
+shared uint chunk_mask[32];
+#endif
 layout(push_constant) uniform Push { GlintCullPush pc; };
 
 shared uint group_frustum;
@@ -95,9 +105,8 @@ bool whole_light_hidden(vec2 origin, float unit, int n, bool regular, int k, ive
   const ivec2 p_lo = ivec2(ux.x, uy.x) << k;
   const ivec2 p_hi = ivec2(ux.y == lsize.x - 1 ? pixels.x - 1 : ((ux.y + 1) << k) - 1,
                            uy.y == lsize.y - 1 ? pixels.y - 1 : ((uy.y + 1) << k) - 1);
-  // A span of s pixels touches at most 2 texels of level kc when s - 1 <= 2^kc, wherever it lies.
   const int span = max(p_hi.x - p_lo.x, p_hi.y - p_lo.y) + 1;
-  int kc = span <= 2 ? 0 : findMSB(span - 2) + 1;
+  int kc = hiz_span_level(span);
   // One level lower where the range happens to lie in 2 texels per axis there (it is aligned; the
   // span rule holds for any placement): finer texels are nearer the light more often.
   if (kc > 0) {
@@ -145,6 +154,57 @@ float grid_test(vec2 center, float size, float z) {
   return float(visible) / float(n * n);
 }
 
+// Cull and grid test of light i: its state (GLINT_FLARE_VISIBLE, _OCCLUDED, _FRUSTUM or _DISABLED),
+// and for a light that reaches the grid test its pixel centre, visible fraction and NDC depth.
+// `words` are the light's three 16-byte words (position, intensity), (colour, size_px), (element,
+// enabled, reserved x2).
+uint cull_light(uint i, out vec4 words[3], out vec2 center, out float fraction, out float ndc_z) {
+  words[0] = light_words[3u * i];
+  words[1] = light_words[3u * i + 1u];
+  words[2] = light_words[3u * i + 2u];
+  center = vec2(0.0);
+  fraction = 0.0;
+  ndc_z = 0.0;
+  GlintFlareLight light;
+  light.position_x = words[0].x;
+  light.position_y = words[0].y;
+  light.position_z = words[0].z;
+  light.intensity = words[0].w;
+  light.color_r = words[1].x;
+  light.color_g = words[1].y;
+  light.color_b = words[1].z;
+  light.size_px = words[1].w;
+  light.element = floatBitsToUint(words[2].x);
+  light.enabled = floatBitsToUint(words[2].y);
+  light.reserved0 = floatBitsToUint(words[2].z);
+  light.reserved1 = floatBitsToUint(words[2].w);
+  if (light.enabled == 0u || !light_finite(light)) return GLINT_FLARE_DISABLED;
+  const vec4 p = vec4(light.position_x, light.position_y, light.position_z, 1.0);
+  const float m[16] = pc.view_proj;
+  const vec4 clip = vec4(m[0] * p.x + m[4] * p.y + m[8] * p.z + m[12], m[1] * p.x + m[5] * p.y + m[9] * p.z + m[13],
+                         m[2] * p.x + m[6] * p.y + m[10] * p.z + m[14], m[3] * p.x + m[7] * p.y + m[11] * p.z + m[15]);
+  // Overflowing clip coordinates (positions near the float range) are culled on the bits too.
+  const bool clip_finite = cull_finite(clip.x) && cull_finite(clip.y) && cull_finite(clip.z) && cull_finite(clip.w);
+  if (!clip_finite || !(clip.w > 0.0)) return GLINT_FLARE_FRUSTUM;
+  const vec3 ndc = clip.xyz / clip.w;
+  if (!(cull_finite(ndc.x) && cull_finite(ndc.y) && cull_finite(ndc.z) && abs(ndc.x) <= pc.margin_ndc &&
+        abs(ndc.y) <= pc.margin_ndc && ndc.z >= 0.0 && ndc.z <= 1.0)) {
+    return GLINT_FLARE_FRUSTUM;
+  }
+  center = (ndc.xy * 0.5 + 0.5) * vec2(pc.width, pc.height);
+  ndc_z = ndc.z;
+  const float size = light.size_px >= 1.0 ? min(light.size_px, GLINT_CULL_MAX_SIZE_PX) : 1.0;
+  fraction = grid_test(center, size, ndc_z);
+  return fraction > 0.0 ? GLINT_FLARE_VISIBLE : GLINT_FLARE_OCCLUDED;
+}
+
+void count_state(uint state) {
+  if (state == GLINT_FLARE_FRUSTUM) atomicAdd(group_frustum, 1u);
+  if (state == GLINT_FLARE_OCCLUDED) atomicAdd(group_occluded, 1u);
+  if (state == GLINT_FLARE_DISABLED) atomicAdd(group_disabled, 1u);
+}
+
+#ifndef GLINT_CULL_ONE_GROUP
 void main() {
   const uint lid = gl_LocalInvocationIndex;  // < GLINT_CULL_GROUP: the bit of this light in the mask
   if (lid == 0u) {
@@ -160,54 +220,17 @@ void main() {
   const uint i = gl_GlobalInvocationID.x;
   const bool in_range = i < pc.count;
   uint state = GLINT_FLARE_DISABLED;
-  float fraction = 0.0;
-  vec2 center = vec2(0.0);
-  float ndc_z = 0.0;
-  if (in_range) {
-    const vec4 l0 = light_words[3u * i], l1 = light_words[3u * i + 1u], l2 = light_words[3u * i + 2u];
-    GlintFlareLight light;
-    light.position_x = l0.x;
-    light.position_y = l0.y;
-    light.position_z = l0.z;
-    light.intensity = l0.w;
-    light.color_r = l1.x;
-    light.color_g = l1.y;
-    light.color_b = l1.z;
-    light.size_px = l1.w;
-    light.element = floatBitsToUint(l2.x);
-    light.enabled = floatBitsToUint(l2.y);
-    light.reserved0 = floatBitsToUint(l2.z);
-    light.reserved1 = floatBitsToUint(l2.w);
-    if (light.enabled != 0u && light_finite(light)) {
-      const vec4 p = vec4(light.position_x, light.position_y, light.position_z, 1.0);
-      const float m[16] = pc.view_proj;
-      const vec4 clip = vec4(m[0] * p.x + m[4] * p.y + m[8] * p.z + m[12], m[1] * p.x + m[5] * p.y + m[9] * p.z + m[13],
-                             m[2] * p.x + m[6] * p.y + m[10] * p.z + m[14], m[3] * p.x + m[7] * p.y + m[11] * p.z + m[15]);
-      state = GLINT_FLARE_FRUSTUM;
-      // Overflowing clip coordinates (positions near the float range) are culled on the bits too.
-      const bool clip_finite = cull_finite(clip.x) && cull_finite(clip.y) && cull_finite(clip.z) && cull_finite(clip.w);
-      if (clip_finite && clip.w > 0.0) {
-        const vec3 ndc = clip.xyz / clip.w;
-        if (cull_finite(ndc.x) && cull_finite(ndc.y) && cull_finite(ndc.z) && abs(ndc.x) <= pc.margin_ndc &&
-            abs(ndc.y) <= pc.margin_ndc && ndc.z >= 0.0 && ndc.z <= 1.0) {
-          center = (ndc.xy * 0.5 + 0.5) * vec2(pc.width, pc.height);
-          ndc_z = ndc.z;
-          const float size = light.size_px >= 1.0 ? min(light.size_px, GLINT_CULL_MAX_SIZE_PX) : 1.0;
-          fraction = grid_test(center, size, ndc_z);
-          state = fraction > 0.0 ? GLINT_FLARE_VISIBLE : GLINT_FLARE_OCCLUDED;
-        }
-      }
-    }
-  }
+  vec4 words[3];
+  vec2 center;
+  float fraction, ndc_z;
+  if (in_range) state = cull_light(i, words, center, fraction, ndc_z);
   const bool visible = in_range && state == GLINT_FLARE_VISIBLE;
 
   if (visible) {
     atomicOr(group_mask[lid >> 5u], 1u << (lid & 31u));
     records[i] = vec4(center, fraction, ndc_z);
   }
-  if (in_range && state == GLINT_FLARE_FRUSTUM) atomicAdd(group_frustum, 1u);
-  if (in_range && state == GLINT_FLARE_OCCLUDED) atomicAdd(group_occluded, 1u);
-  if (in_range && state == GLINT_FLARE_DISABLED) atomicAdd(group_disabled, 1u);
+  if (in_range) count_state(state);
   barrier();
   if (lid == 0u) {  // the counts go to the header through the tile scan (compact.glsl)
     groups[gl_WorkGroupID.x] =
@@ -221,3 +244,79 @@ void main() {
     results[i] = r;
   }
 }
+#else
+// The whole cull in one workgroup (few lights: light_culler.cpp): the lights in chunks of the
+// workgroup's size, one per invocation; a visible light's slot is the visible lights before its
+// chunk plus the bits below its own in the chunk's mask, so instances are in light order, as the
+// compaction of the multi-workgroup path puts them. Then the indirect arguments and statistics,
+// as light_cull_scan.comp writes them. No group buffer, no other dispatch.
+void main() {
+  const uint lid = gl_LocalInvocationIndex;
+  const uint size = gl_WorkGroupSize.x * gl_WorkGroupSize.y;  // at most 1024: 32 mask words
+  const uint words_used = (size + 31u) / 32u;
+  if (lid == 0u) {
+    group_frustum = 0u;
+    group_occluded = 0u;
+    group_disabled = 0u;
+  }
+  uint before = 0u;  // visible lights in the earlier chunks (the same in every invocation)
+  for (uint c0 = 0u; c0 < pc.count; c0 += size) {
+    if (lid < words_used) chunk_mask[lid] = 0u;
+    barrier();
+    const uint i = c0 + lid;
+    const bool in_range = i < pc.count;
+    uint state = GLINT_FLARE_DISABLED;
+    vec4 words[3];
+    vec2 center;
+    float fraction, ndc_z;
+    if (in_range) state = cull_light(i, words, center, fraction, ndc_z);
+    const bool visible = in_range && state == GLINT_FLARE_VISIBLE;
+    if (visible) atomicOr(chunk_mask[lid >> 5u], 1u << (lid & 31u));
+    if (in_range) count_state(state);
+    barrier();
+    uint below = bitCount(chunk_mask[lid >> 5u] & ((1u << (lid & 31u)) - 1u));
+    uint total = 0u;
+    for (uint w = 0u; w < words_used; ++w) {
+      const uint c = bitCount(chunk_mask[w]);
+      below += w < (lid >> 5u) ? c : 0u;
+      total += c;
+    }
+    const uint slot = before + below;
+    if (visible && slot < pc.capacity) {
+      // GlintFlareInstance: (centre, size_px, fraction), (colour, intensity),
+      // (light_index, element, ndc_depth, reserved).
+      instance_words[3u * slot] = floatBitsToUint(vec4(center, words[1].w, fraction));
+      instance_words[3u * slot + 1u] = floatBitsToUint(vec4(words[1].xyz, words[0].w));
+      instance_words[3u * slot + 2u] = uvec4(i, floatBitsToUint(words[2].x), floatBitsToUint(ndc_z), 0u);
+    }
+    if (in_range && (pc.flags & GLINT_CULL_WRITE_RESULTS) != 0u) {
+      GlintFlareLightResult r;
+      r.visible_fraction = visible && slot < pc.capacity ? fraction : 0.0;
+      r.culled = !visible ? state : slot < pc.capacity ? GLINT_FLARE_VISIBLE : GLINT_FLARE_OVERFLOW;
+      results[i] = r;
+    }
+    before += total;
+    barrier();  // the next chunk clears the mask
+  }
+  barrier();  // the counts' atomics are complete
+  if (lid != 0u) return;
+  const uint written = min(before, pc.capacity);
+  indirect.vertex_count = pc.vertex_count;
+  indirect.instance_count = written;
+  indirect.first_vertex = 0u;
+  indirect.first_instance = 0u;
+  const uint groups = written * pc.groups_per_instance;
+  indirect.group_count_x = min(groups, pc.max_group_count_x);
+  indirect.group_count_y = max(1u, (groups + pc.max_group_count_x - 1u) / pc.max_group_count_x);
+  indirect.group_count_z = 1u;
+  indirect.reserved = 0u;
+  stats.total = pc.count;
+  stats.frustum_culled = group_frustum;
+  stats.occluded = group_occluded;
+  stats.visible = before;
+  stats.overflow = before - written;
+  stats.disabled = group_disabled;
+  stats.reserved0 = 0u;
+  stats.reserved1 = 0u;
+}
+#endif

@@ -65,13 +65,16 @@ struct GlintCullPush {
   GLINT_INT width;            // viewport = depth image size in pixels
   GLINT_INT height;
   GLINT_UINT count;        // lights in the list
-  GLINT_UINT reserved0;    // 0; keeps the struct 16-byte aligned
+  GLINT_UINT capacity;     // instances the buffer holds (the one-workgroup cull; 0 otherwise)
   GLINT_UINT grid;         // N: N x N cells per footprint (1 to 16)
   GLINT_UINT levels;       // Hi-Z levels built above level 0 (0 to 14)
   GLINT_UINT flags;        // GLINT_CULL_*
   GLINT_FLOAT margin_ndc;  // frustum margin: |ndc.xy| <= margin_ndc passes
   GLINT_FLOAT depth_bias;  // visible where stored depth is not nearer than light depth - bias
-  GLINT_UINT reserved[3];
+  // The indirect arguments' words, for the one-workgroup cull (light_cull_scan.comp's otherwise):
+  GLINT_UINT vertex_count;         // LightCullFrame::vertex_count
+  GLINT_UINT groups_per_instance;  // LightCullFrame::groups_per_instance
+  GLINT_UINT max_group_count_x;    // maxComputeWorkGroupCount[0]
 };
 
 // Push constants of the light cull's compaction (light_cull_scan.comp, light_cull_scatter.comp):

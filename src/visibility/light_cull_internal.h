@@ -1,0 +1,29 @@
+// Internal switch of the light cull's path for benchmarks and tests (not installed).
+#pragma once
+
+#include <glint/occlusion.h>
+
+#include <cstdint>
+
+namespace glint::detail {
+
+/// The dispatches LightCuller::record() makes (docs/OCCLUSION.md, "Cull, occlusion grid test and
+/// compaction").
+enum class LightCullPath : uint32_t {
+  /// As the light count decides: `one_group` up to LightCuller::one_group_lights(), else `groups`.
+  /// The default.
+  device,
+  /// light_cull.comp, compact_scan_tiles.comp, light_cull_scan.comp, light_cull_scatter.comp:
+  /// workgroups of 64 lights, then the ordered compaction.
+  groups,
+  /// light_cull.comp built with GLINT_CULL_ONE_GROUP: one workgroup culls every light, in chunks of
+  /// its size, and writes the instances, arguments and statistics itself. Any count, on any device.
+  one_group,
+};
+
+struct LightCullAccess {
+  /// Selects the path `culler` records from now on.
+  static void select_path(LightCuller& culler, LightCullPath path);
+};
+
+}  // namespace glint::detail
