@@ -232,11 +232,15 @@ void LightCuller::record(VkCommandBuffer cmd, HiZPyramid& hiz, Image& depth, Buf
   detail::Barriers b;
   const bool one_group = m.path == detail::LightCullPath::one_group ||
                          (m.path == detail::LightCullPath::device && count <= m.one_group_lights);
+  // Both paths' first dispatch reads the depth, the pyramid and the lights (bindings 0 to 2).
+  b.use(depth, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, kCompute, kSampled);
+  b.use(hiz.image(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, kCompute, kSampled, std::max(1u, hiz.levels()));
+  b.use(lights, kCompute, kStorageRead);
+  const detail::Bindings inputs{{depth.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL},
+                                {hiz.image().view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL},
+                                lights};
   if (one_group) {
     // One workgroup: cull, grid test, slots, instances, results, arguments and statistics.
-    b.use(depth, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, kCompute, kSampled);
-    b.use(hiz.image(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, kCompute, kSampled, std::max(1u, hiz.levels()));
-    b.use(lights, kCompute, kStorageRead);
     b.use(out.instances, kCompute, kStorageWrite);
     b.use(results, kCompute, kStorageWrite);
     b.use(out.indirect, kCompute, kStorageWrite);
@@ -246,38 +250,24 @@ void LightCuller::record(VkCommandBuffer cmd, HiZPyramid& hiz, Image& depth, Buf
     push.vertex_count = frame.vertex_count;
     push.groups_per_instance = frame.groups_per_instance;
     push.max_group_count_x = m.max_groups_x;
-    m.one_group.dispatch(cmd,
-                         {{depth.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL},
-                          {hiz.image().view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL},
-                          lights,
-                          out.instances,
-                          results,
-                          out.indirect,
-                          out.stats},
-                         push, m.one_group_size, 1);
+    detail::Bindings set = inputs;
+    for (const Buffer* o : {&out.instances, &results, &out.indirect, &out.stats}) set.push_back(*o);
+    m.one_group.dispatch(cmd, set, push, m.one_group_size, 1);
     if (profiler) profiler->mark(cmd, "light cull");
     return;
   }
   Buffer& groups_state = m.compact.groups();
   m.compact.record_clear_once(cmd, b);  // the scan kernel resets the counters every frame
   // 1. Cull + grid test: visibility masks and records, the other lights' results, the counters.
-  b.use(depth, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, kCompute, kSampled);
-  b.use(hiz.image(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, kCompute, kSampled, std::max(1u, hiz.levels()));
-  b.use(lights, kCompute, kStorageRead);
   b.use(m.records_state, kCompute, kStorageWrite);
   b.use(results, kCompute, kStorageWrite);
   b.use(groups_state, kCompute, kStorageRead | kStorageWrite);
   b.use(out.instances, kCompute, kStorageWrite);  // written by the scatter; here after the last frame's reads
   b.flush(cmd);
   if (count > 0) {
-    m.cull.dispatch(cmd,
-                    {{depth.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL},
-                     {hiz.image().view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL},
-                     lights,
-                     m.records_state,
-                     results,
-                     groups_state},
-                    push, count, 1);
+    detail::Bindings set = inputs;
+    for (const Buffer* o : {&m.records_state, &results, &groups_state}) set.push_back(*o);
+    m.cull.dispatch(cmd, set, push, count, 1);
   }
   if (profiler) profiler->mark(cmd, "light cull");
   // 2. Scan: the masks (and the counters' atomics) are complete; first slots, arguments, stats.
