@@ -158,23 +158,29 @@ TEST_F(AllocationTest, ASteadyStateFrameOfEveryEffectAllocatesNothing) {
   LodBatch lod(context());
   HostBuffer queries(64 * sizeof(LodQuery)), levels(64 * sizeof(float));
 
+  // The raster pass culls 100 lights with a 16 x 16 grid, more than its culler's one_group_lights()
+  // (64 at N = 16 on every device): the four dispatches. The compute pass culls 16 lights in one
+  // workgroup.
   std::vector<std::unique_ptr<LensFlarePass>> passes;
+  std::vector<uint32_t> counts;
   for (FlareDrawPath path : {FlareDrawPath::raster, FlareDrawPath::compute}) {
     FlarePassConfig pc;
     pc.extent = size;
     pc.draw = path;
     pc.cull.capacity = 64;
+    pc.cull.grid = path == FlareDrawPath::raster ? 16 : 4;
     pc.per_light_results = true;
     passes.push_back(std::make_unique<LensFlarePass>(context(), pc));
+    counts.push_back(path == FlareDrawPath::raster ? 100 : 16);
   }
   reference::DepthImage far{size.width, size.height, std::vector<float>(size_t(size.width) * size.height, 1.0f)};
   auto depth = make_depth(far, VK_FORMAT_D32_SFLOAT);
   detail::OwnedImage color(context(), size, kF16, detail::kToolImageUsage | VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT);
   detail::upload(context(), color.state, random_hdr(size.width, size.height, 6));
-  std::vector<GlintFlareLight> list(16);
+  std::vector<GlintFlareLight> list(100);
   for (size_t i = 0; i < list.size(); ++i) {
     list[i] = GlintFlareLight{};
-    list[i].position_x = -0.5f + 0.06f * float(i);
+    list[i].position_x = -0.9f + 0.018f * float(i);
     list[i].position_z = 0.5f;
     list[i].intensity = list[i].color_r = list[i].color_g = list[i].color_b = 1.0f;
     list[i].size_px = 8.0f;
@@ -196,9 +202,9 @@ TEST_F(AllocationTest, ASteadyStateFrameOfEveryEffectAllocatesNothing) {
     c.pyramid += allocations_in([&] { pyramid.record(cmd, in.state, &profiler); });
     for (auto& g : gauss) c.gauss += allocations_in([&] { g->record(cmd, in.state, out.state, &profiler); });
     c.lod += allocations_in([&] { lod.record(cmd, queries.view, levels.view, 64, LodAtlasConfig{}, &profiler); });
-    for (auto& p : passes) {
+    for (size_t i = 0; i < passes.size(); ++i) {
       c.flare += allocations_in([&] {
-        p->record(cmd, color.state, depth.state, lights.view, uint32_t(list.size()), view_proj, look, &profiler);
+        passes[i]->record(cmd, color.state, depth.state, lights.view, counts[i], view_proj, look, &profiler);
       });
     }
   };
@@ -211,7 +217,8 @@ TEST_F(AllocationTest, ASteadyStateFrameOfEveryEffectAllocatesNothing) {
   EXPECT_EQ(second.pyramid, 0u) << "BlurPyramid::record";
   EXPECT_EQ(second.gauss, 0u) << "GaussianBlur::record (separable, pyramid, dual)";
   EXPECT_EQ(second.lod, 0u) << "LodBatch::record";
-  EXPECT_EQ(second.flare, 0u) << "LensFlarePass::record (Hi-Z, cull, raster and compute draws)";
+  EXPECT_EQ(second.flare, 0u)
+      << "LensFlarePass::record (Hi-Z, cull in one workgroup and in four dispatches, raster and compute draws)";
 }
 
 }  // namespace

@@ -163,12 +163,14 @@ class LightCuller {
   /// them. More lights, four dispatches: the cull and grid test in workgroups of 64 lights; the
   /// two-level scan (the second, one workgroup, gives every workgroup its first instance slot,
   /// writes the indirect arguments and statistics and resets the counters); the scatter of the
-  /// visible lights into their slots. Both give the same outputs, the same bits on every run.
+  /// visible lights into their slots. Both give the same outputs (bit for bit on every device
+  /// tested), the same bits on every run.
   /// A light with enabled == 0 or a non-finite float field is GLINT_FLARE_DISABLED.
   /// count == 0 is allowed (zero instances). Afterwards the
   /// outputs were last written by the compute shader stage: a draw needs a barrier to
   /// DRAW_INDIRECT / INDIRECT_COMMAND_READ for `indirect` and to VERTEX_SHADER (or COMPUTE) /
-  /// SHADER_STORAGE_READ for `instances`. The first record() clears the internal counters once.
+  /// SHADER_STORAGE_READ for `instances`. The first four-dispatch record() clears the internal
+  /// counters once.
   /// Throws Error before recording if a buffer is null, too small or lacks a usage, if `depth`
   /// does not match `hiz`, or if count or `frame` is out of range.
   void record(VkCommandBuffer cmd, HiZPyramid& hiz, Image& depth, Buffer& lights, uint32_t count,

@@ -2,7 +2,8 @@
 // (include/glint/flare_pass.h). Nothing here is new GPU work: the cull is told the draw's
 // vertices_per_instance() and groups_per_instance() (docs/FLARE.md, "Interface with the visibility
 // stage"), and each part writes its own barriers from the buffers' state fields, so the frame is
-// Hi-Z -> cull -> scan -> scatter -> draw on one command buffer with no readback.
+// Hi-Z -> cull (one dispatch for few lights, else cull, scan, scatter) -> draw on one command
+// buffer with no readback.
 #include <glint/flare_pass.h>
 #include <glint/gpu/flare_types.h>
 

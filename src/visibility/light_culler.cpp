@@ -62,7 +62,7 @@ static_assert(offsetof(GlintFlareInstance, center_x_px) == 0 && offsetof(GlintFl
 constexpr uint32_t kMaxGroupsX = 65535;  // guaranteed maxComputeWorkGroupCount[0]
 // Samples (lights x N^2) up to which the one-workgroup cull runs: on an NVIDIA H200 it won at
 // 1024 lights with N = 4 (22.9 against 28.4 us; 15.0 against 25.8 at 64 lights) and lost at
-// 1000 lights with N = 8 and 16 (65.7 against 61.9 us, 231.7 against 186.0), where one
+// 1000 lights with N = 8 and 16 (65.7 against 61.9 us, 231.7 against 185.9), where one
 // multiprocessor's fetch rate holds it; fewer samples only shorten its work.
 constexpr uint32_t kOneGroupSamples = 16384;
 

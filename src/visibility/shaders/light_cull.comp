@@ -4,7 +4,8 @@
 // Cull and occlusion grid test of the lens-flare lights (docs/OCCLUSION.md: a grid test on
 // the Hi-Z), the first of the four dispatches of the order-preserving compaction (the same
 // instance order on every run); built with GLINT_CULL_ONE_GROUP, the whole cull of few lights in
-// one workgroup (main() at the end). One invocation per light, GLINT_CULL_GROUP per workgroup:
+// one workgroup (main() at the end). One invocation per light, GLINT_CULL_GROUP per workgroup
+// (the one-workgroup variant: its whole workgroup, chunk after chunk):
 // 1. reject disabled lights and lights with a non-finite float field (GLINT_FLARE_DISABLED), then
 //    project (Vulkan conventions) and reject w <= 0, non-finite clip coordinates, depth outside
 //    [0, 1] and |ndc.xy| > margin (GLINT_FLARE_FRUSTUM);
@@ -23,7 +24,7 @@
 //    masks into instance slots by a prefix sum, light_cull_scatter.comp writes the instances, so
 //    instance order is light order on every run (no atomic decides a slot).
 // The frustum, occluded and disabled counts are summed in shared memory and travel in the group
-// record; the tile scan adds them to the group buffer's header (integer sums: order-independent)
+// record (the one-workgroup variant writes them to the statistics itself); the tile scan adds them to the group buffer's header (integer sums: order-independent)
 // and the top scan resets them, in a separate dispatch (no in-shader reset race,
 // SaschaWillems/Vulkan #748).
 layout(local_size_x_id = 0, local_size_y_id = 1) in;
