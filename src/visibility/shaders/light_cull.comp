@@ -51,6 +51,9 @@ layout(std430, binding = 5) writeonly buffer Indirect { GlintFlareIndirect indir
 layout(std430, binding = 6) writeonly buffer Stats { GlintFlareStats stats; };
 // The visible lights of the current chunk, one bit per invocation (at most 1024 invocations).
 shared uint chunk_mask[32];
+#define GLINT_CULL_STORES_INSTANCES
+#define GLINT_CULL_STORES_ARGUMENTS
+#include "light_cull_outputs.glsl"
 #endif
 layout(push_constant) uniform Push { GlintCullPush pc; };
 
@@ -286,11 +289,7 @@ void main() {
     }
     const uint slot = before + below;
     if (visible && slot < pc.capacity) {
-      // GlintFlareInstance: (centre, size_px, fraction), (colour, intensity),
-      // (light_index, element, ndc_depth, reserved).
-      instance_words[3u * slot] = floatBitsToUint(vec4(center, words[1].w, fraction));
-      instance_words[3u * slot + 1u] = floatBitsToUint(vec4(words[1].xyz, words[0].w));
-      instance_words[3u * slot + 2u] = uvec4(i, floatBitsToUint(words[2].x), floatBitsToUint(ndc_z), 0u);
+      cull_store_instance(slot, i, vec4(center, fraction, ndc_z), words[0], words[1], floatBitsToUint(words[2].x));
     }
     if (in_range && (pc.flags & GLINT_CULL_WRITE_RESULTS) != 0u) {
       GlintFlareLightResult r;
@@ -303,23 +302,7 @@ void main() {
   }
   barrier();  // the counts' atomics are complete
   if (lid != 0u) return;
-  const uint written = min(before, pc.capacity);
-  indirect.vertex_count = pc.vertex_count;
-  indirect.instance_count = written;
-  indirect.first_vertex = 0u;
-  indirect.first_instance = 0u;
-  const uint groups = written * pc.groups_per_instance;
-  indirect.group_count_x = min(groups, pc.max_group_count_x);
-  indirect.group_count_y = max(1u, (groups + pc.max_group_count_x - 1u) / pc.max_group_count_x);
-  indirect.group_count_z = 1u;
-  indirect.reserved = 0u;
-  stats.total = pc.count;
-  stats.frustum_culled = group_frustum;
-  stats.occluded = group_occluded;
-  stats.visible = before;
-  stats.overflow = before - written;
-  stats.disabled = group_disabled;
-  stats.reserved0 = 0u;
-  stats.reserved1 = 0u;
+  cull_store_arguments(pc.count, before, group_frustum, group_occluded, group_disabled, pc.capacity, pc.vertex_count,
+                       pc.groups_per_instance, pc.max_group_count_x);
 }
 #endif

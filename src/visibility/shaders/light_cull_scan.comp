@@ -16,29 +16,14 @@ layout(local_size_x_id = 0, local_size_y_id = 1) in;
 layout(std430, binding = 1) writeonly buffer Indirect { GlintFlareIndirect indirect; };
 layout(std430, binding = 2) writeonly buffer Stats { GlintFlareStats stats; };
 layout(push_constant) uniform Push { GlintCullCompactPush pc; };
+#define GLINT_CULL_STORES_ARGUMENTS
+#include "light_cull_outputs.glsl"
 
 void main() {
   const uint visible = compact_top_scan(pc.count, pc.tile_groups);
   if (gl_LocalInvocationIndex != 0u) return;
-  const uint written = min(visible, pc.capacity);
-  indirect.vertex_count = pc.vertex_count;
-  indirect.instance_count = written;
-  indirect.first_vertex = 0u;
-  indirect.first_instance = 0u;
-  // instances x groups_per_instance workgroups, as rows of at most maxComputeWorkGroupCount[0]
-  // (GlintFlareIndirect says how a kernel recovers its linear workgroup index).
-  const uint groups = written * pc.groups_per_instance;
-  indirect.group_count_x = min(groups, pc.max_group_count_x);
-  indirect.group_count_y = max(1u, (groups + pc.max_group_count_x - 1u) / pc.max_group_count_x);
-  indirect.group_count_z = 1u;
-  indirect.reserved = 0u;
-  stats.total = pc.count;
-  stats.frustum_culled = counters[GLINT_CULL_COUNTER_FRUSTUM];
-  stats.occluded = counters[GLINT_CULL_COUNTER_OCCLUDED];
-  stats.visible = visible;
-  stats.overflow = visible - written;
-  stats.disabled = counters[GLINT_CULL_COUNTER_DISABLED];
-  stats.reserved0 = 0u;
-  stats.reserved1 = 0u;
+  cull_store_arguments(pc.count, visible, counters[GLINT_CULL_COUNTER_FRUSTUM], counters[GLINT_CULL_COUNTER_OCCLUDED],
+                       counters[GLINT_CULL_COUNTER_DISABLED], pc.capacity, pc.vertex_count, pc.groups_per_instance,
+                       pc.max_group_count_x);
   compact_reset_counters();
 }

@@ -23,6 +23,8 @@ layout(std430, binding = 2) readonly buffer Records { vec4 records[]; };  // cen
 layout(std430, binding = 3) writeonly buffer Instances { uvec4 instance_words[]; };  // integer words: bits stored as they are
 layout(std430, binding = 4) writeonly buffer Results { GlintFlareLightResult results[]; };
 layout(push_constant) uniform Push { GlintCullCompactPush pc; };
+#define GLINT_CULL_STORES_INSTANCES
+#include "light_cull_outputs.glsl"
 
 void main() {
   const uint i = (gl_WorkGroupID.y * pc.groups_x + gl_WorkGroupID.x) * gl_WorkGroupSize.x + gl_LocalInvocationIndex;
@@ -33,14 +35,8 @@ void main() {
   uint state = GLINT_FLARE_VISIBLE;
   if (slot < pc.capacity) {
     // Light words: (position, intensity), (colour, size_px), (element, enabled, reserved x2).
-    const vec4 l1 = light_words[3u * i + 1u];
-    const float intensity = light_words[3u * i].w;
-    const uint element = floatBitsToUint(light_words[3u * i + 2u].x);
-    // GlintFlareInstance: (centre, size_px, fraction), (colour, intensity),
-    // (light_index, element, ndc_depth, reserved).
-    instance_words[3u * slot] = floatBitsToUint(vec4(record.xy, l1.w, record.z));
-    instance_words[3u * slot + 1u] = floatBitsToUint(vec4(l1.xyz, intensity));
-    instance_words[3u * slot + 2u] = uvec4(i, element, floatBitsToUint(record.w), 0u);
+    cull_store_instance(slot, i, record, light_words[3u * i], light_words[3u * i + 1u],
+                        floatBitsToUint(light_words[3u * i + 2u].x));
   } else {
     state = GLINT_FLARE_OVERFLOW;
   }
