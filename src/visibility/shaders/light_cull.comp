@@ -5,7 +5,7 @@
 // the Hi-Z), the first of the four dispatches of the order-preserving compaction (the same
 // instance order on every run); built with GLINT_CULL_ONE_GROUP, the whole cull of few lights in
 // one workgroup (main() at the end). One invocation per light, GLINT_CULL_GROUP per workgroup
-// (the one-workgroup variant: its whole workgroup, chunk after chunk):
+// (the one-workgroup variant: up to one invocation per sample, the lights chunk after chunk):
 // 1. reject disabled lights and lights with a non-finite float field (GLINT_FLARE_DISABLED), then
 //    project (Vulkan conventions) and reject w <= 0, non-finite clip coordinates, depth outside
 //    [0, 1] and |ndc.xy| > margin (GLINT_FLARE_FRUSTUM);
@@ -126,51 +126,81 @@ bool whole_light_hidden(vec2 origin, float unit, int n, bool regular, int k, ive
   return all(reversed ? greaterThan(d, vec4(zt)) : lessThan(d, vec4(zt)));
 }
 
-// Visible fraction of the size_px square centred at `center` (pixels) for a light at depth `z`.
-float grid_test(vec2 center, float size, float z) {
-  const int n = int(pc.grid);
-  const bool regular = (pc.flags & GLINT_CULL_REGULAR_GRID) != 0u;
-  const float cell = size / float(n);
-  const float unit = size / float(2 * n * n);  // cell / (2n), the unit of sample_span
-  const int k = min(cell <= 1.0 ? 0 : ceil_log2(cell), int(pc.levels));
-  const ivec2 lsize = max(ivec2(1), ivec2(pc.width, pc.height) >> k);
-  const bool reversed = (pc.flags & GLINT_CULL_REVERSED_Z) != 0u;
-  const float zt = reversed ? z + pc.depth_bias : z - pc.depth_bias;
-  const vec2 origin = center - 0.5 * size;
-  if (n > 1 && whole_light_hidden(origin, unit, n, regular, k, lsize, zt, reversed)) {
-    return 0.0;
-  }
-  int visible = 0;
-  for (int j = 0; j < n; ++j) {
-    for (int i = 0; i < n; ++i) {
-      const ivec2 sx = sample_span(i, j, n, regular), sy = sample_span(j, i, n, regular);
-      const ivec2 tx = texel_range(origin.x + float(sx.x) * unit, origin.x + float(sx.y) * unit, k, pc.width, lsize.x);
-      const ivec2 ty = texel_range(origin.y + float(sy.x) * unit, origin.y + float(sy.y) * unit, k, pc.height, lsize.y);
-      bool seen = (tx.y - tx.x + 1) * (ty.y - ty.x + 1) > GLINT_CULL_MAX_WINDOW_TEXELS;
-      for (int y = ty.x; y <= ty.y && !seen; ++y) {
-        for (int x = tx.x; x <= tx.y && !seen; ++x) {
-          const float d = fetch_level(k, ivec2(x, y));
-          // Visible where the stored depth is not nearer than the light.
-          seen = reversed ? d <= zt : d >= zt;
-        }
-      }
-      visible += seen ? 1 : 0;
-    }
-  }
-  return float(visible) / float(n * n);
+// The grid test of one light: what every sample of it needs (grid_setup), shared by the whole-light
+// early out and the samples.
+struct GridTest {
+  vec2 origin;    // the light square's top-left corner, pixels
+  float unit;     // cell / (2n), the unit of sample_span
+  float zt;       // the light's depth moved by the depth bias, compared with the texels
+  int n;          // samples per side
+  int k;          // the Hi-Z level the samples read
+  ivec2 lsize;    // that level's size
+  bool regular;   // GLINT_CULL_REGULAR_GRID
+  bool reversed;  // GLINT_CULL_REVERSED_Z
+};
+
+// The grid test of the size_px square centred at `center` (pixels) for a light at depth `z`.
+GridTest grid_setup(vec2 center, float size, float z) {
+  GridTest g;
+  g.n = int(pc.grid);
+  g.regular = (pc.flags & GLINT_CULL_REGULAR_GRID) != 0u;
+  const float cell = size / float(g.n);
+  g.unit = size / float(2 * g.n * g.n);
+  g.k = min(cell <= 1.0 ? 0 : ceil_log2(cell), int(pc.levels));
+  g.lsize = max(ivec2(1), ivec2(pc.width, pc.height) >> g.k);
+  g.reversed = (pc.flags & GLINT_CULL_REVERSED_Z) != 0u;
+  g.zt = g.reversed ? z + pc.depth_bias : z - pc.depth_bias;
+  g.origin = center - 0.5 * size;
+  return g;
 }
 
-// Cull and grid test of light i: its state (GLINT_FLARE_VISIBLE, _OCCLUDED, _FRUSTUM or _DISABLED),
-// and for a light that reaches the grid test its pixel centre, visible fraction and NDC depth.
-// `words` are the light's three 16-byte words (position, intensity), (colour, size_px), (element,
-// enabled, reserved x2).
-uint cull_light(uint i, out vec4 words[3], out vec2 center, out float fraction, out float ndc_z) {
+// Whether the grid test can stop at the whole-light early out (the fraction is then 0).
+bool grid_hidden(GridTest g) {
+  return g.n > 1 && whole_light_hidden(g.origin, g.unit, g.n, g.regular, g.k, g.lsize, g.zt, g.reversed);
+}
+
+// Whether the sample of cell (i, j) sees the light: any depth texel under its footprint is not
+// nearer than the light (the loop stops at the first such texel; the answer does not depend on
+// the order of the reads).
+bool sample_seen(GridTest g, int i, int j) {
+  const ivec2 sx = sample_span(i, j, g.n, g.regular), sy = sample_span(j, i, g.n, g.regular);
+  const ivec2 tx = texel_range(g.origin.x + float(sx.x) * g.unit, g.origin.x + float(sx.y) * g.unit, g.k, pc.width,
+                               g.lsize.x);
+  const ivec2 ty = texel_range(g.origin.y + float(sy.x) * g.unit, g.origin.y + float(sy.y) * g.unit, g.k, pc.height,
+                               g.lsize.y);
+  bool seen = (tx.y - tx.x + 1) * (ty.y - ty.x + 1) > GLINT_CULL_MAX_WINDOW_TEXELS;
+  for (int y = ty.x; y <= ty.y && !seen; ++y) {
+    for (int x = tx.x; x <= tx.y && !seen; ++x) {
+      const float d = fetch_level(g.k, ivec2(x, y));
+      // Visible where the stored depth is not nearer than the light.
+      seen = g.reversed ? d <= g.zt : d >= g.zt;
+    }
+  }
+  return seen;
+}
+
+// Visible fraction of the size_px square centred at `center` (pixels) for a light at depth `z`.
+float grid_test(vec2 center, float size, float z) {
+  const GridTest g = grid_setup(center, size, z);
+  if (grid_hidden(g)) return 0.0;
+  int visible = 0;
+  for (int j = 0; j < g.n; ++j) {
+    for (int i = 0; i < g.n; ++i) visible += sample_seen(g, i, j) ? 1 : 0;
+  }
+  return float(visible) / float(g.n * g.n);
+}
+
+// Cull of light i up to its grid test: GLINT_FLARE_DISABLED or _FRUSTUM, or GLINT_FLARE_VISIBLE for
+// a light that goes on to the grid test, with its pixel centre, NDC depth and size in pixels (the
+// square the grid covers). `words` are the light's three 16-byte words (position, intensity),
+// (colour, size_px), (element, enabled, reserved x2).
+uint cull_project(uint i, out vec4 words[3], out vec2 center, out float ndc_z, out float size) {
   words[0] = light_words[3u * i];
   words[1] = light_words[3u * i + 1u];
   words[2] = light_words[3u * i + 2u];
   center = vec2(0.0);
-  fraction = 0.0;
   ndc_z = 0.0;
+  size = 1.0;
   GlintFlareLight light;
   light.position_x = words[0].x;
   light.position_y = words[0].y;
@@ -199,7 +229,17 @@ uint cull_light(uint i, out vec4 words[3], out vec2 center, out float fraction, 
   }
   center = (ndc.xy * 0.5 + 0.5) * vec2(pc.width, pc.height);
   ndc_z = ndc.z;
-  const float size = light.size_px >= 1.0 ? min(light.size_px, GLINT_CULL_MAX_SIZE_PX) : 1.0;
+  size = light.size_px >= 1.0 ? min(light.size_px, GLINT_CULL_MAX_SIZE_PX) : 1.0;
+  return GLINT_FLARE_VISIBLE;
+}
+
+// Cull and grid test of light i: its state (GLINT_FLARE_VISIBLE, _OCCLUDED, _FRUSTUM or _DISABLED),
+// and for a light that reaches the grid test its pixel centre, visible fraction and NDC depth.
+uint cull_light(uint i, out vec4 words[3], out vec2 center, out float fraction, out float ndc_z) {
+  float size;
+  fraction = 0.0;
+  const uint state = cull_project(i, words, center, ndc_z, size);
+  if (state != GLINT_FLARE_VISIBLE) return state;
   fraction = grid_test(center, size, ndc_z);
   return fraction > 0.0 ? GLINT_FLARE_VISIBLE : GLINT_FLARE_OCCLUDED;
 }
@@ -251,54 +291,98 @@ void main() {
   }
 }
 #else
-// The whole cull in one workgroup (few lights: light_culler.cpp): the lights in chunks of the
-// workgroup's size, one per invocation; a visible light's slot is the visible lights before its
-// chunk plus the bits below its own in the chunk's mask, so instances are in light order, as the
-// compaction of the multi-workgroup path puts them. Then the indirect arguments and statistics,
-// as light_cull_scan.comp writes them. No group buffer, no other dispatch.
+// The whole cull in one workgroup (few lights: light_culler.cpp). The lights go in chunks. When the
+// workgroup holds more invocations than lights, each light gets `lanes` of them, which share its
+// grid test: lane s tests samples s, s + lanes, ... and adds how many see the light to the light's
+// shared count, and one lane runs the whole-light early out (lane n^2 when there is one lane per
+// sample and one more, else lane 0 before its samples). So the test of few lights waits on one
+// round of texel reads, not on a light's samples one after another. The count is an integer sum,
+// so the fraction is the one grid_test() returns. With as many lights as invocations or more
+// (lanes = 1) each invocation tests one light with cull_light(), as the four-dispatch path does.
+// A visible light's slot is the visible lights before its chunk plus the visible lights below it in
+// the chunk's mask, so instances are in light order, as the compaction of the multi-workgroup path
+// puts them. Then the indirect arguments and statistics, as light_cull_scan.comp writes them. No
+// group buffer, no other dispatch.
+shared uint light_seen[1024];  // per light of the chunk: samples that see it; bit 31: the early out
+const uint kHidden = 0x80000000u;
+
 void main() {
   const uint lid = gl_LocalInvocationIndex;
   const uint size = gl_WorkGroupSize.x * gl_WorkGroupSize.y;  // at most 1024: 32 mask words
-  const uint words_used = (size + 31u) / 32u;
+  const uint n2 = pc.grid * pc.grid;
+  // Invocations per light: one per sample and one for the early out when the workgroup holds them
+  // for every light (the same in every invocation: pc.count is uniform).
+  const uint lanes = clamp(size / max(pc.count, 1u), 1u, pc.grid > 1u ? n2 + 1u : 1u);
+  const uint per_chunk = size / lanes;  // lights per chunk
+  const uint words_used = (per_chunk + 31u) / 32u;
+  const uint l = lid / lanes, lane = lid % lanes;
+  const bool own_hidden_lane = lanes == n2 + 1u;  // lane n2 runs the early out, else lane 0 does
   if (lid == 0u) {
     group_frustum = 0u;
     group_occluded = 0u;
     group_disabled = 0u;
   }
   uint before = 0u;  // visible lights in the earlier chunks (the same in every invocation)
-  for (uint c0 = 0u; c0 < pc.count; c0 += size) {
+  for (uint c0 = 0u; c0 < pc.count; c0 += per_chunk) {
     if (lid < words_used) chunk_mask[lid] = 0u;
+    if (lid < per_chunk) light_seen[lid] = 0u;
     barrier();
-    const uint i = c0 + lid;
-    const bool in_range = i < pc.count;
+    const uint i = c0 + l;
+    const bool in_range = l < per_chunk && i < pc.count;
     uint state = GLINT_FLARE_DISABLED;
     vec4 words[3];
     vec2 center;
-    float fraction, ndc_z;
-    if (in_range) state = cull_light(i, words, center, fraction, ndc_z);
-    const bool visible = in_range && state == GLINT_FLARE_VISIBLE;
-    if (visible) atomicOr(chunk_mask[lid >> 5u], 1u << (lid & 31u));
-    if (in_range) count_state(state);
+    float ndc_z, fraction = 0.0;
+    if (lanes == 1u) {  // one invocation per light: the four-dispatch path's own test
+      if (in_range) state = cull_light(i, words, center, fraction, ndc_z);
+    } else {
+      float light_size;
+      if (in_range) state = cull_project(i, words, center, ndc_z, light_size);
+      if (in_range && state == GLINT_FLARE_VISIBLE) {  // the grid test, shared by the light's lanes
+        const GridTest g = grid_setup(center, light_size, ndc_z);
+        bool hidden = false;
+        if (lane == (own_hidden_lane ? n2 : 0u)) {
+          hidden = grid_hidden(g);
+          if (hidden) atomicOr(light_seen[l], kHidden);
+        }
+        uint seen = 0u;
+        for (uint t = lane; t < n2 && !hidden; t += lanes) {
+          seen += sample_seen(g, int(t % pc.grid), int(t / pc.grid)) ? 1u : 0u;
+        }
+        if (seen > 0u) atomicAdd(light_seen[l], seen);
+      }
+      barrier();
+      // Lane 0 of each light carries it from here.
+      if (in_range && lane == 0u && state == GLINT_FLARE_VISIBLE) {
+        const uint c = light_seen[l];
+        fraction = (c & kHidden) != 0u ? 0.0 : float(c) / float(n2);
+        state = fraction > 0.0 ? GLINT_FLARE_VISIBLE : GLINT_FLARE_OCCLUDED;
+      }
+    }
+    const bool leader = in_range && lane == 0u;
+    const bool visible = leader && state == GLINT_FLARE_VISIBLE;
+    if (visible) atomicOr(chunk_mask[l >> 5u], 1u << (l & 31u));
+    if (leader) count_state(state);
     barrier();
-    uint below = bitCount(chunk_mask[lid >> 5u] & ((1u << (lid & 31u)) - 1u));
+    uint below = bitCount(chunk_mask[l >> 5u] & ((1u << (l & 31u)) - 1u));
     uint total = 0u;
     for (uint w = 0u; w < words_used; ++w) {
       const uint c = bitCount(chunk_mask[w]);
-      below += w < (lid >> 5u) ? c : 0u;
+      below += w < (l >> 5u) ? c : 0u;
       total += c;
     }
     const uint slot = before + below;
     if (visible && slot < pc.capacity) {
       cull_store_instance(slot, i, vec4(center, fraction, ndc_z), words[0], words[1], floatBitsToUint(words[2].x));
     }
-    if (in_range && (pc.flags & GLINT_CULL_WRITE_RESULTS) != 0u) {
+    if (leader && (pc.flags & GLINT_CULL_WRITE_RESULTS) != 0u) {
       GlintFlareLightResult r;
       r.visible_fraction = visible && slot < pc.capacity ? fraction : 0.0;
       r.culled = !visible ? state : slot < pc.capacity ? GLINT_FLARE_VISIBLE : GLINT_FLARE_OVERFLOW;
       results[i] = r;
     }
     before += total;
-    barrier();  // the next chunk clears the mask
+    barrier();  // the next chunk clears the mask and the counts
   }
   barrier();  // the counts' atomics are complete
   if (lid != 0u) return;
