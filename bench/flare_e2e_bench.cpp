@@ -7,13 +7,15 @@
 // The scene is the occlusion benchmark's kind (reference::random_scene: sloped depth boxes, lights
 // in front of and behind them, at the edges, off screen, behind the camera), with flare sizes of
 // 8 to 128 px. Counters: median_us, visible / occluded / frustum_culled lights of the frame, and
-// the split into Hi-Z, cull (+ finalize) and draw of one more frame.
+// the split into Hi-Z, cull (+ finalize) and draw of one more frame, and each mark's own time
+// (us_ and the profiler label).
 #include <benchmark/benchmark.h>
 #include <glint/flare_pass.h>
 
 #include <algorithm>
 #include <array>
 #include <cstring>
+#include <map>
 #include <string>
 
 #include "bench_support.h"
@@ -79,7 +81,7 @@ void BM_FlareEndToEnd(benchmark::State& state) {
 
   // One more frame with the parts' marks, and its statistics.
   detail::OwnedBuffer readback(ctx, sizeof(GlintFlareStats), VK_BUFFER_USAGE_TRANSFER_DST_BIT, true);
-  const std::vector<Profiler::Stage> stages = stage_marks(ctx, 8, [&](VkCommandBuffer cmd, Profiler* p) {
+  const std::vector<Profiler::Stage> stages = stage_marks(ctx, 16, [&](VkCommandBuffer cmd, Profiler* p) {
     frame(cmd, p);
     detail::Barriers b;
     b.use(pass.stats(), VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
@@ -94,8 +96,12 @@ void BM_FlareEndToEnd(benchmark::State& state) {
   GlintFlareStats st;
   std::memcpy(&st, readback.mapped(), sizeof st);
   double hiz_us = 0, cull_us = 0, draw_us = 0;
+  std::map<std::string, double> by_label;  // us_ + label (spaces as '_'): each dispatch's mark
   for (const auto& s : stages) {
-    if (s.label == "hi-z") {
+    std::string key = "us_" + s.label;
+    std::replace(key.begin(), key.end(), ' ', '_');
+    by_label[key] += s.ms * 1e3;
+    if (s.label.rfind("hi-z", 0) == 0) {
       hiz_us += s.ms * 1e3;
     } else if (s.label.find("cull") != std::string::npos) {
       cull_us += s.ms * 1e3;
@@ -111,6 +117,9 @@ void BM_FlareEndToEnd(benchmark::State& state) {
   state.counters["us_hiz"] = hiz_us;
   state.counters["us_cull"] = cull_us;
   state.counters["us_draw"] = draw_us;
+  for (const auto& [key, us] : by_label) {
+    if (key != "us_hiz" && key != "us_cull" && key != "us_draw") state.counters[key] = us;
+  }
   state.SetLabel(std::string(compute ? "compute" : "raster") + " rgba16f, hi-z levels " +
                  std::to_string(pass.hiz().levels()) + " on " + ctx.info().name);
 }

@@ -100,12 +100,14 @@ void LensFlare::record_compute(VkCommandBuffer cmd, Image& color, Buffer& instan
   b.use(m.gather_args_state, kCompute, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
   b.flush(cmd);
   m.gather_args.dispatch(cmd, {indirect_words, m.gather_args_state}, ap, 1, 1);
+  if (profiler) profiler->mark(cmd, "flare arguments");
   // 2. The sprite pre-pass: every sprite of every instance, once.
   b.use(m.gather_args_state, kIndirect, VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT);
   b.use(instances, kCompute, VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
   b.use(store, kCompute, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
   b.flush(cmd);
   m.sprites.dispatch_indirect(cmd, {instances, indirect_words, store}, p, m.gather_args_buffer.buffer(), 16);
+  if (profiler) profiler->mark(cmd, "flare sprites");
   // 3. The gather, one workgroup per tile.
   b.use(store, kCompute, VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
   b.use(m.atlas_image.state, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, kCompute, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT,

@@ -288,6 +288,7 @@ void HiZPyramid::record(VkCommandBuffer cmd, Image& depth, Profiler* profiler) {
   b.flush(cmd);
   m.stream_pipeline.dispatch(cmd, m.stream_bindings(depth), m.stream_push, m.stream_width, m.stream_height);
   if (tile_pass) {  // the tile pass reads the stream pass's last level
+    if (profiler) profiler->mark(cmd, "hi-z stream");
     b.use(m.pyramid.state, VK_IMAGE_LAYOUT_GENERAL, kCompute, kStorageRead | kStorageWrite, std::max(1u, m.levels));
     b.flush(cmd);
     m.tile_pipeline.dispatch(cmd, m.tile_bindings(), m.tile_push, m.tile_groups_x * 256, m.tile_groups_y);
