@@ -16,6 +16,7 @@
 
 #include "core/barriers.h"
 #include "core/half.h"
+#include "flare/flare_internal.h"
 #include "flare/shaders/flare_params.h"
 #include "reference/flare_reference.h"
 #include "reference/lod_reference.h"
@@ -544,6 +545,64 @@ TEST_F(FlareTest, ComputeGathersManyLightsInBatchesAndChunks) {
   EXPECT_EQ(d.outside, 0u) << d.first;
   std::printf("flare compute, 300 lights: %u sprites on the busiest pixel, worst |error| / tolerance %.3f\n", most,
               d.worst_ratio);
+}
+
+// Up to one_dispatch_instances() instances (the gather's workgroup / 9), record_compute() draws in
+// one dispatch whose invocations evaluate the sprites themselves (flare_gather.comp, kFused); above
+// it, the launch arguments, the sprite pre-pass and the gather. Both list a tile's sprites in
+// (instance, slot) order and sum them in that order, so they give the same bits: 1 instance, the
+// limit, and 300 (several batches of the one-dispatch path, forced, and chunks), both formats. The
+// instances buffer's size picks the path: the commands record_compute() makes (barriers and
+// dispatches, detail::recorded_commands()) are the one-dispatch path's up to the limit and the
+// pre-pass's above it.
+TEST_F(FlareTest, OneDispatchDrawGivesTheBitsOfThePrePass) {
+  for (VkFormat format : {kF16, kF32}) {
+    const std::string fmt = format == kF16 ? "rgba16f" : "rgba32f";
+    LensFlare flare(context(), format, {kW, kH});
+    const uint32_t most = flare.one_dispatch_instances();
+    const uint32_t expected = context().info().type == VK_PHYSICAL_DEVICE_TYPE_CPU ? 64 / 9 : 256 / 9;
+    EXPECT_EQ(most, expected) << fmt;
+    ASSERT_GT(most, 0u);
+    const CpuImage background = as_stored(random_hdr(kW, kH, 81), format);
+    auto lights = random_instances(300, 31);
+    for (auto& g : lights) g.size_px = 2.0f + 0.3f * g.size_px;  // small, so that 300 stay readable
+    const FlareConfig config;
+    for (uint32_t n : {1u, most, 300u}) {
+      const std::vector<GlintFlareInstance> list(lights.begin(), lights.begin() + n);
+      FlareInputs in(list, n, flare.groups_per_instance());
+      detail::LensFlareAccess::select_gather(flare, detail::FlareGatherPath::pre_pass);
+      const CpuImage a = draw(flare, Path::compute, background, format, in, config);
+      detail::LensFlareAccess::select_gather(flare, detail::FlareGatherPath::one_dispatch);
+      const CpuImage b = draw(flare, Path::compute, background, format, in, config);
+      const std::string what = fmt + ", " + std::to_string(n) + " instances";
+      EXPECT_NE(std::memcmp(a.rgba.data(), background.rgba.data(), a.rgba.size() * 4), 0) << what << ": drew nothing";
+      EXPECT_EQ(std::memcmp(a.rgba.data(), b.rgba.data(), a.rgba.size() * 4), 0) << what;
+    }
+    detail::LensFlareAccess::select_gather(flare, detail::FlareGatherPath::device);
+    // Commands of one record_compute() with a buffer of `capacity` instances, on the same LensFlare
+    // (its pipelines and sprite store already made).
+    auto commands = [&](detail::FlareGatherPath path, size_t capacity) {
+      detail::LensFlareAccess::select_gather(flare, path);
+      FlareInputs in(std::vector<GlintFlareInstance>(lights.begin(), lights.begin() + 1), 1,
+                     flare.groups_per_instance(), capacity);
+      auto color = make_color(background, format);
+      uint64_t made = 0;
+      context().run_once([&](VkCommandBuffer cmd) {
+        in.record_upload(cmd);
+        record(flare, Path::compute, cmd, color.state, in, config);  // first use: makes what it needs
+        const uint64_t before = detail::recorded_commands();
+        record(flare, Path::compute, cmd, color.state, in, config);
+        made = detail::recorded_commands() - before;
+      });
+      detail::LensFlareAccess::select_gather(flare, detail::FlareGatherPath::device);
+      return made;
+    };
+    const uint64_t one = commands(detail::FlareGatherPath::one_dispatch, most + 1);
+    const uint64_t three = commands(detail::FlareGatherPath::pre_pass, most);
+    EXPECT_LT(one, three) << fmt;
+    EXPECT_EQ(commands(detail::FlareGatherPath::device, most), one) << fmt << ": " << most << " instances";
+    EXPECT_EQ(commands(detail::FlareGatherPath::device, most + 1), three) << fmt << ": " << most + 1 << " instances";
+  }
 }
 
 // The sprite pre-pass stores 304 bytes per instance in one storage-buffer descriptor, fewer

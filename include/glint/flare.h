@@ -16,6 +16,10 @@
 
 namespace glint {
 
+namespace detail {
+struct LensFlareAccess;  // benchmarks' and tests' switch of the compute draw's path (src/flare/flare_internal.h)
+}
+
 /// Named looks (docs/FLARE.md, "The look"): each sets only the anamorphic ratio and the intensity.
 enum class FlarePreset : uint32_t {
   retro_subtle = 0,   //!< anamorphic ratio 1.8, intensity 0.6
@@ -114,6 +118,11 @@ class LensFlare {
   /// device (maxStorageBufferRange / 48); record_compute() refuses an instance buffer whose range
   /// holds more.
   uint32_t max_compute_instances() const;
+  /// The most instances an instances buffer may hold for record_compute() to draw in one dispatch
+  /// (each of the gather's invocations evaluates one sprite, with no pre-pass and no launch
+  /// arguments to write): the gather's workgroup size / 9 (28 on GPUs, 7 on CPU devices). A larger
+  /// buffer takes three dispatches (docs/FLARE.md, "Compute (record_compute)").
+  uint32_t one_dispatch_instances() const;
 
   /// Records the atlas generation if it has not been recorded yet (adopted contexts; a no-op on
   /// standalone ones). record_*() call it themselves; call it earlier to keep the first frame short.
@@ -126,9 +135,10 @@ class LensFlare {
   void record_raster(VkCommandBuffer cmd, Image& color, Buffer& instances, Buffer& indirect, const FlareConfig& config,
                      Profiler* profiler = nullptr);
 
-  /// Compute path: one dispatch of flare_gather, a workgroup per screen tile, that reads the
+  /// Compute path: a dispatch of flare_gather, a workgroup per screen tile, that reads the
   /// instance count from `indirect`, bins the sprites that touch its tile, sums their light in fp32
-  /// and adds it to the lit pixels of `color`. Same image as record_raster within
+  /// and adds it to the lit pixels of `color`; before it, for an instances buffer of more than
+  /// one_dispatch_instances(), a sprite pre-pass and the two dispatches' launch arguments. Same image as record_raster within
   /// docs/FLARE.md's tolerance. Throws Error before recording anything for a bad argument.
   void record_compute(VkCommandBuffer cmd, Image& color, Buffer& instances, Buffer& indirect, const FlareConfig& config,
                       Profiler* profiler = nullptr);
@@ -140,6 +150,7 @@ class LensFlare {
   struct Impl;
 
  private:
+  friend struct detail::LensFlareAccess;
   std::unique_ptr<Impl> impl_;
 };
 

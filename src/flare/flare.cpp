@@ -212,6 +212,7 @@ LensFlare::~LensFlare() = default;
 
 uint32_t LensFlare::groups_per_instance() const { return 1; }
 uint32_t LensFlare::max_compute_instances() const { return impl_->max_compute_instances; }
+uint32_t LensFlare::one_dispatch_instances() const { return impl_->one_dispatch_instances(); }
 void LensFlare::record_setup(VkCommandBuffer cmd) {
   detail::check_command_buffer("LensFlare::record_setup", cmd);
   impl_->record_setup(cmd);

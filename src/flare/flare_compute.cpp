@@ -7,20 +7,20 @@ namespace glint {
 using namespace flare_detail;
 using detail::concat;
 
-detail::ComputePipeline LensFlare::Impl::make_gather(uint32_t beyond_store) const {
+detail::ComputePipeline LensFlare::Impl::make_gather(uint32_t beyond_store, uint32_t one_dispatch) const {
   const auto SB = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
   detail::PipelineDesc d;
   d.kernel_id = std::string("flare_gather_") + detail::format_variant(format);
   d.bindings = {SB, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, SB, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, SB};
   d.push_constant_bytes = sizeof(GlintFlarePush);
   d.workgroup = workgroup;
-  d.specialization = {beyond_store};
+  d.specialization = {beyond_store, one_dispatch};
   return detail::ComputePipeline(*context, d);
 }
 
 void LensFlare::Impl::make_compute_pipelines() {
   const auto SB = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-  gather = make_gather(0);
+  gather = make_gather(0, 0);
   detail::PipelineDesc sp;
   sp.kernel_id = "flare_sprites_main";
   sp.bindings = {SB, SB, SB};
@@ -64,6 +64,36 @@ void LensFlare::record_compute(VkCommandBuffer cmd, Image& color, Buffer& instan
   const VkDeviceSize bound_offset = args_offset - args_offset % m.storage_alignment;
   const Buffer indirect_words{indirect.buffer, bound_offset,   args_offset - bound_offset + sizeof(uint32_t),
                               indirect.usage,  indirect.stage, indirect.access};
+  GlintFlarePush p = m.push(config);
+  p.indirect_word = uint32_t((args_offset - bound_offset) / sizeof(uint32_t));
+  detail::Barriers b;
+  // (A workgroup of fewer than GLINT_FLARE_SPRITES invocations, which ContextOptions::workgroup_2d
+  // can force, holds no instance's sprites: it always takes the pre-pass.)
+  const bool one_dispatch = m.one_dispatch_instances() > 0 &&
+                            (m.gather_path == detail::FlareGatherPath::one_dispatch ||
+                             (m.gather_path == detail::FlareGatherPath::device &&
+                              instances.size / sizeof(GlintFlareInstance) <= m.one_dispatch_instances()));
+  if (one_dispatch) {
+    // The gather evaluates the sprites itself: one dispatch of every tile, launched whatever the
+    // count (each tile of a frame without instances reads the count and stores nothing). `blocks`
+    // (binding 4) is not read; the instances buffer stands in for it.
+    if (!m.gather_one_dispatch_made) {
+      m.gather_one_dispatch = m.make_gather(0, 1);
+      m.gather_one_dispatch_made = true;
+    }
+    b.use(indirect, kCompute, VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
+    b.use(instances, kCompute, VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
+    b.use(m.atlas_image.state, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, kCompute, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT,
+          GLINT_FLARE_ATLAS_LEVELS);
+    b.use(color, VK_IMAGE_LAYOUT_GENERAL, kCompute, kStorageRW);
+    b.flush(cmd);
+    m.gather_one_dispatch.dispatch(
+        cmd, {instances, m.atlas_binding(), indirect_words, {color.view, VK_IMAGE_LAYOUT_GENERAL}, instances}, p,
+        m.tiles_x * m.workgroup.x, m.tiles_y * m.workgroup.y);
+    if (profiler) profiler->mark(cmd, "flare gather");
+    return;
+  }
+
   // Instances whose sprites the pre-pass stores (all of them up to max_stored_instances).
   const uint32_t capacity = std::min(uint32_t(instances.size / sizeof(GlintFlareInstance)), m.max_stored_instances);
   if (m.sprite_stores.empty() || m.sprite_stores.back()->capacity < capacity) {
@@ -85,15 +115,12 @@ void LensFlare::record_compute(VkCommandBuffer cmd, Image& color, Buffer& instan
   // The instances buffer holds more than the store: the gather evaluates the rest itself.
   const bool beyond = instances.size / sizeof(GlintFlareInstance) > sprite_store.capacity;
   if (beyond && !m.gather_beyond_made) {
-    m.gather_beyond = m.make_gather(1);
+    m.gather_beyond = m.make_gather(1, 0);
     m.gather_beyond_made = true;
   }
 
-  GlintFlarePush p = m.push(config);
-  p.indirect_word = uint32_t((args_offset - bound_offset) / sizeof(uint32_t));
   GlintFlareGatherArgsPush ap{p.indirect_word, m.tiles_x, m.tiles_y, std::min(capacity, sprite_store.capacity),
                               m.max_groups_x};
-  detail::Barriers b;
   // 1. The launch arguments: every tile when any instance is visible, none otherwise; the
   //    pre-pass's groups for the instances.
   b.use(indirect, kCompute, VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
@@ -120,4 +147,10 @@ void LensFlare::record_compute(VkCommandBuffer cmd, Image& color, Buffer& instan
                          p, m.gather_args_buffer.buffer(), 0);
   if (profiler) profiler->mark(cmd, "flare gather");
 }
+
+namespace detail {
+
+void LensFlareAccess::select_gather(LensFlare& flare, FlareGatherPath path) { flare.impl_->gather_path = path; }
+
+}  // namespace detail
 }  // namespace glint

@@ -21,6 +21,7 @@
 #include "core/kernel_table.h"
 #include "core/pipeline.h"
 #include "core/resources.h"
+#include "flare/flare_internal.h"
 #include "flare/shaders/flare_params.h"
 
 namespace glint::flare_detail {
@@ -69,6 +70,10 @@ struct LensFlare::Impl {
   // made at its first use.
   detail::ComputePipeline gather_beyond;
   bool gather_beyond_made = false;
+  // The one-dispatch gather (specialization constant 3 = 1), made at its first use.
+  detail::ComputePipeline gather_one_dispatch;
+  bool gather_one_dispatch_made = false;
+  detail::FlareGatherPath gather_path = detail::FlareGatherPath::device;
   detail::OwnedBuffer gather_args_buffer;  // the gather's VkDispatchIndirectCommand, then the pre-pass's
   Buffer gather_args_state;
   // The pre-pass's sprite blocks, one store per size: a larger instances buffer gets a new store,
@@ -96,7 +101,8 @@ struct LensFlare::Impl {
   void make_atlas();
   void make_raster_pipeline();
   void make_compute_pipelines();
-  detail::ComputePipeline make_gather(uint32_t beyond_store) const;
+  detail::ComputePipeline make_gather(uint32_t beyond_store, uint32_t one_dispatch) const;
+  uint32_t one_dispatch_instances() const { return workgroup.x * workgroup.y / GLINT_FLARE_SPRITES; }
   void record_setup(VkCommandBuffer cmd);
   GlintFlarePush push(const FlareConfig& c) const;
   void check_inputs(const char* fn, const Image& color, VkImageUsageFlags usage, const char* usage_name,

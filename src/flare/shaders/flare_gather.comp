@@ -4,7 +4,9 @@
 // Lens flares for compute-only engines (docs/FLARE.md, "The two paths": compute), accumulated by gathering: one
 // workgroup per screen tile of GLINT_FLARE_GATHER_ROWS x workgroup pixels (each invocation keeps
 // its column's pixels in registers), no atomics on the image or on any global buffer. The sprites
-// were evaluated once for the frame by flare_sprites.comp (layout in flare_params.h).
+// were evaluated once for the frame by flare_sprites.comp (layout in flare_params.h), or, for few
+// instances (kFused), by the gather's own invocations, one sprite each: the whole draw is then
+// this one dispatch.
 // 1. Binning: invocation t takes instance base + t (the count is instance_count of the indirect
 //    arguments, read here; indices past the buffers are skipped), tests the union of its sprites'
 //    conservative rectangles against the tile and, when it meets the tile, each sprite's own
@@ -35,6 +37,12 @@ layout(push_constant) uniform Push { GlintFlarePush pc; };
 // 1 when the instances buffer holds more instances than the sprite store (LensFlare::record_compute
 // picks this variant only then): the sprites of the instances beyond it are evaluated here.
 layout(constant_id = 2) const uint kBeyondStore = 0u;
+// 1 for the one-dispatch draw of few instances (LensFlare::record_compute picks it when the
+// instances buffer holds at most threads / GLINT_FLARE_SPRITES instances): there is no pre-pass,
+// invocation t evaluates sprite t % GLINT_FLARE_SPRITES of instance t / GLINT_FLARE_SPRITES itself
+// and lists it where it meets the tile, so the list is in the same (instance, slot) order and the
+// sums are the same as the pre-pass's draw gives. `blocks` is not read.
+layout(constant_id = 3) const uint kFused = 0u;
 
 const uint kMaxThreads = GLINT_FLARE_GATHER_MAX_THREADS;
 shared uint s_scan[2][kMaxThreads];                     // hit counts, then their prefix sums
@@ -71,17 +79,29 @@ void main() {
   // Instances below `stored` have their sprites in `blocks`; the rest (only with kBeyondStore:
   // an instances buffer larger than one descriptor of blocks holds) are evaluated here, with the
   // same function.
-  const uint stored = min(count, uint(blocks.length()) / GLINT_FLARE_BLOCK_VEC4S);
-  if (kBeyondStore == 0u) count = stored;
+  const uint stored = kFused != 0u ? 0u : min(count, uint(blocks.length()) / GLINT_FLARE_BLOCK_VEC4S);
+  if (kBeyondStore == 0u && kFused == 0u) count = stored;
+  // Instances per batch: one per invocation, or (kFused) one per GLINT_FLARE_SPRITES invocations.
+  const uint batch = kFused != 0u ? threads / GLINT_FLARE_SPRITES : threads;
 
   vec3 sum[GLINT_FLARE_GATHER_ROWS];  // indexed by unrolled loops only, so it stays in registers
   [[unroll]] for (uint r = 0u; r < GLINT_FLARE_GATHER_ROWS; ++r) sum[r] = vec3(0.0);
 
-  for (uint base = 0u; base < count; base += threads) {
-    // 1. Binning: the instance's union rectangle, then each of its sprites, against the tile.
+  for (uint base = 0u; base < count; base += batch) {
+    // 1. Binning: the instance's union rectangle, then each of its sprites, against the tile
+    //    (kFused: this invocation's own sprite).
     uint i = base + t;
     uint hits = 0u;  // bit `slot`: that sprite meets the tile
-    if (i < count) {
+    GlintFlareSprite mine;  // kFused: the sprite this invocation evaluated
+    if (kFused != 0u) {
+      const uint slot = t % GLINT_FLARE_SPRITES;
+      i = base + t / GLINT_FLARE_SPRITES;
+      if (t / GLINT_FLARE_SPRITES < batch && i < count) {
+        mine = glint_flare_sprite(instances[i], slot, pc);
+        vec4 b = glint_flare_sprite_bounds(mine);
+        if (b.x < tile_hi.x && b.z > tile_lo.x && b.y < tile_hi.y && b.w > tile_lo.y) hits = 1u << slot;
+      }
+    } else if (i < count) {
       vec4 u = kBeyondStore != 0u && i >= stored ? vec4(tile_lo, tile_hi) : blocks[i * GLINT_FLARE_BLOCK_VEC4S];
       if (u.x < tile_hi.x && u.z > tile_lo.x && u.y < tile_hi.y && u.w > tile_lo.y) {
         [[unroll]] for (uint slot = 0u; slot < GLINT_FLARE_SPRITES; ++slot) {
@@ -120,12 +140,18 @@ void main() {
     for (uint at = s_scan[src][t] - own; hits != 0u; ++at) {
       uint slot = uint(findLSB(hits));
       hits &= hits - 1u;
-      s_list[at] = i * 16u + slot;
+      if (kFused == 0u) {
+        s_list[at] = i * 16u + slot;
+      } else {  // at most one sprite per invocation, so the list is one chunk: stored as it is
+        s_rect[at] = vec4(mine.lo, mine.size);
+        s_rgb_lod[at] = vec4(mine.rgb, mine.lod);
+        s_tile[at] = mine.tile;
+      }
     }
     for (uint e0 = 0u; e0 < listed; e0 += threads) {
       barrier();  // the previous chunk's sprites have been shaded (and every invocation read `listed`)
       // 2. Sprites: one per invocation, mostly as flare_sprites.comp stored it.
-      if (e0 + t < listed) {
+      if (kFused == 0u && e0 + t < listed) {
         uint packed = s_list[e0 + t];
         GlintFlareSprite s = gather_sprite(packed >> 4u, packed & 15u, stored);
         s_rect[t] = vec4(s.lo, s.size);
