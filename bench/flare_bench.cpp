@@ -28,6 +28,7 @@
 #include "bench_support.h"
 #include "core/barriers.h"
 #include "core/resources.h"
+#include "flare/flare_internal.h"
 #include "flare/shaders/flare_params.h"
 #include "reference/flare_reference.h"
 #include "support/transfer.h"
@@ -59,18 +60,17 @@ std::vector<GlintFlareInstance> bench_lights(uint32_t n, uint32_t width, uint32_
   return out;
 }
 
-void BM_FlareDraw(benchmark::State& state) {
-  const auto width = static_cast<uint32_t>(state.range(0));
-  const auto height = static_cast<uint32_t>(state.range(1));
-  const auto lights = static_cast<uint32_t>(state.range(2));
-  const bool compute = state.range(3) != 0;
-  const bool mixed = state.range(4) != 0;
+// The draw of `lights` instances (an instances buffer of exactly that many) into a width x height
+// RGBA16F image, the compute path with its dispatches chosen by `path`.
+void run_flare_draw(benchmark::State& state, uint32_t width, uint32_t height, uint32_t lights, bool compute, bool mixed,
+                    detail::FlareGatherPath path) {
   const Context& ctx = context();
   const VkFormat format = VK_FORMAT_R16G16B16A16_SFLOAT;
 
   detail::OwnedImage color(ctx, {width, height}, format, detail::kToolImageUsage | VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT);
   detail::upload(ctx, color.state, random_hdr(width, height, 7));
   LensFlare flare(ctx, format, {width, height});
+  detail::LensFlareAccess::select_gather(flare, path);
   const FlareConfig config = FlareConfig::preset(FlarePreset::cinematic);
 
   const std::vector<GlintFlareInstance> list = bench_lights(lights, width, height, mixed);
@@ -128,8 +128,16 @@ void BM_FlareDraw(benchmark::State& state) {
   state.counters["lights"] = lights;
   state.counters["sprite_pixels"] = pixels;
   state.counters["fill_pixels_per_second"] = benchmark::Counter(pixels, benchmark::Counter::kIsIterationInvariantRate);
-  state.SetLabel(std::string(compute ? "compute" : "raster") + (mixed ? " mixed sizes" : "") + " rgba16f on " +
-                 ctx.info().name);
+  const bool one_dispatch = path == detail::FlareGatherPath::one_dispatch ||
+                            (path == detail::FlareGatherPath::device && lights <= flare.one_dispatch_instances());
+  state.SetLabel(std::string(compute ? (one_dispatch ? "compute, one dispatch" : "compute, pre-pass") : "raster") +
+                 (mixed ? " mixed sizes" : "") + " rgba16f on " + ctx.info().name);
+}
+
+void BM_FlareDraw(benchmark::State& state) {
+  run_flare_draw(state, static_cast<uint32_t>(state.range(0)), static_cast<uint32_t>(state.range(1)),
+                 static_cast<uint32_t>(state.range(2)), state.range(3) != 0, state.range(4) != 0,
+                 detail::FlareGatherPath::device);
 }
 
 BENCHMARK(BM_FlareDraw)
@@ -142,6 +150,20 @@ BENCHMARK(BM_FlareDraw)
     ->Args({1920, 1080, 0, 0, 0})
     ->Args({1920, 1080, 0, 1, 0})
     ->ArgNames({"w", "h", "lights", "compute", "sizes"})
+    ->UseManualTime()
+    ->Unit(benchmark::kMicrosecond);
+
+// The compute draw's two structures on the same lights (1920x1080, mixed sizes), whatever the
+// instance count would choose: path 1 the launch arguments, sprite pre-pass and gather, path 2 the
+// one-dispatch gather that evaluates the sprites itself (LensFlare::one_dispatch_instances()).
+void BM_FlareGatherPath(benchmark::State& state) {
+  run_flare_draw(state, 1920, 1080, static_cast<uint32_t>(state.range(0)), true, true,
+                 state.range(1) == 1 ? detail::FlareGatherPath::pre_pass : detail::FlareGatherPath::one_dispatch);
+}
+
+BENCHMARK(BM_FlareGatherPath)
+    ->ArgsProduct({{10, 28, 64, 128, 256, 1000}, {1, 2}})
+    ->ArgNames({"lights", "path"})
     ->UseManualTime()
     ->Unit(benchmark::kMicrosecond);
 

@@ -547,27 +547,26 @@ TEST_F(FlareTest, ComputeGathersManyLightsInBatchesAndChunks) {
               d.worst_ratio);
 }
 
-// Up to one_dispatch_instances() instances (the gather's workgroup / 9), record_compute() draws in
-// one dispatch whose invocations evaluate the sprites themselves (flare_gather.comp, kFused); above
-// it, the launch arguments, the sprite pre-pass and the gather. Both list a tile's sprites in
-// (instance, slot) order and sum them in that order, so they give the same bits: 1 instance, the
-// limit, and 300 (several batches of the one-dispatch path, forced, and chunks), both formats. The
-// instances buffer's size picks the path: the commands record_compute() makes (barriers and
-// dispatches, detail::recorded_commands()) are the one-dispatch path's up to the limit and the
-// pre-pass's above it.
+// Up to one_dispatch_instances() instances (the gather's workgroup / 9 on GPUs, none on CPU
+// devices), record_compute() draws in one dispatch whose invocations evaluate the sprites themselves
+// (flare_gather.comp, kFused); above it, the launch arguments, the sprite pre-pass and the gather.
+// Both list a tile's sprites in (instance, slot) order and sum them in that order, so they give the
+// same bits: 1 instance, 28 (one batch of the GPUs' 32x8 workgroup, four of lavapipe's 8x8) and 300
+// (several batches, and chunks), both formats, the path forced. The instances buffer's size picks
+// the path: the commands record_compute() makes (barriers and dispatches,
+// detail::recorded_commands()) are the one-dispatch path's up to the limit and the pre-pass's above.
 TEST_F(FlareTest, OneDispatchDrawGivesTheBitsOfThePrePass) {
   for (VkFormat format : {kF16, kF32}) {
     const std::string fmt = format == kF16 ? "rgba16f" : "rgba32f";
     LensFlare flare(context(), format, {kW, kH});
     const uint32_t most = flare.one_dispatch_instances();
-    const uint32_t expected = context().info().type == VK_PHYSICAL_DEVICE_TYPE_CPU ? 64 / 9 : 256 / 9;
+    const uint32_t expected = context().info().type == VK_PHYSICAL_DEVICE_TYPE_CPU ? 0 : 256 / 9;
     EXPECT_EQ(most, expected) << fmt;
-    ASSERT_GT(most, 0u);
     const CpuImage background = as_stored(random_hdr(kW, kH, 81), format);
     auto lights = random_instances(300, 31);
     for (auto& g : lights) g.size_px = 2.0f + 0.3f * g.size_px;  // small, so that 300 stay readable
     const FlareConfig config;
-    for (uint32_t n : {1u, most, 300u}) {
+    for (uint32_t n : {1u, 28u, 300u}) {
       const std::vector<GlintFlareInstance> list(lights.begin(), lights.begin() + n);
       FlareInputs in(list, n, flare.groups_per_instance());
       detail::LensFlareAccess::select_gather(flare, detail::FlareGatherPath::pre_pass);
@@ -598,9 +597,11 @@ TEST_F(FlareTest, OneDispatchDrawGivesTheBitsOfThePrePass) {
       return made;
     };
     const uint64_t one = commands(detail::FlareGatherPath::one_dispatch, most + 1);
-    const uint64_t three = commands(detail::FlareGatherPath::pre_pass, most);
+    const uint64_t three = commands(detail::FlareGatherPath::pre_pass, std::max(most, 1u));
     EXPECT_LT(one, three) << fmt;
-    EXPECT_EQ(commands(detail::FlareGatherPath::device, most), one) << fmt << ": " << most << " instances";
+    if (most > 0) {
+      EXPECT_EQ(commands(detail::FlareGatherPath::device, most), one) << fmt << ": " << most << " instances";
+    }
     EXPECT_EQ(commands(detail::FlareGatherPath::device, most + 1), three) << fmt << ": " << most + 1 << " instances";
   }
 }

@@ -120,8 +120,9 @@ class LensFlare {
   uint32_t max_compute_instances() const;
   /// The most instances an instances buffer may hold for record_compute() to draw in one dispatch
   /// (each of the gather's invocations evaluates one sprite, with no pre-pass and no launch
-  /// arguments to write): the gather's workgroup size / 9 (28 on GPUs, 7 on CPU devices). A larger
-  /// buffer takes three dispatches (docs/FLARE.md, "Compute (record_compute)").
+  /// arguments to write): the gather's workgroup size / 9 on GPUs (28), 0 on CPU devices, where
+  /// the pre-pass is faster. A larger buffer takes three dispatches (docs/FLARE.md,
+  /// "Compute (record_compute)").
   uint32_t one_dispatch_instances() const;
 
   /// Records the atlas generation if it has not been recorded yet (adopted contexts; a no-op on
@@ -138,8 +139,9 @@ class LensFlare {
   /// Compute path: a dispatch of flare_gather, a workgroup per screen tile, that reads the
   /// instance count from `indirect`, bins the sprites that touch its tile, sums their light in fp32
   /// and adds it to the lit pixels of `color`; before it, for an instances buffer of more than
-  /// one_dispatch_instances(), a sprite pre-pass and the two dispatches' launch arguments. Same image as record_raster within
-  /// docs/FLARE.md's tolerance. Throws Error before recording anything for a bad argument.
+  /// one_dispatch_instances(), a sprite pre-pass and the two dispatches' launch arguments. Same
+  /// image as record_raster within docs/FLARE.md's tolerance. Throws Error before recording
+  /// anything for a bad argument.
   void record_compute(VkCommandBuffer cmd, Image& color, Buffer& instances, Buffer& indirect, const FlareConfig& config,
                       Profiler* profiler = nullptr);
 

@@ -197,6 +197,7 @@ LensFlare::LensFlare(const Context& context, VkFormat color_format, VkExtent2D e
     m.workgroup = {32, 8};
   }
   if (m.workgroup.x * m.workgroup.y > GLINT_FLARE_GATHER_MAX_THREADS) m.workgroup = {16, 16};
+  m.one_dispatch_limit = context.info().type == VK_PHYSICAL_DEVICE_TYPE_CPU ? 0 : m.one_dispatch_batch();
   const uint32_t tile_h = m.workgroup.y * GLINT_FLARE_GATHER_ROWS;
   m.tiles_x = (extent.width + m.workgroup.x - 1) / m.workgroup.x;
   m.tiles_y = (extent.height + tile_h - 1) / tile_h;
@@ -212,7 +213,7 @@ LensFlare::~LensFlare() = default;
 
 uint32_t LensFlare::groups_per_instance() const { return 1; }
 uint32_t LensFlare::max_compute_instances() const { return impl_->max_compute_instances; }
-uint32_t LensFlare::one_dispatch_instances() const { return impl_->one_dispatch_instances(); }
+uint32_t LensFlare::one_dispatch_instances() const { return impl_->one_dispatch_limit; }
 void LensFlare::record_setup(VkCommandBuffer cmd) {
   detail::check_command_buffer("LensFlare::record_setup", cmd);
   impl_->record_setup(cmd);

@@ -69,10 +69,10 @@ void LensFlare::record_compute(VkCommandBuffer cmd, Image& color, Buffer& instan
   detail::Barriers b;
   // (A workgroup of fewer than GLINT_FLARE_SPRITES invocations, which ContextOptions::workgroup_2d
   // can force, holds no instance's sprites: it always takes the pre-pass.)
-  const bool one_dispatch = m.one_dispatch_instances() > 0 &&
-                            (m.gather_path == detail::FlareGatherPath::one_dispatch ||
-                             (m.gather_path == detail::FlareGatherPath::device &&
-                              instances.size / sizeof(GlintFlareInstance) <= m.one_dispatch_instances()));
+  const bool one_dispatch =
+      m.one_dispatch_batch() > 0 && (m.gather_path == detail::FlareGatherPath::one_dispatch ||
+                                     (m.gather_path == detail::FlareGatherPath::device &&
+                                      instances.size / sizeof(GlintFlareInstance) <= m.one_dispatch_limit));
   if (one_dispatch) {
     // The gather evaluates the sprites itself: one dispatch of every tile, launched whatever the
     // count (each tile of a frame without instances reads the count and stores nothing). `blocks`

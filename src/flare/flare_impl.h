@@ -102,7 +102,13 @@ struct LensFlare::Impl {
   void make_raster_pipeline();
   void make_compute_pipelines();
   detail::ComputePipeline make_gather(uint32_t beyond_store, uint32_t one_dispatch) const;
-  uint32_t one_dispatch_instances() const { return workgroup.x * workgroup.y / GLINT_FLARE_SPRITES; }
+  // Instances per batch of the one-dispatch gather (one invocation per sprite).
+  uint32_t one_dispatch_batch() const { return workgroup.x * workgroup.y / GLINT_FLARE_SPRITES; }
+  // The most instances for which record_compute() takes the one-dispatch gather by itself: one
+  // batch on GPUs; none on CPU devices, which run a tile's invocations one after another, so that
+  // every tile evaluating the sprites itself costs more than the two dispatches it saves (lavapipe,
+  // 10 lights at 1080p: 164 ms with the pre-pass, 256 ms in one dispatch).
+  uint32_t one_dispatch_limit = 0;
   void record_setup(VkCommandBuffer cmd);
   GlintFlarePush push(const FlareConfig& c) const;
   void check_inputs(const char* fn, const Image& color, VkImageUsageFlags usage, const char* usage_name,

@@ -16,7 +16,8 @@ enum class FlareGatherPath : uint32_t {
   /// sprite evaluated once, then the gather reading them.
   pre_pass,
   /// flare_gather.comp with kFused: the gather evaluates the sprites itself, one per invocation,
-  /// in batches of one_dispatch_instances() instances. Any count, on any device.
+  /// in batches of (workgroup size / 9) instances. Any count, on any device whose gather workgroup
+  /// holds 9 invocations (else the pre-pass).
   one_dispatch,
 };
 

@@ -37,7 +37,7 @@ layout(push_constant) uniform Push { GlintFlarePush pc; };
 // 1 when the instances buffer holds more instances than the sprite store (LensFlare::record_compute
 // picks this variant only then): the sprites of the instances beyond it are evaluated here.
 layout(constant_id = 2) const uint kBeyondStore = 0u;
-// 1 for the one-dispatch draw of few instances (LensFlare::record_compute picks it when the
+// 1 for the one-dispatch draw of few instances (LensFlare::record_compute picks it on GPUs when the
 // instances buffer holds at most threads / GLINT_FLARE_SPRITES instances): there is no pre-pass,
 // invocation t evaluates sprite t % GLINT_FLARE_SPRITES of instance t / GLINT_FLARE_SPRITES itself
 // and lists it where it meets the tile, so the list is in the same (instance, slot) order and the
