@@ -95,6 +95,9 @@ struct LightCuller::Impl {
   // GLINT_CULL_ONE_GROUP), which the count chooses up to one_group_lights lights
   // (detail::LightCullPath).
   detail::ComputePipeline one_group;
+  // The same kernel with one invocation per light (specialization constant kShareSamples = 0), for
+  // as many lights as invocations or more, where no light's samples can be shared.
+  detail::ComputePipeline one_group_per_light;
   uint32_t one_group_size = 64;
   uint32_t one_group_lights = 64;
   detail::LightCullPath path = detail::LightCullPath::device;
@@ -135,7 +138,11 @@ LightCuller::LightCuller(const Context& context, const LightCullConfig& config) 
   d.kernel_id = "light_cull_one_group";
   d.bindings = {S, S, B, B, B, B, B};
   d.workgroup = {m.one_group_size, 1};
+  d.specialization = {1};
   m.one_group = detail::ComputePipeline(context, d);
+  d.specialization = {0};
+  m.one_group_per_light = detail::ComputePipeline(context, d);
+  d.specialization = {};
   detail::Compaction::Desc cd;
   cd.max_items = config.max_lights;
   cd.scan_kernel = "light_cull_scan_main";  // writes the indirect arguments and statistics
@@ -252,7 +259,9 @@ void LightCuller::record(VkCommandBuffer cmd, HiZPyramid& hiz, Image& depth, Buf
     push.max_group_count_x = m.max_groups_x;
     detail::Bindings set = inputs;
     for (const Buffer* o : {&out.instances, &results, &out.indirect, &out.stats}) set.push_back(*o);
-    m.one_group.dispatch(cmd, set, push, m.one_group_size, 1);
+    // Fewer lights than invocations: the lights share their samples over the workgroup.
+    (m.one_group_size / std::max(count, 1u) >= 2 ? m.one_group : m.one_group_per_light)
+        .dispatch(cmd, set, push, m.one_group_size, 1);
     if (profiler) profiler->mark(cmd, "light cull");
     return;
   }

@@ -305,6 +305,9 @@ void main() {
 // group buffer, no other dispatch.
 shared uint light_seen[1024];  // per light of the chunk: samples that see it; bit 31: the early out
 const uint kHidden = 0x80000000u;
+// 0: one invocation per light whatever the count (light_culler.cpp picks this build when the
+// workgroup holds no more invocations than lights, so that the kernel is the plain per-light one).
+layout(constant_id = 2) const uint kShareSamples = 1u;
 
 void main() {
   const uint lid = gl_LocalInvocationIndex;
@@ -312,7 +315,7 @@ void main() {
   const uint n2 = pc.grid * pc.grid;
   // Invocations per light: one per sample and one for the early out when the workgroup holds them
   // for every light (the same in every invocation: pc.count is uniform).
-  const uint lanes = clamp(size / max(pc.count, 1u), 1u, pc.grid > 1u ? n2 + 1u : 1u);
+  const uint lanes = kShareSamples != 0u ? clamp(size / max(pc.count, 1u), 1u, pc.grid > 1u ? n2 + 1u : 1u) : 1u;
   const uint per_chunk = size / lanes;  // lights per chunk
   const uint words_used = (per_chunk + 31u) / 32u;
   const uint l = lid / lanes, lane = lid % lanes;
