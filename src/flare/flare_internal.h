@@ -17,7 +17,7 @@ enum class FlareGatherPath : uint32_t {
   pre_pass,
   /// flare_gather.comp with kFused: the gather evaluates the sprites itself, one per invocation,
   /// in batches of (workgroup size / 9) instances. Any count, on any device whose gather workgroup
-  /// holds 9 invocations (else the pre-pass).
+  /// holds at least 9 invocations (else the pre-pass).
   one_dispatch,
 };
 

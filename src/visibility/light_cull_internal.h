@@ -18,8 +18,8 @@ enum class LightCullPath : uint32_t {
   groups,
   /// light_cull.comp built with GLINT_CULL_ONE_GROUP: one workgroup culls every light, in chunks of
   /// its size, and writes the instances, arguments and statistics itself. Any count, on any device.
-  /// Fewer lights than invocations share their samples over the workgroup on GPUs, not on CPU
-  /// devices (docs/OCCLUSION.md, "One workgroup for few lights").
+  /// Up to half as many lights as invocations share their samples over the workgroup on GPUs, not
+  /// on CPU devices (docs/OCCLUSION.md, "One workgroup for few lights").
   one_group,
   /// `one_group` with the samples shared wherever the count allows, on any device (tests run the
   /// shared build on CPU devices so).

@@ -96,11 +96,11 @@ struct LightCuller::Impl {
   // (detail::LightCullPath).
   detail::ComputePipeline one_group;
   // The same kernel with one invocation per light (specialization constant kShareSamples = 0), for
-  // as many lights as invocations or more, where no light's samples can be shared.
+  // more than half as many lights as invocations (where each light would get one) and on CPU devices.
   detail::ComputePipeline one_group_per_light;
   uint32_t one_group_size = 64;
   uint32_t one_group_lights = 64;
-  // Whether fewer lights than invocations share their samples (GPUs). CPU devices run a
+  // Whether up to half as many lights as invocations share their samples (GPUs). CPU devices run a
   // workgroup's invocations one after another, so sharing only adds its barrier and atomics there
   // (lavapipe, 10 lights: 79 us per light, 119 us shared).
   bool share_samples = true;
@@ -265,7 +265,8 @@ void LightCuller::record(VkCommandBuffer cmd, HiZPyramid& hiz, Image& depth, Buf
     push.max_group_count_x = m.max_groups_x;
     detail::Bindings set = inputs;
     for (const Buffer* o : {&out.instances, &results, &out.indirect, &out.stats}) set.push_back(*o);
-    // Fewer lights than invocations: on GPUs the lights share their samples over the workgroup.
+    // At most half as many lights as invocations: on GPUs the lights share their samples over the
+    // workgroup (at least two invocations each).
     const bool share = (m.share_samples || m.path == detail::LightCullPath::one_group_shared_samples) &&
                        m.one_group_size / std::max(count, 1u) >= 2;
     (share ? m.one_group : m.one_group_per_light).dispatch(cmd, set, push, m.one_group_size, 1);

@@ -14,7 +14,10 @@
 //    at a position given by an exclusive prefix sum of the invocations' hit counts
 //    (Hillis & Steele 1986, in shared memory): the list is in (instance, slot) order, the order the
 //    raster path draws in, on every run: no atomic decides the order of the sums, so every run gives the same bits.
-// 2. Sprites: the listed sprites are read into shared memory in chunks of one per invocation.
+//    kFused: invocation t evaluates sprite t % GLINT_FLARE_SPRITES of instance
+//    base + t / GLINT_FLARE_SPRITES and tests that sprite's rectangle; the list has the same order.
+// 2. Sprites: the listed sprites are read into shared memory in chunks of one per invocation
+//    (kFused: the invocation that listed a sprite stores it there itself; one chunk per batch).
 // 3. Shading: every invocation adds glint_flare_shade (the function flare.frag evaluates) of every
 //    listed sprite at each of its pixel centres, in fp32.
 // Finally a pixel that received light is read, gains the sum and is written once (alpha kept);
@@ -46,7 +49,7 @@ layout(constant_id = 3) const uint kFused = 0u;
 
 const uint kMaxThreads = GLINT_FLARE_GATHER_MAX_THREADS;
 shared uint s_scan[2][kMaxThreads];                     // hit counts, then their prefix sums
-shared uint s_list[kMaxThreads * GLINT_FLARE_SPRITES];  // instance * 16 + slot
+shared uint s_list[kMaxThreads * GLINT_FLARE_SPRITES];  // instance * 16 + slot (not used with kFused)
 shared vec4 s_rect[kMaxThreads];                        // lo.xy, size.xy of the listed sprites
 shared vec4 s_rgb_lod[kMaxThreads];
 shared uint s_tile[kMaxThreads];

@@ -49,7 +49,7 @@ layout(std430, binding = 3) writeonly buffer Instances { uvec4 instance_words[];
 layout(std430, binding = 4) writeonly buffer Results { GlintFlareLightResult results[]; };
 layout(std430, binding = 5) writeonly buffer Indirect { GlintFlareIndirect indirect; };
 layout(std430, binding = 6) writeonly buffer Stats { GlintFlareStats stats; };
-// The visible lights of the current chunk, one bit per invocation (at most 1024 invocations).
+// The visible lights of the current chunk, one bit per light of the chunk (at most 1024).
 shared uint chunk_mask[32];
 #define GLINT_CULL_STORES_INSTANCES
 #define GLINT_CULL_STORES_ARGUMENTS
@@ -297,16 +297,18 @@ void main() {
 // shared count, and one lane runs the whole-light early out (lane n^2 when there is one lane per
 // sample and one more, else lane 0 before its samples). So the test of few lights waits on one
 // round of texel reads, not on a light's samples one after another. The count is an integer sum,
-// so the fraction is the one grid_test() returns. With as many lights as invocations or more
-// (lanes = 1) each invocation tests one light with cull_light(), as the four-dispatch path does.
+// so the fraction is the one grid_test() returns. With more than half as many lights as
+// invocations (lanes = 1) each invocation tests one light with cull_light(), as the four-dispatch
+// path does.
 // A visible light's slot is the visible lights before its chunk plus the visible lights below it in
 // the chunk's mask, so instances are in light order, as the compaction of the multi-workgroup path
 // puts them. Then the indirect arguments and statistics, as light_cull_scan.comp writes them. No
 // group buffer, no other dispatch.
 shared uint light_seen[1024];  // per light of the chunk: samples that see it; bit 31: the early out
 const uint kHidden = 0x80000000u;
-// 0: one invocation per light whatever the count (light_culler.cpp picks this build when the
-// workgroup holds no more invocations than lights, so that the kernel is the plain per-light one).
+// 0: one invocation per light whatever the count (light_culler.cpp picks this build on CPU devices
+// and for more than half as many lights as invocations): lanes is then the constant 1, so the
+// sharing code and light_seen fold away.
 layout(constant_id = 2) const uint kShareSamples = 1u;
 
 void main() {
@@ -328,7 +330,7 @@ void main() {
   uint before = 0u;  // visible lights in the earlier chunks (the same in every invocation)
   for (uint c0 = 0u; c0 < pc.count; c0 += per_chunk) {
     if (lid < words_used) chunk_mask[lid] = 0u;
-    if (lid < per_chunk) light_seen[lid] = 0u;
+    if (lanes > 1u && lid < per_chunk) light_seen[lid] = 0u;
     barrier();
     const uint i = c0 + l;
     const bool in_range = l < per_chunk && i < pc.count;
