@@ -684,8 +684,12 @@ TEST_F(OcclusionTest, OneWorkgroupCullGivesTheBitsOfTheFourDispatches) {
           EXPECT_EQ(std::memcmp(c.results.data(), d.results.data(), c.results.size() * sizeof c.results[0]), 0)
               << lights;
           ASSERT_EQ(c.instances.size(), d.instances.size()) << lights;
-          EXPECT_EQ(std::memcmp(c.instances.data(), d.instances.data(), c.instances.size() * sizeof c.instances[0]), 0)
-              << lights;
+          // (memcmp of an empty vector's data(), which may be null, is undefined: none visible at 1 light.)
+          if (!c.instances.empty()) {
+            EXPECT_EQ(std::memcmp(c.instances.data(), d.instances.data(), c.instances.size() * sizeof c.instances[0]),
+                      0)
+                << lights;
+          }
           EXPECT_TRUE(c.canary_intact && d.canary_intact) << lights;
           expect_cull_matches(c, first, cc, reversed, 8, lights);
         }
