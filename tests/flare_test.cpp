@@ -560,6 +560,7 @@ TEST_F(FlareTest, OneDispatchDrawGivesTheBitsOfThePrePass) {
   for (VkFormat format : {kF16, kF32}) {
     const std::string fmt = format == kF16 ? "rgba16f" : "rgba32f";
     LensFlare flare(context(), format, {kW, kH});
+    const reference::FlareAtlas atlas = read_flare_atlas(flare);
     const uint32_t most = flare.one_dispatch_instances();
     // The gather's workgroup as flare.cpp picks it: 32x8 on GPUs with 256 invocations and 32-wide
     // subgroups, else the device's 2D choice.
@@ -584,6 +585,10 @@ TEST_F(FlareTest, OneDispatchDrawGivesTheBitsOfThePrePass) {
       const std::string what = fmt + ", " + std::to_string(n) + " instances";
       EXPECT_NE(std::memcmp(a.rgba.data(), background.rgba.data(), a.rgba.size() * 4), 0) << what << ": drew nothing";
       EXPECT_EQ(std::memcmp(a.rgba.data(), b.rgba.data(), a.rgba.size() * 4), 0) << what;
+      // And against the float64 reference on its own (lavapipe never takes it by itself).
+      const auto ref = reference::flare_composite(background, list, n, config, atlas, flare_sampler_precision());
+      const FlareDeviation d = compare_flare(b, ref, format);
+      EXPECT_EQ(d.outside, 0u) << what << ", one dispatch: " << d.first;
     }
     detail::LensFlareAccess::select_gather(flare, detail::FlareGatherPath::device);
     // Commands of one record_compute() with a buffer of `capacity` instances, on the same LensFlare

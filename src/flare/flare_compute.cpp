@@ -21,6 +21,12 @@ detail::ComputePipeline LensFlare::Impl::make_gather(uint32_t beyond_store, uint
 void LensFlare::Impl::make_compute_pipelines() {
   const auto SB = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
   gather = make_gather(0, 0);
+  // The one-dispatch gather, here where the device takes it by itself (so that a first frame does
+  // not compile it); on CPU devices only a forced path makes it, at its first use.
+  if (one_dispatch_limit > 0) {
+    gather_one_dispatch = make_gather(0, 1);
+    gather_one_dispatch_made = true;
+  }
   detail::PipelineDesc sp;
   sp.kernel_id = "flare_sprites_main";
   sp.bindings = {SB, SB, SB};

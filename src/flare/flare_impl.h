@@ -70,7 +70,8 @@ struct LensFlare::Impl {
   // made at its first use.
   detail::ComputePipeline gather_beyond;
   bool gather_beyond_made = false;
-  // The one-dispatch gather (specialization constant 3 = 1), made at its first use.
+  // The one-dispatch gather (specialization constant 3 = 1), made with the others on GPUs, at its
+  // first use elsewhere.
   detail::ComputePipeline gather_one_dispatch;
   bool gather_one_dispatch_made = false;
   detail::FlareGatherPath gather_path = detail::FlareGatherPath::device;
