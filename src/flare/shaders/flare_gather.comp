@@ -53,6 +53,7 @@ shared uint s_list[kMaxThreads * GLINT_FLARE_SPRITES];  // instance * 16 + slot 
 shared vec4 s_rect[kMaxThreads];                        // lo.xy, size.xy of the listed sprites
 shared vec4 s_rgb_lod[kMaxThreads];
 shared uint s_tile[kMaxThreads];
+shared uint s_hit[kMaxThreads / 32u];  // kFused: bit t % 32 of word t / 32 is set when invocation t's sprite meets the tile
 
 // The sprite in `slot` of instance i: read from the pre-pass's block when the instance has one,
 // else evaluated.
@@ -97,6 +98,8 @@ void main() {
     uint hits = 0u;  // bit `slot`: that sprite meets the tile
     GlintFlareSprite mine;  // kFused: the sprite this invocation evaluated
     if (kFused != 0u) {
+      // The previous batch's last barrier ended its reads of the mask.
+      if (t < (threads + 31u) / 32u) s_hit[t] = 0u;
       const uint slot = t % GLINT_FLARE_SPRITES;
       i = base + t / GLINT_FLARE_SPRITES;
       if (t / GLINT_FLARE_SPRITES < batch && i < count) {
@@ -113,15 +116,37 @@ void main() {
         }
       }
     }
-    // Inclusive scan of the hit counts (the previous batch's last barrier ended its reads), one
-    // step per power of two below the workgroup size (at most GLINT_FLARE_GATHER_MAX_THREADS =
-    // 256), written out: `threads` is a specialization constant, so the steps past it fold away
-    // and no loop is left (lavapipe ends a shader after 65535 loop iterations in all, which the
-    // loop over batches would otherwise reach with a few hundred thousand instances).
-    const uint own = uint(bitCount(hits));
-    s_scan[0][t] = own;
-    barrier();
-    uint src = 0u;
+    uint listed;  // sprites in this batch's list: the same in every invocation
+    if (kFused != 0u) {
+      // At most one sprite per invocation: its place in the list is the number of invocations
+      // before it whose sprite meets the tile, counted in a mask of one bit per invocation that
+      // the invocations set with atomicOr (OR gives the same bits in any order): two barriers,
+      // where the scan below takes one per power of two up to the workgroup size.
+      barrier();
+      if (hits != 0u) atomicOr(s_hit[t >> 5u], 1u << (t & 31u));
+      barrier();
+      uint at = uint(bitCount(s_hit[t >> 5u] & ((1u << (t & 31u)) - 1u)));
+      listed = 0u;
+      for (uint w = 0u; w < (threads + 31u) / 32u; ++w) {
+        const uint c = uint(bitCount(s_hit[w]));
+        listed += c;
+        if (w < (t >> 5u)) at += c;
+      }
+      if (hits != 0u) {  // one chunk: stored as it is
+        s_rect[at] = vec4(mine.lo, mine.size);
+        s_rgb_lod[at] = vec4(mine.rgb, mine.lod);
+        s_tile[at] = mine.tile;
+      }
+    } else {
+      // Inclusive scan of the hit counts (the previous batch's last barrier ended its reads), one
+      // step per power of two below the workgroup size (at most GLINT_FLARE_GATHER_MAX_THREADS =
+      // 256), written out: `threads` is a specialization constant, so the steps past it fold away
+      // and no loop is left (lavapipe ends a shader after 65535 loop iterations in all, which the
+      // loop over batches would otherwise reach with a few hundred thousand instances).
+      const uint own = uint(bitCount(hits));
+      s_scan[0][t] = own;
+      barrier();
+      uint src = 0u;
 #define GLINT_SCAN_STEP(d)                        \
   if ((d) < threads) {                            \
     uint v = s_scan[src][t];                      \
@@ -130,25 +155,20 @@ void main() {
     barrier();                                    \
     src ^= 1u;                                    \
   }
-    GLINT_SCAN_STEP(1u)
-    GLINT_SCAN_STEP(2u)
-    GLINT_SCAN_STEP(4u)
-    GLINT_SCAN_STEP(8u)
-    GLINT_SCAN_STEP(16u)
-    GLINT_SCAN_STEP(32u)
-    GLINT_SCAN_STEP(64u)
-    GLINT_SCAN_STEP(128u)
+      GLINT_SCAN_STEP(1u)
+      GLINT_SCAN_STEP(2u)
+      GLINT_SCAN_STEP(4u)
+      GLINT_SCAN_STEP(8u)
+      GLINT_SCAN_STEP(16u)
+      GLINT_SCAN_STEP(32u)
+      GLINT_SCAN_STEP(64u)
+      GLINT_SCAN_STEP(128u)
 #undef GLINT_SCAN_STEP
-    const uint listed = s_scan[src][threads - 1u];  // the same in every invocation
-    for (uint at = s_scan[src][t] - own; hits != 0u; ++at) {
-      uint slot = uint(findLSB(hits));
-      hits &= hits - 1u;
-      if (kFused == 0u) {
+      listed = s_scan[src][threads - 1u];  // the same in every invocation
+      for (uint at = s_scan[src][t] - own; hits != 0u; ++at) {
+        uint slot = uint(findLSB(hits));
+        hits &= hits - 1u;
         s_list[at] = i * 16u + slot;
-      } else {  // at most one sprite per invocation, so the list is one chunk: stored as it is
-        s_rect[at] = vec4(mine.lo, mine.size);
-        s_rgb_lod[at] = vec4(mine.rgb, mine.lod);
-        s_tile[at] = mine.tile;
       }
     }
     for (uint e0 = 0u; e0 < listed; e0 += threads) {
@@ -161,7 +181,7 @@ void main() {
         s_rgb_lod[t] = vec4(s.rgb, s.lod);
         s_tile[t] = s.tile;
       }
-      barrier();
+      if (kFused == 0u) barrier();  // kFused: the list was stored before the barrier above
       // 3. Shading: each listed sprite at each of this invocation's pixel centres.
       uint n = min(threads, listed - e0);
       for (uint k = 0u; k < n; ++k) {
