@@ -114,11 +114,27 @@ struct HiZPyramid::Impl {
 
   // The two dispatches that build `levels` (>= 1) levels: the stream pass writes levels 1 to
   // stream_levels (by 64x64 blocks of the depth image, the last block of a row or column up to the
-  // edge; or one invocation per level-2 texel); the tile pass reduces level stream_levels by 64x64
+  // edge or, where stream_blocks() says so, the remainder a block of its own; or one invocation per
+  // level-2 texel); the tile pass reduces level stream_levels by 64x64
   // tiles through up to 6 levels, and its last workgroup the rest. That level is at most
   // 16384 / 4 = 4096 = 64 tiles wide (after the texel stream pass; 256 = 4 tiles after the block
   // one), so the tail always fits one workgroup, and 2 + 6 + 6 = 14 levels cover the largest
   // pyramid.
+  //
+  // Blocks of the block stream pass along a side of `size` depth texels that builds levels 1 to
+  // `built`: one per 64 texels, the last up to the edge (64 to 127 texels), except where the
+  // remainder r = size % 64 is at least 2^built: then the remainder is a block of its own. It owns
+  // the last texel of every level j <= built (size >> j > (size - r) >> j exactly when r >= 2^j,
+  // the size less r being a multiple of 64), and its texels cover only depth texels of its own
+  // (child c >= (size - r) >> j covers parents >= 2c), so the 64-texel block before it holds no
+  // last texel and is built on the interior path; the edge path then runs over r rows or columns
+  // instead of 64 + r.
+  static uint32_t stream_blocks(uint32_t size, uint32_t built) {
+    const uint32_t full = size >> 6, rest = size & 63;
+    if (full == 0) return 1;
+    return full + (rest >= (1u << built) ? 1 : 0);
+  }
+
   void plan() {
     const uint32_t reversed = config.reversed_z ? 1u : 0u;
     const uint32_t first = stream_levels;
@@ -127,8 +143,8 @@ struct HiZPyramid::Impl {
     stream_push.tile_levels = std::min(first, levels);
     stream_push.reversed_z = reversed;
     if (stream == detail::HiZStream::blocks) {  // a workgroup of 16x16 per 64x64 block
-      stream_width = std::max(1u, config.extent.width >> 6) * 16;
-      stream_height = std::max(1u, config.extent.height >> 6) * 16;
+      stream_width = stream_blocks(config.extent.width, stream_push.tile_levels) * 16;
+      stream_height = stream_blocks(config.extent.height, stream_push.tile_levels) * 16;
     } else {  // an invocation per level-2 texel (level 2's size even when only level 1 is built)
       stream_width = std::max(1u, config.extent.width >> 2);
       stream_height = std::max(1u, config.extent.height >> 2);

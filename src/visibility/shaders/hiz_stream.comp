@@ -9,7 +9,9 @@
 //
 // Workgroup g (16x16 invocations; block_of() maps launch order to g) owns the depth texels
 // [64 g, 64 g + 64) per axis, the last workgroup of a row or column up to the edge (64 to 127
-// texels; 64 exactly where the size is a multiple of 64), and the texels of levels 1..6 over
+// texels; 64 exactly where the size is a multiple of 64; where the remainder r = size % 64 is at
+// least 2^pc.tile_levels, the host launches one more block per axis, of r texels, which then owns
+// the last texel of every level built: HiZPyramid's stream_blocks()), and the texels of levels 1..6 over
 // them: texel c of level k covers the depth texels [c * 2^k, (c + 1) * 2^k), the last one of a
 // row or column up to the edge (the fold rule, hiz_fold.glsl). Each texel holds the farthest
 // depth it covers (max for standard Z, min for reversed Z).
@@ -127,10 +129,12 @@ void interior(ivec2 g, vec2 inv_size) {
 
 // Children of level 1 per invocation in an edge workgroup: up to 63x63 over 256 invocations,
 // gathered kEdgeBatch at a time. The batch sets the kernel's register count (the interior path
-// alone needs 40 on the H100): all 16 gathers in flight took 118 registers there, 8 take 77 and
-// were the fastest (docs/OCCLUSION.md, "Speed").
+// alone needs 40 on the H100): all 16 gathers in flight took 118 registers there, 8 took 77 and
+// 4 take 54, which lets 4 workgroups share a multiprocessor instead of 3: as fast for full
+// pyramids, faster for shallow ones, whose remainder blocks need at most 4 (docs/OCCLUSION.md,
+// "Speed").
 const int kEdgeLevel1PerInvocation = 16;
-const int kEdgeBatch = 8;
+const int kEdgeBatch = 4;
 
 // Edge workgroup: level 1 of the region [begin, begin + region) of the depth image into tile A
 // (origin begin / 2) by gathers, then levels 2..pc.tile_levels in shared memory.
