@@ -222,6 +222,27 @@ TEST_F(OcclusionTest, HiZRepeatsFramesAndCapsLevels) {
       expect_pyramid(read_pyramid(hiz), d, false, "capped at " + std::to_string(levels) + " levels" + stream_name(s));
     }
   }
+  // Engine sizes on either side of the block stream pass's split of a remainder into blocks of its
+  // own (a remainder r = size % 64 of at least 2^levels): 1920x1080 at 5 levels (r = 56 rows: split;
+  // the flare pass's pyramid), 1280x720 at 4 levels (r = 16: split) and 5 (merged), reversed Z.
+  struct Capped {
+    uint32_t w, h, levels;
+  };
+  for (const Capped c : {Capped{1920, 1080, 5}, Capped{1280, 720, 4}, Capped{1280, 720, 5}}) {
+    const auto e = random_depth(c.w, c.h, 11 + c.levels);
+    auto depth = make_depth(e, VK_FORMAT_D32_SFLOAT);
+    HiZConfig capped;
+    capped.extent = {c.w, c.h};
+    capped.reversed_z = true;
+    capped.max_cell_px = (1u << (c.levels - 1)) + 1;
+    HiZPyramid hiz(context(), capped);
+    ASSERT_EQ(hiz.levels(), c.levels);
+    detail::HiZAccess::select_stream(hiz, detail::HiZStream::blocks);
+    poison_pyramid(hiz);
+    context().run_once([&](VkCommandBuffer cmd) { hiz.record(cmd, depth.state); });
+    expect_pyramid(read_pyramid(hiz), e, true,
+                   std::to_string(c.w) + "x" + std::to_string(c.h) + " capped at " + std::to_string(c.levels));
+  }
 }
 
 // Everything the cull writes for one frame.
