@@ -131,8 +131,8 @@ void interior(ivec2 g, vec2 inv_size) {
 // gathered kEdgeBatch at a time. The batch sets the kernel's register count (the interior path
 // alone needs 40 on the H100): all 16 gathers in flight took 118 registers there, 8 took 77 and
 // 4 take 54, which lets 4 workgroups share a multiprocessor instead of 3: as fast for full
-// pyramids, faster for shallow ones, whose remainder blocks need at most 4 (docs/OCCLUSION.md,
-// "Speed").
+// pyramids, faster for shallow ones, where a remainder block of 64 columns (at most 32x31 texels
+// of level 1) needs one batch (docs/OCCLUSION.md, "Speed").
 const int kEdgeLevel1PerInvocation = 16;
 const int kEdgeBatch = 4;
 
