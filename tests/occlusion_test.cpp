@@ -118,7 +118,7 @@ TEST_F(OcclusionTest, HiZMatchesReferenceAtAllSizes) {
   // 640x360 and 96x192: one side a multiple of 64, as in 1920x1080, so the block stream pass builds
   // that side's last blocks as interior ones; 96 = 64 + 32 folds (a mask of 31 would miss it).
   // 191x190: a corner block of 127x126 depth texels, 63x63 of level 1 (the most an edge block
-  // gathers: all its batches of 8 per invocation).
+  // gathers: all its batches of 4 per invocation).
   const HiZCase cases[] = {{1, 1},     {7, 3},    {3, 7},     {2, 1},      {64, 64},  {65, 63},
                            {127, 129}, {130, 67}, {333, 97},  {640, 360},  {96, 192}, {4097, 2},
                            {2, 600},   {8200, 2}, {3, 16384}, {1030, 771}, {191, 190}};
@@ -224,11 +224,12 @@ TEST_F(OcclusionTest, HiZRepeatsFramesAndCapsLevels) {
   }
   // Engine sizes on either side of the block stream pass's split of a remainder into blocks of its
   // own (a remainder r = size % 64 of at least 2^levels): 1920x1080 at 5 levels (r = 56 rows: split;
-  // the flare pass's pyramid), 1280x720 at 4 levels (r = 16: split) and 5 (merged), reversed Z.
+  // the flare pass's pyramid), 1280x720 at 4 levels (r = 16: split) and 5 (merged), and odd
+  // remainders whose blocks fold inside themselves: 333x97 at 3 levels (r = 13 and 33), reversed Z.
   struct Capped {
     uint32_t w, h, levels;
   };
-  for (const Capped c : {Capped{1920, 1080, 5}, Capped{1280, 720, 4}, Capped{1280, 720, 5}}) {
+  for (const Capped c : {Capped{1920, 1080, 5}, Capped{1280, 720, 4}, Capped{1280, 720, 5}, Capped{333, 97, 3}}) {
     const auto e = random_depth(c.w, c.h, 11 + c.levels);
     auto depth = make_depth(e, VK_FORMAT_D32_SFLOAT);
     HiZConfig capped;

@@ -15,7 +15,10 @@
 //    (Hillis & Steele 1986, in shared memory): the list is in (instance, slot) order, the order the
 //    raster path draws in, on every run: no atomic decides the order of the sums, so every run gives the same bits.
 //    kFused: invocation t evaluates sprite t % GLINT_FLARE_SPRITES of instance
-//    base + t / GLINT_FLARE_SPRITES and tests that sprite's rectangle; the list has the same order.
+//    base + t / GLINT_FLARE_SPRITES and tests that sprite's rectangle; the same prefix sum, of at
+//    most one sprite per invocation, is counted from a bit mask of the invocations whose sprite
+//    meets the tile (set with atomicOr, which gives the same bits in any order), so the list has
+//    the same order.
 // 2. Sprites: the listed sprites are read into shared memory in chunks of one per invocation
 //    (kFused: the invocation that listed a sprite stores it there itself; one chunk per batch).
 // 3. Shading: every invocation adds glint_flare_shade (the function flare.frag evaluates) of every
@@ -53,7 +56,7 @@ shared uint s_list[kMaxThreads * GLINT_FLARE_SPRITES];  // instance * 16 + slot 
 shared vec4 s_rect[kMaxThreads];                        // lo.xy, size.xy of the listed sprites
 shared vec4 s_rgb_lod[kMaxThreads];
 shared uint s_tile[kMaxThreads];
-shared uint s_hit[kMaxThreads / 32u];  // kFused: bit t % 32 of word t / 32 is set when invocation t's sprite meets the tile
+shared uint s_hit[(kMaxThreads + 31u) / 32u];  // kFused: bit t % 32 of word t / 32 is set when invocation t's sprite meets the tile
 
 // The sprite in `slot` of instance i: read from the pre-pass's block when the instance has one,
 // else evaluated.
@@ -127,7 +130,7 @@ void main() {
       barrier();
       uint at = uint(bitCount(s_hit[t >> 5u] & ((1u << (t & 31u)) - 1u)));
       listed = 0u;
-      for (uint w = 0u; w < (threads + 31u) / 32u; ++w) {
+      [[unroll]] for (uint w = 0u; w < (threads + 31u) / 32u; ++w) {  // a specialization constant: no loop left
         const uint c = uint(bitCount(s_hit[w]));
         listed += c;
         if (w < (t >> 5u)) at += c;

@@ -130,8 +130,9 @@ void interior(ivec2 g, vec2 inv_size) {
 // Children of level 1 per invocation in an edge workgroup: up to 63x63 over 256 invocations,
 // gathered kEdgeBatch at a time. The batch sets the kernel's register count (the interior path
 // alone needs 40 on the H100): all 16 gathers in flight took 118 registers there, 8 took 77 and
-// 4 take 54, which lets 4 workgroups share a multiprocessor instead of 3: as fast for full
-// pyramids, faster for shallow ones, where a remainder block of 64 columns (at most 32x31 texels
+// 4 take 54, which lets 4 workgroups share a multiprocessor instead of 3: on the H200 0.1 us
+// slower for the full pyramid at 3840x2160 (the same at 1920x1080), 1 us faster for the flare
+// pass's shallow one at 1920x1080, where a remainder block of 64 columns (at most 32x31 texels
 // of level 1) needs one batch (docs/OCCLUSION.md, "Speed").
 const int kEdgeLevel1PerInvocation = 16;
 const int kEdgeBatch = 4;
