@@ -23,10 +23,7 @@ void LensFlare::Impl::make_compute_pipelines() {
   gather = make_gather(0, 0);
   // The one-dispatch gather, here where the device takes it by itself (so that a first frame does
   // not compile it); on CPU devices only a forced path makes it, at its first use.
-  if (one_dispatch_limit > 0) {
-    gather_one_dispatch = make_gather(0, 1);
-    gather_one_dispatch_made = true;
-  }
+  if (one_dispatch_limit > 0) gather_one_dispatch = make_gather(0, 1);
   detail::PipelineDesc sp;
   sp.kernel_id = "flare_sprites_main";
   sp.bindings = {SB, SB, SB};
@@ -83,10 +80,7 @@ void LensFlare::record_compute(VkCommandBuffer cmd, Image& color, Buffer& instan
     // The gather evaluates the sprites itself: one dispatch of every tile, launched whatever the
     // count (each tile of a frame without instances reads the count and stores nothing). `blocks`
     // (binding 4) is not read; the instances buffer stands in for it.
-    if (!m.gather_one_dispatch_made) {
-      m.gather_one_dispatch = m.make_gather(0, 1);
-      m.gather_one_dispatch_made = true;
-    }
+    if (!m.gather_one_dispatch) m.gather_one_dispatch = m.make_gather(0, 1);
     b.use(indirect, kCompute, VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
     b.use(instances, kCompute, VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
     b.use(m.atlas_image.state, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, kCompute, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT,
@@ -120,10 +114,7 @@ void LensFlare::record_compute(VkCommandBuffer cmd, Image& color, Buffer& instan
   Buffer& store = sprite_store.state;
   // The instances buffer holds more than the store: the gather evaluates the rest itself.
   const bool beyond = instances.size / sizeof(GlintFlareInstance) > sprite_store.capacity;
-  if (beyond && !m.gather_beyond_made) {
-    m.gather_beyond = m.make_gather(1, 0);
-    m.gather_beyond_made = true;
-  }
+  if (beyond && !m.gather_beyond) m.gather_beyond = m.make_gather(1, 0);
 
   GlintFlareGatherArgsPush ap{p.indirect_word, m.tiles_x, m.tiles_y, std::min(capacity, sprite_store.capacity),
                               m.max_groups_x};

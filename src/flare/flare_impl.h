@@ -67,13 +67,11 @@ struct LensFlare::Impl {
   // arguments that flare_gather_args.comp writes from the instance count.
   detail::ComputePipeline gather, gather_args, sprites;
   // The gather for instances buffers larger than the sprite store (specialization constant 2 = 1),
-  // made at its first use.
+  // made at its first use (empty until then).
   detail::ComputePipeline gather_beyond;
-  bool gather_beyond_made = false;
   // The one-dispatch gather (specialization constant 3 = 1), made with the others on GPUs, at its
-  // first use elsewhere.
+  // first use elsewhere (empty until then).
   detail::ComputePipeline gather_one_dispatch;
-  bool gather_one_dispatch_made = false;
   detail::FlareGatherPath gather_path = detail::FlareGatherPath::device;
   detail::OwnedBuffer gather_args_buffer;  // the gather's VkDispatchIndirectCommand, then the pre-pass's
   Buffer gather_args_state;
