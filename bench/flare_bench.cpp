@@ -14,7 +14,9 @@
 // 0 lights measures the fixed cost of each path.
 //
 // Counters: median_us, sprite_pixels (pixels the sprites cover on screen, from the float64
-// reference's sprite geometry: the fill work) and fill_pixels_per_second.
+// reference's sprite geometry: the fill work), fill_pixels_per_second and, for the compute path,
+// how that work falls on the gather's tiles (tile_load below): tile_sprites_max,
+// tile_sprites_mean and invocation_samples_max.
 #include <benchmark/benchmark.h>
 #include <glint/flare.h>
 #include <glint/gpu/flare_types.h>
@@ -58,6 +60,55 @@ std::vector<GlintFlareInstance> bench_lights(uint32_t n, uint32_t width, uint32_
     g.element = GLINT_FLARE_ELEMENT_GLOW;
   }
   return out;
+}
+
+// How the compute draw's work falls on its tiles, from the float64 reference's sprite geometry: the
+// most and the mean sprites a tile lists (each sprite's rectangle widened by the 2-pixel margin of
+// glint_flare_sprite_bounds) and the most samples one invocation shades (the pixels of its column
+// in its tile, rows `tile.depth` apart, that a sprite lights). The gather's dispatch lasts as long as
+// its slowest tile.
+struct TileLoad {
+  double sprites_max = 0, sprites_mean = 0, samples_max = 0;
+};
+
+TileLoad tile_load(const std::vector<reference::FlareSprite>& sprites, uint32_t width, uint32_t height,
+                   VkExtent3D tile) {
+  const uint32_t tx = (width + tile.width - 1) / tile.width, ty = (height + tile.height - 1) / tile.height;
+  std::vector<uint32_t> listed(size_t(tx) * ty, 0), samples(size_t(width) * height, 0);
+  for (const auto& s : sprites) {
+    if (!(s.width > 0.0)) continue;
+    const double x0 = s.lo_x - 2.0, x1 = s.lo_x + s.width + 2.0, y0 = s.lo_y - 2.0, y1 = s.lo_y + s.height + 2.0;
+    for (uint32_t j = 0; j < ty; ++j) {
+      for (uint32_t i = 0; i < tx; ++i) {
+        if (x0 < double(i + 1) * tile.width && x1 > double(i) * tile.width && y0 < double(j + 1) * tile.height &&
+            y1 > double(j) * tile.height) {
+          ++listed[size_t(j) * tx + i];
+        }
+      }
+    }
+    // Pixel p is lit when its centre p + 0.5 lies in [lo, lo + size).
+    const auto first = [](double lo) { return std::max(0.0, std::ceil(lo - 0.5)); };
+    const auto end = [](double hi, uint32_t n) { return std::min(double(n), std::ceil(hi - 0.5)); };
+    for (double y = first(s.lo_y); y < end(s.lo_y + s.height, height); ++y) {
+      for (double x = first(s.lo_x); x < end(s.lo_x + s.width, width); ++x) ++samples[size_t(y) * width + size_t(x)];
+    }
+  }
+  TileLoad load;
+  for (uint32_t v : listed) {
+    load.sprites_max = std::max(load.sprites_max, double(v));
+    load.sprites_mean += double(v) / double(listed.size());
+  }
+  for (uint32_t y0 = 0; y0 < height; y0 += tile.height) {
+    for (uint32_t row = 0; row < tile.depth; ++row) {
+      for (uint32_t x = 0; x < width; ++x) {
+        double sum = 0;
+        for (uint32_t y = y0 + row; y < std::min(y0 + tile.height, height); y += tile.depth)
+          sum += samples[size_t(y) * width + x];
+        load.samples_max = std::max(load.samples_max, sum);
+      }
+    }
+  }
+  return load;
 }
 
 // The draw of `lights` instances (an instances buffer of exactly that many) into a width x height
@@ -116,9 +167,11 @@ void run_flare_draw(benchmark::State& state, uint32_t width, uint32_t height, ui
     state.SetIterationTime(median * 1e-3);
   }
   double pixels = 0;  // on-screen area of every sprite (the fill work of either path)
+  std::vector<reference::FlareSprite> sprites;
   for (const auto& g : list) {
     for (uint32_t slot = 0; slot < GLINT_FLARE_SPRITES; ++slot) {
       const auto s = reference::flare_sprite(g, slot, config, width, height);
+      sprites.push_back(s);
       const double w = std::clamp(s.lo_x + s.width, 0.0, double(width)) - std::clamp(s.lo_x, 0.0, double(width));
       const double h = std::clamp(s.lo_y + s.height, 0.0, double(height)) - std::clamp(s.lo_y, 0.0, double(height));
       pixels += std::max(w, 0.0) * std::max(h, 0.0);
@@ -130,6 +183,12 @@ void run_flare_draw(benchmark::State& state, uint32_t width, uint32_t height, ui
   state.counters["fill_pixels_per_second"] = benchmark::Counter(pixels, benchmark::Counter::kIsIterationInvariantRate);
   const bool one_dispatch = path == detail::FlareGatherPath::one_dispatch ||
                             (path == detail::FlareGatherPath::device && lights <= flare.one_dispatch_instances());
+  if (compute) {
+    const TileLoad load = tile_load(sprites, width, height, detail::LensFlareAccess::gather_tile(flare, one_dispatch));
+    state.counters["tile_sprites_max"] = load.sprites_max;
+    state.counters["tile_sprites_mean"] = load.sprites_mean;
+    state.counters["invocation_samples_max"] = load.samples_max;
+  }
   state.SetLabel(std::string(compute ? (one_dispatch ? "compute, one dispatch" : "compute, pre-pass") : "raster") +
                  (mixed ? " mixed sizes" : "") + " rgba16f on " + ctx.info().name);
 }

@@ -619,6 +619,47 @@ TEST_F(FlareTest, OneDispatchDrawGivesTheBitsOfThePrePass) {
   }
 }
 
+// The pre-pass gather's tile height (rows per invocation: 2 on GPUs, 8 on CPU devices, where the
+// one-dispatch gather takes 8) changes which workgroup shades a pixel, not the list it sums nor
+// its order: 500 small lights, whose ghosts at t = 1 all land on the image centre (hundreds of
+// sprites on its pixels, several chunks of the shared list), both formats, give the same bits at
+// 1, 2, 4 and 8 rows, and match the float64 reference.
+TEST_F(FlareTest, PrePassGatherGivesTheSameBitsAtEveryTileHeight) {
+  const DeviceInfo& info = context().info();
+  for (VkFormat format : {kF16, kF32}) {
+    const std::string fmt = format == kF16 ? "rgba16f" : "rgba32f";
+    LensFlare flare(context(), format, {kW, kH});
+    const uint32_t rows = detail::LensFlareAccess::gather_tile(flare, false).height /
+                          detail::LensFlareAccess::gather_tile(flare, false).depth;
+    EXPECT_EQ(rows, info.type == VK_PHYSICAL_DEVICE_TYPE_CPU ? 8u : GLINT_FLARE_GATHER_PRE_PASS_ROWS) << fmt;
+    EXPECT_EQ(detail::LensFlareAccess::gather_tile(flare, true).height,
+              GLINT_FLARE_GATHER_ROWS * detail::LensFlareAccess::gather_tile(flare, true).depth)
+        << fmt;
+    const reference::FlareAtlas atlas = read_flare_atlas(flare);
+    const CpuImage background = as_stored(random_hdr(kW, kH, 83), format);
+    auto lights = random_instances(500, 37);
+    for (auto& g : lights) g.size_px = 2.0f + 0.2f * g.size_px;
+    const FlareConfig config;
+    FlareInputs in(lights, uint32_t(lights.size()), flare.groups_per_instance());
+    detail::LensFlareAccess::select_gather(flare, detail::FlareGatherPath::pre_pass);
+    std::vector<CpuImage> images;
+    for (uint32_t r : {1u, 2u, 4u, 8u}) {
+      detail::LensFlareAccess::set_pre_pass_rows(flare, r);
+      images.push_back(draw(flare, Path::compute, background, format, in, config));
+      EXPECT_EQ(std::memcmp(images.back().rgba.data(), images.front().rgba.data(), images.front().rgba.size() * 4), 0)
+          << fmt << ", " << r << " rows against 1";
+    }
+    EXPECT_NE(std::memcmp(images[0].rgba.data(), background.rgba.data(), background.rgba.size() * 4), 0)
+        << fmt << ": drew nothing";
+    const auto ref = reference::flare_composite(background, lights, uint32_t(lights.size()), config, atlas,
+                                                flare_sampler_precision());
+    const FlareDeviation d = compare_flare(images[1], ref, format);
+    EXPECT_EQ(d.outside, 0u) << fmt << ": " << d.first;
+    EXPECT_THROW(detail::LensFlareAccess::set_pre_pass_rows(flare, 0), Error);
+    EXPECT_THROW(detail::LensFlareAccess::set_pre_pass_rows(flare, GLINT_FLARE_GATHER_ROWS + 1), Error);
+  }
+}
+
 // The sprite pre-pass stores 304 bytes per instance in one storage-buffer descriptor, fewer
 // instances than the 48-byte instances buffer may hold (maxStorageBufferRange / 304 against / 48):
 // the gather evaluates the sprites of the instances beyond the store itself. Lights at both ends of

@@ -138,8 +138,8 @@ GlintFlarePush LensFlare::Impl::push(const FlareConfig& c) const {
   p.ghost_pos3 = c.ghost_positions[3];
   p.ghost_pos4 = c.ghost_positions[4];
   p.tile_w = workgroup.x;
-  p.tile_h = workgroup.y * GLINT_FLARE_GATHER_ROWS;
-  p.indirect_word = 0;  // set by record_compute
+  p.tile_h = workgroup.y * GLINT_FLARE_GATHER_ROWS;  // record_compute sets its path's
+  p.indirect_word = 0;                               // set by record_compute
   return p;
 }
 
@@ -198,9 +198,13 @@ LensFlare::LensFlare(const Context& context, VkFormat color_format, VkExtent2D e
   }
   if (m.workgroup.x * m.workgroup.y > GLINT_FLARE_GATHER_MAX_THREADS) m.workgroup = {16, 16};
   m.one_dispatch_limit = context.info().type == VK_PHYSICAL_DEVICE_TYPE_CPU ? 0 : m.one_dispatch_batch();
-  const uint32_t tile_h = m.workgroup.y * GLINT_FLARE_GATHER_ROWS;
-  m.tiles_x = (extent.width + m.workgroup.x - 1) / m.workgroup.x;
-  m.tiles_y = (extent.height + tile_h - 1) / tile_h;
+  // The pre-pass gather's tiles are 4 times shorter on GPUs: 1000 lights at 1080p 638 -> 489 us on
+  // the H200, where the one-dispatch gather of 10 lights was slower with shorter tiles (34.9 us with
+  // 8 rows, 37.6 with 4; docs/FLARE.md "Speed"). CPU devices keep 8 rows (a tile's invocations run
+  // one after another there, so the tile size sets only how often each instance is binned).
+  m.tiles_one_dispatch = m.gather_tiles(GLINT_FLARE_GATHER_ROWS);
+  m.tiles_pre_pass = m.gather_tiles(
+      context.info().type == VK_PHYSICAL_DEVICE_TYPE_CPU ? GLINT_FLARE_GATHER_ROWS : GLINT_FLARE_GATHER_PRE_PASS_ROWS);
   m.make_atlas();
   m.make_raster_pipeline();
   m.make_compute_pipelines();

@@ -14,8 +14,13 @@ detail::ComputePipeline LensFlare::Impl::make_gather(uint32_t beyond_store, uint
   d.bindings = {SB, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, SB, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, SB};
   d.push_constant_bytes = sizeof(GlintFlarePush);
   d.workgroup = workgroup;
-  d.specialization = {beyond_store, one_dispatch};
+  d.specialization = {beyond_store, one_dispatch, (one_dispatch ? tiles_one_dispatch : tiles_pre_pass).rows};
   return detail::ComputePipeline(*context, d);
+}
+
+LensFlare::Impl::GatherTiles LensFlare::Impl::gather_tiles(uint32_t rows) const {
+  const uint32_t tile_h = workgroup.y * rows;
+  return {rows, (extent.width + workgroup.x - 1) / workgroup.x, (extent.height + tile_h - 1) / tile_h};
 }
 
 void LensFlare::Impl::make_compute_pipelines() {
@@ -87,9 +92,10 @@ void LensFlare::record_compute(VkCommandBuffer cmd, Image& color, Buffer& instan
           GLINT_FLARE_ATLAS_LEVELS);
     b.use(color, VK_IMAGE_LAYOUT_GENERAL, kCompute, kStorageRW);
     b.flush(cmd);
+    p.tile_h = m.workgroup.y * m.tiles_one_dispatch.rows;
     m.gather_one_dispatch.dispatch(
         cmd, {instances, m.atlas_binding(), indirect_words, {color.view, VK_IMAGE_LAYOUT_GENERAL}, instances}, p,
-        m.tiles_x * m.workgroup.x, m.tiles_y * m.workgroup.y);
+        m.tiles_one_dispatch.x * m.workgroup.x, m.tiles_one_dispatch.y * m.workgroup.y);
     if (profiler) profiler->mark(cmd, "flare gather");
     return;
   }
@@ -116,8 +122,8 @@ void LensFlare::record_compute(VkCommandBuffer cmd, Image& color, Buffer& instan
   const bool beyond = instances.size / sizeof(GlintFlareInstance) > sprite_store.capacity;
   if (beyond && !m.gather_beyond) m.gather_beyond = m.make_gather(1, 0);
 
-  GlintFlareGatherArgsPush ap{p.indirect_word, m.tiles_x, m.tiles_y, std::min(capacity, sprite_store.capacity),
-                              m.max_groups_x};
+  GlintFlareGatherArgsPush ap{p.indirect_word, m.tiles_pre_pass.x, m.tiles_pre_pass.y,
+                              std::min(capacity, sprite_store.capacity), m.max_groups_x};
   // 1. The launch arguments: every tile when any instance is visible, none otherwise; the
   //    pre-pass's groups for the instances.
   b.use(indirect, kCompute, VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
@@ -138,6 +144,7 @@ void LensFlare::record_compute(VkCommandBuffer cmd, Image& color, Buffer& instan
         GLINT_FLARE_ATLAS_LEVELS);
   b.use(color, VK_IMAGE_LAYOUT_GENERAL, kCompute, kStorageRW);
   b.flush(cmd);
+  p.tile_h = m.workgroup.y * m.tiles_pre_pass.rows;
   (beyond ? m.gather_beyond : m.gather)
       .dispatch_indirect(cmd,
                          {instances, m.atlas_binding(), indirect_words, {color.view, VK_IMAGE_LAYOUT_GENERAL}, store},
@@ -148,6 +155,23 @@ void LensFlare::record_compute(VkCommandBuffer cmd, Image& color, Buffer& instan
 namespace detail {
 
 void LensFlareAccess::select_gather(LensFlare& flare, FlareGatherPath path) { flare.impl_->gather_path = path; }
+
+VkExtent3D LensFlareAccess::gather_tile(const LensFlare& flare, bool one_dispatch) {
+  const LensFlare::Impl& m = *flare.impl_;
+  const uint32_t rows = (one_dispatch ? m.tiles_one_dispatch : m.tiles_pre_pass).rows;
+  return {m.workgroup.x, m.workgroup.y * rows, m.workgroup.y};
+}
+
+void LensFlareAccess::set_pre_pass_rows(LensFlare& flare, uint32_t rows) {
+  if (rows < 1 || rows > GLINT_FLARE_GATHER_ROWS) {
+    throw Error(ErrorCode::invalid_argument, concat("LensFlareAccess::set_pre_pass_rows: rows is ", rows,
+                                                    "; accepted 1 to ", GLINT_FLARE_GATHER_ROWS));
+  }
+  LensFlare::Impl& m = *flare.impl_;
+  m.tiles_pre_pass = m.gather_tiles(rows);
+  m.gather = m.make_gather(0, 0);
+  m.gather_beyond = {};  // made again at its next use, with these rows
+}
 
 }  // namespace detail
 }  // namespace glint

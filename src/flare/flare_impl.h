@@ -47,7 +47,12 @@ struct LensFlare::Impl {
   uint32_t max_groups_x = 65535;         // maxComputeWorkGroupCount[0]
   VkDeviceSize storage_alignment = 256;  // minStorageBufferOffsetAlignment
   detail::Workgroup2D workgroup;         // the gather's workgroup
-  uint32_t tiles_x = 0, tiles_y = 0;     // gather tiles: workgroup x by workgroup y * GATHER_ROWS
+  // The gather's tiles, workgroup x by workgroup y * rows pixels: the one-dispatch gather's
+  // (GLINT_FLARE_GATHER_ROWS) and the pre-pass gather's (GLINT_FLARE_GATHER_PRE_PASS_ROWS on GPUs).
+  struct GatherTiles {
+    uint32_t rows = GLINT_FLARE_GATHER_ROWS, x = 0, y = 0;
+  };
+  GatherTiles tiles_one_dispatch, tiles_pre_pass;
 
   // Atlas: one image with every level, a view of all levels (sampling) and one per level (storage).
   detail::OwnedImage atlas_image;      // state tracks all levels together
@@ -101,6 +106,7 @@ struct LensFlare::Impl {
   void make_raster_pipeline();
   void make_compute_pipelines();
   detail::ComputePipeline make_gather(uint32_t beyond_store, uint32_t one_dispatch) const;
+  GatherTiles gather_tiles(uint32_t rows) const;
   // Instances per batch of the one-dispatch gather (one invocation per sprite).
   uint32_t one_dispatch_batch() const { return workgroup.x * workgroup.y / GLINT_FLARE_SPRITES; }
   // The most instances for which record_compute() takes the one-dispatch gather by itself: one

@@ -24,6 +24,14 @@ enum class FlareGatherPath : uint32_t {
 struct LensFlareAccess {
   /// Selects the path `flare` records from now on.
   static void select_gather(LensFlare& flare, FlareGatherPath path);
+  /// The pixels of one tile of the one-dispatch or the pre-pass gather (workgroup x by workgroup
+  /// y * rows) and the workgroup height: invocation (x, y) of a tile shades rows y, y + height, ...
+  /// of column x.
+  static VkExtent3D gather_tile(const LensFlare& flare, bool one_dispatch);
+  /// Makes the pre-pass gather (and the one beyond the sprite store) shade `rows` pixels per
+  /// invocation from now on, 1 to GLINT_FLARE_GATHER_ROWS (tests: every tile height gives the
+  /// same bits).
+  static void set_pre_pass_rows(LensFlare& flare, uint32_t rows);
 };
 
 }  // namespace glint::detail

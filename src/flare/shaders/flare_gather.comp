@@ -2,7 +2,7 @@
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_control_flow_attributes : require
 // Lens flares for compute-only engines (docs/FLARE.md, "The two paths": compute), accumulated by gathering: one
-// workgroup per screen tile of GLINT_FLARE_GATHER_ROWS x workgroup pixels (each invocation keeps
+// workgroup per screen tile of kRows x workgroup pixels (each invocation keeps
 // its column's pixels in registers), no atomics on the image or on any global buffer. The sprites
 // were evaluated once for the frame by flare_sprites.comp (layout in flare_params.h), or, for few
 // instances (kFused), by the gather's own invocations, one sprite each: the whole draw is then
@@ -49,6 +49,9 @@ layout(constant_id = 2) const uint kBeyondStore = 0u;
 // and lists it where it meets the tile, so the list is in the same (instance, slot) order and the
 // sums are the same as the pre-pass's draw gives. `blocks` is not read.
 layout(constant_id = 3) const uint kFused = 0u;
+// Pixels each invocation shades, one per row, rows gl_WorkGroupSize.y apart (at most
+// GLINT_FLARE_GATHER_ROWS; flare_params.h says which path takes how many).
+layout(constant_id = 4) const uint kRows = GLINT_FLARE_GATHER_ROWS;
 
 const uint kMaxThreads = GLINT_FLARE_GATHER_MAX_THREADS;
 shared uint s_scan[2][kMaxThreads];                     // hit counts, then their prefix sums
@@ -92,7 +95,7 @@ void main() {
   const uint batch = kFused != 0u ? threads / GLINT_FLARE_SPRITES : threads;
 
   vec3 sum[GLINT_FLARE_GATHER_ROWS];  // indexed by unrolled loops only, so it stays in registers
-  [[unroll]] for (uint r = 0u; r < GLINT_FLARE_GATHER_ROWS; ++r) sum[r] = vec3(0.0);
+  [[unroll]] for (uint r = 0u; r < kRows; ++r) sum[r] = vec3(0.0);
 
   for (uint base = 0u; base < count; base += batch) {
     // 1. Binning: the instance's union rectangle, then each of its sprites, against the tile
@@ -203,7 +206,7 @@ void main() {
         // whole row of the workgroup) skip its divisions and the sample. A small sprite meets one
         // or two of the 8 rows.
         const vec4 b = glint_flare_sprite_bounds(s);
-        [[unroll]] for (uint r = 0u; r < GLINT_FLARE_GATHER_ROWS; ++r) {
+        [[unroll]] for (uint r = 0u; r < kRows; ++r) {
           vec2 pixel = vec2(p0.x, p0.y + r * gl_WorkGroupSize.y) + 0.5;
           if (pixel.y > b.y && pixel.y < b.w) sum[r] += glint_flare_shade(s, pixel, atlas).rgb;
         }
@@ -212,7 +215,7 @@ void main() {
     barrier();  // the list is consumed before the next batch resets it
   }
 
-  [[unroll]] for (uint r = 0u; r < GLINT_FLARE_GATHER_ROWS; ++r) {
+  [[unroll]] for (uint r = 0u; r < kRows; ++r) {
     uvec2 p = uvec2(p0.x, p0.y + r * gl_WorkGroupSize.y);
     if (sum[r] == vec3(0.0) || p.x >= uint(pc.viewport_w) || p.y >= uint(pc.viewport_h)) continue;
     vec4 c = imageLoad(color, ivec2(p));

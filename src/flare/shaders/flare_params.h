@@ -69,13 +69,17 @@
 #define GLINT_FLARE_GHOST_GAIN_4 0.45
 
 // ---- Compute path (flare_gather.comp) ------------------------------------------------------------
-// One workgroup per screen tile; each invocation shades GLINT_FLARE_GATHER_ROWS pixels of one column
-// (rows a workgroup height apart), so a 32x8 workgroup gathers a 32x64 tile (1020 tiles at 1080p).
-// Larger tiles bin each instance against fewer tiles; the rows share one binning and one sprite
-// setup per tile.
+// One workgroup per screen tile; each invocation shades `rows` pixels of one column (rows a
+// workgroup height apart; specialization constant 4), so a 32x8 workgroup with 8 rows gathers a
+// 32x64 tile (1020 tiles at 1080p). Larger tiles bin each instance against fewer tiles; the rows
+// share one binning and one sprite setup per tile. The one-dispatch gather (few instances) and CPU
+// devices take GLINT_FLARE_GATHER_ROWS; the pre-pass gather on GPUs GLINT_FLARE_GATHER_PRE_PASS_ROWS,
+// so that the sprites piled on one spot (every light's ghost at t = 1 lands on the image centre)
+// are shaded by four times as many workgroups (docs/FLARE.md, "Speed").
 // Shared lists and the binning scan are sized for at most GLINT_FLARE_GATHER_MAX_THREADS
 // invocations (20 KiB).
 #define GLINT_FLARE_GATHER_ROWS 8u
+#define GLINT_FLARE_GATHER_PRE_PASS_ROWS 2u
 #define GLINT_FLARE_GATHER_MAX_THREADS 256u
 
 // The sprite pre-pass (flare_sprites.comp) evaluates every sprite once per frame into a buffer the
