@@ -65,14 +65,14 @@ std::vector<GlintFlareInstance> bench_lights(uint32_t n, uint32_t width, uint32_
 // How the compute draw's work falls on its tiles, from the float64 reference's sprite geometry: the
 // most and the mean sprites a tile lists (each sprite's rectangle widened by the 2-pixel margin of
 // glint_flare_sprite_bounds) and the most samples one invocation shades (the pixels of its column
-// in its tile, rows `tile.depth` apart, that a sprite lights). The gather's dispatch lasts as long as
+// in its tile, rows `tile.row_step` apart, that a sprite lights). The gather's dispatch lasts as long as
 // its slowest tile.
 struct TileLoad {
   double sprites_max = 0, sprites_mean = 0, samples_max = 0;
 };
 
 TileLoad tile_load(const std::vector<reference::FlareSprite>& sprites, uint32_t width, uint32_t height,
-                   VkExtent3D tile) {
+                   detail::FlareGatherTile tile) {
   const uint32_t tx = (width + tile.width - 1) / tile.width, ty = (height + tile.height - 1) / tile.height;
   std::vector<uint32_t> listed(size_t(tx) * ty, 0), samples(size_t(width) * height, 0);
   for (const auto& s : sprites) {
@@ -99,10 +99,10 @@ TileLoad tile_load(const std::vector<reference::FlareSprite>& sprites, uint32_t 
     load.sprites_mean += double(v) / double(listed.size());
   }
   for (uint32_t y0 = 0; y0 < height; y0 += tile.height) {
-    for (uint32_t row = 0; row < tile.depth; ++row) {
+    for (uint32_t row = 0; row < tile.row_step; ++row) {
       for (uint32_t x = 0; x < width; ++x) {
         double sum = 0;
-        for (uint32_t y = y0 + row; y < std::min(y0 + tile.height, height); y += tile.depth)
+        for (uint32_t y = y0 + row; y < std::min(y0 + tile.height, height); y += tile.row_step)
           sum += samples[size_t(y) * width + x];
         load.samples_max = std::max(load.samples_max, sum);
       }

@@ -138,8 +138,8 @@ GlintFlarePush LensFlare::Impl::push(const FlareConfig& c) const {
   p.ghost_pos3 = c.ghost_positions[3];
   p.ghost_pos4 = c.ghost_positions[4];
   p.tile_w = workgroup.x;
-  p.tile_h = workgroup.y * GLINT_FLARE_GATHER_ROWS;  // record_compute sets its path's
-  p.indirect_word = 0;                               // set by record_compute
+  p.tile_h = 0;         // record_compute sets its path's (0 would draw nothing)
+  p.indirect_word = 0;  // set by record_compute
   return p;
 }
 
@@ -189,8 +189,9 @@ LensFlare::LensFlare(const Context& context, VkFormat color_format, VkExtent2D e
   m.max_stored_instances = uint32_t(props.limits.maxStorageBufferRange / kBlockBytes);
   m.max_groups_x = props.limits.maxComputeWorkGroupCount[0];
   m.storage_alignment = std::max<VkDeviceSize>(1, props.limits.minStorageBufferOffsetAlignment);
-  // The gather's workgroup: 32x8 on GPUs (a 32x64 tile; on the H100 it beat 16x8, whose tiles bin
-  // every instance twice as often: docs/FLARE.md), the device's 2D choice (8x8) on CPU devices.
+  // The gather's workgroup: 32x8 on GPUs (on the H100 it beat 16x8 when both gathered 8 rows, 16x8's
+  // tiles binning every instance twice as often: docs/FLARE.md), the device's 2D choice (8x8) on CPU
+  // devices.
   m.workgroup = detail::choose_workgroup_2d(context);
   if (context.info().type != VK_PHYSICAL_DEVICE_TYPE_CPU && context.info().max_workgroup_invocations >= 256 &&
       context.info().subgroup_size >= 32) {

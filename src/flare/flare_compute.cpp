@@ -156,7 +156,7 @@ namespace detail {
 
 void LensFlareAccess::select_gather(LensFlare& flare, FlareGatherPath path) { flare.impl_->gather_path = path; }
 
-VkExtent3D LensFlareAccess::gather_tile(const LensFlare& flare, bool one_dispatch) {
+FlareGatherTile LensFlareAccess::gather_tile(const LensFlare& flare, bool one_dispatch) {
   const LensFlare::Impl& m = *flare.impl_;
   const uint32_t rows = (one_dispatch ? m.tiles_one_dispatch : m.tiles_pre_pass).rows;
   return {m.workgroup.x, m.workgroup.y * rows, m.workgroup.y};

@@ -21,13 +21,17 @@ enum class FlareGatherPath : uint32_t {
   one_dispatch,
 };
 
+/// One tile of a gather: `width` x `height` pixels; invocation (x, y) shades rows y, y + row_step,
+/// ... of column x (row_step is the workgroup height, height / row_step the rows per invocation).
+struct FlareGatherTile {
+  uint32_t width = 0, height = 0, row_step = 0;
+};
+
 struct LensFlareAccess {
   /// Selects the path `flare` records from now on.
   static void select_gather(LensFlare& flare, FlareGatherPath path);
-  /// The pixels of one tile of the one-dispatch or the pre-pass gather (workgroup x by workgroup
-  /// y * rows) and the workgroup height: invocation (x, y) of a tile shades rows y, y + height, ...
-  /// of column x.
-  static VkExtent3D gather_tile(const LensFlare& flare, bool one_dispatch);
+  /// The tile of the one-dispatch or of the pre-pass gather (workgroup x by workgroup y * rows).
+  static FlareGatherTile gather_tile(const LensFlare& flare, bool one_dispatch);
   /// Makes the pre-pass gather (and the one beyond the sprite store) shade `rows` pixels per
   /// invocation from now on, 1 to GLINT_FLARE_GATHER_ROWS (tests: every tile height gives the
   /// same bits).

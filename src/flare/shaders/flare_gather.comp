@@ -2,8 +2,8 @@
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_control_flow_attributes : require
 // Lens flares for compute-only engines (docs/FLARE.md, "The two paths": compute), accumulated by gathering: one
-// workgroup per screen tile of kRows x workgroup pixels (each invocation keeps
-// its column's pixels in registers), no atomics on the image or on any global buffer. The sprites
+// workgroup per screen tile of workgroup x by (workgroup y * kRows) pixels (each invocation keeps
+// its column's kRows pixels in registers), no atomics on the image or on any global buffer. The sprites
 // were evaluated once for the frame by flare_sprites.comp (layout in flare_params.h), or, for few
 // instances (kFused), by the gather's own invocations, one sprite each: the whole draw is then
 // this one dispatch.
@@ -78,8 +78,9 @@ GlintFlareSprite gather_sprite(uint i, uint slot, uint stored) {
 
 // The pre-pass gather's workgroup k of n along one axis takes tile centre_out(k, n): the middle
 // tile first, then its neighbours alternately on either side (n / 2, n / 2 - 1, n / 2 + 1, ...; a
-// bijection of 0 .. n - 1). GPUs start workgroups in the order of their IDs, and every light's
-// ghost at t = 1 lands on the image centre, so with many lights the tiles that list the most
+// bijection of 0 .. n - 1). The H200 starts a dispatch's workgroups about in the order of their
+// IDs (as measured below; Vulkan promises no order), and every light's ghost at t = 1 lands on
+// the image centre, so with many lights the tiles that list the most
 // sprites start first instead of halfway through the dispatch (NVIDIA H200, 1000 lights at 1080p:
 // 488.9 -> 375.2 us). The one-dispatch gather of few instances keeps the IDs' order, which was
 // faster there (10 lights: 34.9 us against 36.6 centre first; docs/FLARE.md, "Speed").
@@ -89,9 +90,9 @@ void main() {
   const uint threads = gl_WorkGroupSize.x * gl_WorkGroupSize.y;
   const uint t = gl_LocalInvocationIndex;
   // The tile, and this invocation's column of pixels in it (rows gl_WorkGroupSize.y apart).
-  const uvec2 tile_id =
-      kFused != 0u ? gl_WorkGroupID.xy
-                   : uvec2(centre_out(gl_WorkGroupID.x, gl_NumWorkGroups.x), centre_out(gl_WorkGroupID.y, gl_NumWorkGroups.y));
+  const uvec2 tile_id = kFused != 0u ? gl_WorkGroupID.xy
+                                     : uvec2(centre_out(gl_WorkGroupID.x, gl_NumWorkGroups.x),
+                                             centre_out(gl_WorkGroupID.y, gl_NumWorkGroups.y));
   const uvec2 tile0 = tile_id * uvec2(pc.tile_w, pc.tile_h);
   const vec2 tile_lo = vec2(tile0), tile_hi = vec2(tile0 + uvec2(pc.tile_w, pc.tile_h));
   const uvec2 p0 = tile0 + gl_LocalInvocationID.xy;
@@ -216,7 +217,7 @@ void main() {
         // Rows whose centre lies outside the sprite's conservative rectangle get 0 from
         // glint_flare_shade, and adding 0 leaves a sum unchanged: two comparisons (the same for a
         // whole row of the workgroup) skip its divisions and the sample. A small sprite meets one
-        // or two of the 8 rows.
+        // or two of 8 rows.
         const vec4 b = glint_flare_sprite_bounds(s);
         [[unroll]] for (uint r = 0u; r < kRows; ++r) {
           vec2 pixel = vec2(p0.x, p0.y + r * gl_WorkGroupSize.y) + 0.5;

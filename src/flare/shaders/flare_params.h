@@ -117,7 +117,7 @@ struct GlintFlarePush {
   GLINT_FLOAT ghost_pos3;
   GLINT_FLOAT ghost_pos4;
   GLINT_UINT tile_w;         // compute: the gather's tile in pixels (workgroup x)
-  GLINT_UINT tile_h;         // (workgroup y * GLINT_FLARE_GATHER_ROWS)
+  GLINT_UINT tile_h;         // (workgroup y * the gather's rows, its specialization constant 4)
   GLINT_UINT indirect_word;  // compute: index of instance_count in the bound indirect words
 };
 
