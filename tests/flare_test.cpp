@@ -620,10 +620,13 @@ TEST_F(FlareTest, OneDispatchDrawGivesTheBitsOfThePrePass) {
 }
 
 // The pre-pass gather's tile height (rows per invocation: 2 on GPUs, 8 on CPU devices, where the
-// one-dispatch gather takes 8) changes which workgroup shades a pixel, not the list it sums nor
-// its order: 500 small lights, whose ghosts at t = 1 all land on the image centre (hundreds of
-// sprites on its pixels, several chunks of the shared list), both formats, give the same bits at
-// 1, 2, 4 and 8 rows, and match the float64 reference.
+// one-dispatch gather takes 8) and the order its workgroups take the tiles in (from the image
+// centre on GPUs, the IDs' order on CPU devices and in the one-dispatch gather) change which
+// workgroup shades a pixel and when, not the list it sums nor its order: 500 small lights, whose
+// ghosts at t = 1 all land on the image centre (hundreds of sprites on its pixels, several chunks
+// of the shared list), both formats, give the same bits at 1, 2, 4 and 8 rows (an odd count of
+// tiles at 4 rows on lavapipe, 5 columns on GPUs), in both orders, and match the float64
+// reference.
 TEST_F(FlareTest, PrePassGatherGivesTheSameBitsAtEveryTileHeight) {
   const DeviceInfo& info = context().info();
   for (VkFormat format : {kF16, kF32}) {
@@ -635,6 +638,8 @@ TEST_F(FlareTest, PrePassGatherGivesTheSameBitsAtEveryTileHeight) {
               info.type == VK_PHYSICAL_DEVICE_TYPE_CPU ? GLINT_FLARE_GATHER_ROWS : GLINT_FLARE_GATHER_PRE_PASS_ROWS)
         << fmt;
     EXPECT_EQ(one.height, GLINT_FLARE_GATHER_ROWS * one.row_step) << fmt;
+    EXPECT_EQ(pre.centre_first, info.type != VK_PHYSICAL_DEVICE_TYPE_CPU) << fmt;
+    EXPECT_FALSE(one.centre_first) << fmt;
     const reference::FlareAtlas atlas = read_flare_atlas(flare);
     const CpuImage background = as_stored(random_hdr(kW, kH, 83), format);
     auto lights = random_instances(500, 37);
@@ -643,11 +648,13 @@ TEST_F(FlareTest, PrePassGatherGivesTheSameBitsAtEveryTileHeight) {
     FlareInputs in(lights, uint32_t(lights.size()), flare.groups_per_instance());
     detail::LensFlareAccess::select_gather(flare, detail::FlareGatherPath::pre_pass);
     std::vector<CpuImage> images;
-    for (uint32_t r : {1u, 2u, 4u, 8u}) {
-      detail::LensFlareAccess::set_pre_pass_rows(flare, r);
-      images.push_back(draw(flare, Path::compute, background, format, in, config));
-      EXPECT_EQ(std::memcmp(images.back().rgba.data(), images.front().rgba.data(), images.front().rgba.size() * 4), 0)
-          << fmt << ", " << r << " rows against 1";
+    for (bool centre_first : {false, true}) {
+      for (uint32_t r : {1u, 2u, 4u, 8u}) {
+        detail::LensFlareAccess::set_pre_pass_tiles(flare, r, centre_first);
+        images.push_back(draw(flare, Path::compute, background, format, in, config));
+        EXPECT_EQ(std::memcmp(images.back().rgba.data(), images.front().rgba.data(), images.front().rgba.size() * 4), 0)
+            << fmt << ", " << r << " rows" << (centre_first ? ", centre first" : "") << " against 1 row";
+      }
     }
     EXPECT_NE(std::memcmp(images[0].rgba.data(), background.rgba.data(), background.rgba.size() * 4), 0)
         << fmt << ": drew nothing";
@@ -655,8 +662,8 @@ TEST_F(FlareTest, PrePassGatherGivesTheSameBitsAtEveryTileHeight) {
                                                 flare_sampler_precision());
     const FlareDeviation d = compare_flare(images[1], ref, format);
     EXPECT_EQ(d.outside, 0u) << fmt << ": " << d.first;
-    EXPECT_THROW(detail::LensFlareAccess::set_pre_pass_rows(flare, 0), Error);
-    EXPECT_THROW(detail::LensFlareAccess::set_pre_pass_rows(flare, GLINT_FLARE_GATHER_ROWS + 1), Error);
+    EXPECT_THROW(detail::LensFlareAccess::set_pre_pass_tiles(flare, 0, false), Error);
+    EXPECT_THROW(detail::LensFlareAccess::set_pre_pass_tiles(flare, GLINT_FLARE_GATHER_ROWS + 1, true), Error);
   }
 }
 
@@ -704,7 +711,7 @@ TEST_F(FlareTest, ComputeDrawsInstancesBeyondItsSpriteStore) {
   // 441 k instances in, where 2 rows would triple them), else 8.
   const detail::FlareGatherTile tile = detail::LensFlareAccess::gather_tile(flare, false);
   const uint32_t other = tile.height / tile.row_step == GLINT_FLARE_GATHER_ROWS ? 4u : GLINT_FLARE_GATHER_ROWS;
-  detail::LensFlareAccess::set_pre_pass_rows(flare, other);
+  detail::LensFlareAccess::set_pre_pass_tiles(flare, other, true);
   const CpuImage e = draw(flare, Path::compute, background, kF32, big, config);
   EXPECT_EQ(std::memcmp(e.rgba.data(), b.rgba.data(), b.rgba.size() * 4), 0) << other << " rows";
   std::printf("flare compute, %llu instances (%llu stored): worst |error| / tolerance %.3f\n",

@@ -14,13 +14,14 @@ detail::ComputePipeline LensFlare::Impl::make_gather(uint32_t beyond_store, uint
   d.bindings = {SB, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, SB, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, SB};
   d.push_constant_bytes = sizeof(GlintFlarePush);
   d.workgroup = workgroup;
-  d.specialization = {beyond_store, one_dispatch, (one_dispatch ? tiles_one_dispatch : tiles_pre_pass).rows};
+  const GatherTiles& tiles = one_dispatch ? tiles_one_dispatch : tiles_pre_pass;
+  d.specialization = {beyond_store, one_dispatch, tiles.rows, tiles.centre_first ? 1u : 0u};
   return detail::ComputePipeline(*context, d);
 }
 
-LensFlare::Impl::GatherTiles LensFlare::Impl::gather_tiles(uint32_t rows) const {
+LensFlare::Impl::GatherTiles LensFlare::Impl::gather_tiles(uint32_t rows, bool centre_first) const {
   const uint32_t tile_h = workgroup.y * rows;
-  return {rows, (extent.width + workgroup.x - 1) / workgroup.x, (extent.height + tile_h - 1) / tile_h};
+  return {rows, (extent.width + workgroup.x - 1) / workgroup.x, (extent.height + tile_h - 1) / tile_h, centre_first};
 }
 
 void LensFlare::Impl::make_compute_pipelines() {
@@ -158,19 +159,19 @@ void LensFlareAccess::select_gather(LensFlare& flare, FlareGatherPath path) { fl
 
 FlareGatherTile LensFlareAccess::gather_tile(const LensFlare& flare, bool one_dispatch) {
   const LensFlare::Impl& m = *flare.impl_;
-  const uint32_t rows = (one_dispatch ? m.tiles_one_dispatch : m.tiles_pre_pass).rows;
-  return {m.workgroup.x, m.workgroup.y * rows, m.workgroup.y};
+  const LensFlare::Impl::GatherTiles& t = one_dispatch ? m.tiles_one_dispatch : m.tiles_pre_pass;
+  return {m.workgroup.x, m.workgroup.y * t.rows, m.workgroup.y, t.centre_first};
 }
 
-void LensFlareAccess::set_pre_pass_rows(LensFlare& flare, uint32_t rows) {
+void LensFlareAccess::set_pre_pass_tiles(LensFlare& flare, uint32_t rows, bool centre_first) {
   if (rows < 1 || rows > GLINT_FLARE_GATHER_ROWS) {
-    throw Error(ErrorCode::invalid_argument, concat("LensFlareAccess::set_pre_pass_rows: rows is ", rows,
+    throw Error(ErrorCode::invalid_argument, concat("LensFlareAccess::set_pre_pass_tiles: rows is ", rows,
                                                     "; accepted 1 to ", GLINT_FLARE_GATHER_ROWS));
   }
   LensFlare::Impl& m = *flare.impl_;
-  m.tiles_pre_pass = m.gather_tiles(rows);
+  m.tiles_pre_pass = m.gather_tiles(rows, centre_first);
   m.gather = m.make_gather(0, 0);
-  m.gather_beyond = {};  // made again at its next use, with these rows
+  m.gather_beyond = {};  // made again at its next use, with these tiles
 }
 
 }  // namespace detail

@@ -49,8 +49,11 @@ struct LensFlare::Impl {
   detail::Workgroup2D workgroup;         // the gather's workgroup
   // The gather's tiles, workgroup x by workgroup y * rows pixels: the one-dispatch gather's
   // (GLINT_FLARE_GATHER_ROWS) and the pre-pass gather's (GLINT_FLARE_GATHER_PRE_PASS_ROWS on GPUs).
+  // centre_first: the workgroups take the tiles from the image centre outwards (specialization
+  // constant 5; the pre-pass gather on GPUs).
   struct GatherTiles {
     uint32_t rows = GLINT_FLARE_GATHER_ROWS, x = 0, y = 0;
+    bool centre_first = false;
   };
   GatherTiles tiles_one_dispatch, tiles_pre_pass;
 
@@ -106,7 +109,7 @@ struct LensFlare::Impl {
   void make_raster_pipeline();
   void make_compute_pipelines();
   detail::ComputePipeline make_gather(uint32_t beyond_store, uint32_t one_dispatch) const;
-  GatherTiles gather_tiles(uint32_t rows) const;
+  GatherTiles gather_tiles(uint32_t rows, bool centre_first) const;
   // Instances per batch of the one-dispatch gather (one invocation per sprite).
   uint32_t one_dispatch_batch() const { return workgroup.x * workgroup.y / GLINT_FLARE_SPRITES; }
   // The most instances for which record_compute() takes the one-dispatch gather by itself: one

@@ -25,6 +25,7 @@ enum class FlareGatherPath : uint32_t {
 /// ... of column x (row_step is the workgroup height, height / row_step the rows per invocation).
 struct FlareGatherTile {
   uint32_t width = 0, height = 0, row_step = 0;
+  bool centre_first = false;  // the workgroups take the tiles from the image centre outwards
 };
 
 struct LensFlareAccess {
@@ -33,9 +34,10 @@ struct LensFlareAccess {
   /// The tile of the one-dispatch or of the pre-pass gather (workgroup x by workgroup y * rows).
   static FlareGatherTile gather_tile(const LensFlare& flare, bool one_dispatch);
   /// Makes the pre-pass gather (and the one beyond the sprite store) shade `rows` pixels per
-  /// invocation from now on, 1 to GLINT_FLARE_GATHER_ROWS (tests: every tile height gives the
-  /// same bits).
-  static void set_pre_pass_rows(LensFlare& flare, uint32_t rows);
+  /// invocation from now on, 1 to GLINT_FLARE_GATHER_ROWS, its workgroups taking the tiles from
+  /// the image centre outwards or in their IDs' order (tests: every tile height and order gives
+  /// the same bits).
+  static void set_pre_pass_tiles(LensFlare& flare, uint32_t rows, bool centre_first);
 };
 
 }  // namespace glint::detail

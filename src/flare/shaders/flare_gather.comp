@@ -76,23 +76,24 @@ GlintFlareSprite gather_sprite(uint i, uint slot, uint stored) {
   return s;
 }
 
-// The pre-pass gather's workgroup k of n along one axis takes tile centre_out(k, n): the middle
-// tile first, then its neighbours alternately on either side (n / 2, n / 2 - 1, n / 2 + 1, ...; a
-// bijection of 0 .. n - 1). The H200 starts a dispatch's workgroups about in the order of their
-// IDs (as measured below; Vulkan promises no order), and every light's ghost at t = 1 lands on
-// the image centre, so with many lights the tiles that list the most
-// sprites start first instead of halfway through the dispatch (NVIDIA H200, 1000 lights at 1080p:
-// 488.9 -> 375.2 us). The one-dispatch gather of few instances keeps the IDs' order, which was
-// faster there (10 lights: 34.9 us against 36.6 centre first; docs/FLARE.md, "Speed").
+// With kCentreFirst, workgroup k of n along one axis takes tile centre_out(k, n): the middle tile
+// first, then its neighbours alternately on either side (n / 2, n / 2 - 1, n / 2 + 1, ...; a
+// bijection of 0 .. n - 1). The H200 starts a dispatch's workgroups about in the order of their IDs
+// (as measured; Vulkan promises no order), and every light's ghost at t = 1 lands on the image
+// centre, so with many lights the tiles that list the most sprites start first instead of halfway
+// through the dispatch (1000 lights at 1080p: 488.9 -> 375.2 us). The host sets it for the
+// pre-pass gather on GPUs; the one-dispatch gather (10 lights: 34.9 us against 36.6 centre first)
+// and lavapipe were faster in the IDs' order (docs/FLARE.md, "Speed").
+layout(constant_id = 5) const uint kCentreFirst = 0u;
 uint centre_out(uint k, uint n) { return (k & 1u) == 0u ? (n >> 1u) + (k >> 1u) : (n >> 1u) - ((k + 1u) >> 1u); }
 
 void main() {
   const uint threads = gl_WorkGroupSize.x * gl_WorkGroupSize.y;
   const uint t = gl_LocalInvocationIndex;
   // The tile, and this invocation's column of pixels in it (rows gl_WorkGroupSize.y apart).
-  const uvec2 tile_id = kFused != 0u ? gl_WorkGroupID.xy
-                                     : uvec2(centre_out(gl_WorkGroupID.x, gl_NumWorkGroups.x),
-                                             centre_out(gl_WorkGroupID.y, gl_NumWorkGroups.y));
+  const uvec2 tile_id = kCentreFirst == 0u ? gl_WorkGroupID.xy
+                                           : uvec2(centre_out(gl_WorkGroupID.x, gl_NumWorkGroups.x),
+                                                   centre_out(gl_WorkGroupID.y, gl_NumWorkGroups.y));
   const uvec2 tile0 = tile_id * uvec2(pc.tile_w, pc.tile_h);
   const vec2 tile_lo = vec2(tile0), tile_hi = vec2(tile0 + uvec2(pc.tile_w, pc.tile_h));
   const uvec2 p0 = tile0 + gl_LocalInvocationID.xy;
