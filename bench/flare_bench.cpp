@@ -181,8 +181,12 @@ void run_flare_draw(benchmark::State& state, uint32_t width, uint32_t height, ui
   state.counters["lights"] = lights;
   state.counters["sprite_pixels"] = pixels;
   state.counters["fill_pixels_per_second"] = benchmark::Counter(pixels, benchmark::Counter::kIsIterationInvariantRate);
-  const bool one_dispatch = path == detail::FlareGatherPath::one_dispatch ||
-                            (path == detail::FlareGatherPath::device && lights <= flare.one_dispatch_instances());
+  // As record_compute() decides: a gather workgroup of fewer than GLINT_FLARE_SPRITES invocations
+  // (ContextOptions::workgroup_2d can force one) holds no instance's sprites and takes the pre-pass.
+  const detail::FlareGatherTile one_tile = detail::LensFlareAccess::gather_tile(flare, true);
+  const bool one_dispatch = one_tile.width * one_tile.row_step >= GLINT_FLARE_SPRITES &&
+                            (path == detail::FlareGatherPath::one_dispatch ||
+                             (path == detail::FlareGatherPath::device && lights <= flare.one_dispatch_instances()));
   if (compute) {
     const TileLoad load = tile_load(sprites, width, height, detail::LensFlareAccess::gather_tile(flare, one_dispatch));
     state.counters["tile_sprites_max"] = load.sprites_max;
