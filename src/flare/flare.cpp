@@ -192,22 +192,17 @@ LensFlare::LensFlare(const Context& context, VkFormat color_format, VkExtent2D e
   // The gather's workgroup: 32x8 on GPUs (on the H100 it beat 16x8 when both gathered 8 rows, 16x8's
   // tiles binning every instance twice as often: docs/FLARE.md), the device's 2D choice (8x8) on CPU
   // devices.
+  const bool cpu = context.info().type == VK_PHYSICAL_DEVICE_TYPE_CPU;
   m.workgroup = detail::choose_workgroup_2d(context);
-  if (context.info().type != VK_PHYSICAL_DEVICE_TYPE_CPU && context.info().max_workgroup_invocations >= 256 &&
-      context.info().subgroup_size >= 32) {
+  if (!cpu && context.info().max_workgroup_invocations >= 256 && context.info().subgroup_size >= 32) {
     m.workgroup = {32, 8};
   }
   if (m.workgroup.x * m.workgroup.y > GLINT_FLARE_GATHER_MAX_THREADS) m.workgroup = {16, 16};
-  m.one_dispatch_limit = context.info().type == VK_PHYSICAL_DEVICE_TYPE_CPU ? 0 : m.one_dispatch_batch();
-  // The pre-pass gather's tiles are 4 times shorter on GPUs: 1000 lights at 1080p 638 -> 489 us on
-  // the H200, where the one-dispatch gather of 10 lights was slower with shorter tiles (34.9 us with
-  // 8 rows, 37.6 with 4; docs/FLARE.md "Speed"). CPU devices keep 8 rows (a tile's invocations run
-  // one after another there, so the tile size sets only how often each instance is binned).
-  // The pre-pass gather on GPUs starts its tiles from the image centre (flare_gather.comp,
-  // centre_out): 1000 lights 488.9 -> 375.2 us on the H200. lavapipe was 4 to 7 % slower with that
-  // order (10 lights at 1080p, 223.5 -> 232 ms), and the one-dispatch gather on the H200 too (34.9 ->
-  // 36.6 us), so they keep the workgroup IDs' order.
-  const bool cpu = context.info().type == VK_PHYSICAL_DEVICE_TYPE_CPU;
+  m.one_dispatch_limit = cpu ? 0 : m.one_dispatch_batch();
+  // The tiles of each gather, as measured (docs/FLARE.md, "Speed"; flare_params.h): on GPUs the
+  // pre-pass gather's are 4 times shorter and start from the image centre, where every light's
+  // ghost at t = 1 piles up; the one-dispatch gather and CPU devices keep 8 rows in the workgroup
+  // IDs' order, which was faster there.
   m.tiles_one_dispatch = m.gather_tiles(GLINT_FLARE_GATHER_ROWS, false);
   m.tiles_pre_pass = m.gather_tiles(cpu ? GLINT_FLARE_GATHER_ROWS : GLINT_FLARE_GATHER_PRE_PASS_ROWS, !cpu);
   m.make_atlas();
