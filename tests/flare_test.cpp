@@ -560,6 +560,9 @@ TEST_F(FlareTest, OneDispatchDrawGivesTheBitsOfThePrePass) {
   for (VkFormat format : {kF16, kF32}) {
     const std::string fmt = format == kF16 ? "rgba16f" : "rgba32f";
     LensFlare flare(context(), format, {kW, kH});
+    // A split tile groups its sums by slice (CrowdedTilesSplitIntoSlicesMatchTheReference): the
+    // bits compared here are those of the unsplit gather.
+    detail::LensFlareAccess::set_split(flare, false);
     const reference::FlareAtlas atlas = read_flare_atlas(flare);
     const uint32_t most = flare.one_dispatch_instances();
     // The gather's workgroup as flare.cpp picks it: 32x8 on GPUs with 256 invocations and 32-wide
@@ -619,10 +622,11 @@ TEST_F(FlareTest, OneDispatchDrawGivesTheBitsOfThePrePass) {
   }
 }
 
-// The pre-pass gather's tile height (rows per invocation: 2 on GPUs, 8 on CPU devices, where the
-// one-dispatch gather takes 8) and the order its workgroups take the tiles in (from the image
-// centre on GPUs, the IDs' order on CPU devices and in the one-dispatch gather) change which
-// workgroup shades a pixel and when, not the list it sums nor its order: 500 small lights, whose
+// The pre-pass gather's tile height (rows per invocation: 8 on every device, as in the
+// one-dispatch gather) and the order its workgroups take the tiles in (from the image centre on
+// GPUs, the IDs' order on CPU devices and in the one-dispatch gather) change which workgroup
+// shades a pixel and when, not the list it sums nor its order (without the split of crowded
+// tiles, which groups a split tile's sums by slice: the next test): 500 small lights, whose
 // ghosts at t = 1 all land on the image centre (hundreds of sprites on its pixels, several chunks
 // of the shared list), both formats, give the same bits at 1, 2, 4 and 8 rows (an odd count of
 // tiles at 4 rows on lavapipe, 5 columns on GPUs), in both orders, and match the float64
@@ -634,9 +638,7 @@ TEST_F(FlareTest, PrePassGatherGivesTheSameBitsAtEveryTileHeight) {
     LensFlare flare(context(), format, {kW, kH});
     const detail::FlareGatherTile pre = detail::LensFlareAccess::gather_tile(flare, false);
     const detail::FlareGatherTile one = detail::LensFlareAccess::gather_tile(flare, true);
-    EXPECT_EQ(pre.height / pre.row_step,
-              info.type == VK_PHYSICAL_DEVICE_TYPE_CPU ? GLINT_FLARE_GATHER_ROWS : GLINT_FLARE_GATHER_PRE_PASS_ROWS)
-        << fmt;
+    EXPECT_EQ(pre.height, GLINT_FLARE_GATHER_ROWS * pre.row_step) << fmt;
     EXPECT_EQ(one.height, GLINT_FLARE_GATHER_ROWS * one.row_step) << fmt;
     EXPECT_EQ(pre.centre_first, info.type != VK_PHYSICAL_DEVICE_TYPE_CPU) << fmt;
     EXPECT_FALSE(one.centre_first) << fmt;
@@ -647,6 +649,7 @@ TEST_F(FlareTest, PrePassGatherGivesTheSameBitsAtEveryTileHeight) {
     const FlareConfig config;
     FlareInputs in(lights, uint32_t(lights.size()), flare.groups_per_instance());
     detail::LensFlareAccess::select_gather(flare, detail::FlareGatherPath::pre_pass);
+    detail::LensFlareAccess::set_split(flare, false);
     std::vector<CpuImage> images;
     for (bool centre_first : {false, true}) {
       for (uint32_t r : {1u, 2u, 4u, 8u}) {
@@ -664,6 +667,82 @@ TEST_F(FlareTest, PrePassGatherGivesTheSameBitsAtEveryTileHeight) {
     EXPECT_EQ(d.outside, 0u) << fmt << ": " << d.first;
     EXPECT_THROW(detail::LensFlareAccess::set_pre_pass_tiles(flare, 0, false), Error);
     EXPECT_THROW(detail::LensFlareAccess::set_pre_pass_tiles(flare, GLINT_FLARE_GATHER_ROWS + 1, true), Error);
+  }
+}
+
+// The words of a device buffer (the split plan), read back after the commands before.
+std::vector<uint32_t> read_words(Buffer buffer) {
+  detail::OwnedBuffer staging(context(), buffer.size, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true);
+  context().run_once([&](VkCommandBuffer cmd) {
+    detail::Barriers b;
+    b.use(buffer, VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
+    b.flush(cmd);
+    VkBufferCopy c{buffer.offset, 0, buffer.size};
+    vkCmdCopyBuffer(cmd, buffer.buffer, staging.buffer(), 1, &c);
+  });
+  staging.invalidate();
+  std::vector<uint32_t> words(buffer.size / 4);
+  std::memcpy(words.data(), staging.mapped(), words.size() * 4);
+  return words;
+}
+
+// Crowded tiles split into slices (flare_params.h, "Crowded tiles"), on every device: 500 small
+// lights whose ghosts at t = 1 pile on the image centre, both formats, with thresholds that split
+// the tiles counting at least 200 sprites into up to 8 slices. The plan read back splits some
+// tiles and uses at most GLINT_FLARE_SPLIT_SLOTS slots; the image matches the float64 reference;
+// a second frame plans the same and gives the same bits, with the counts and finished-slice
+// words zeroed by the kernels after use. With a tile's every sprite a slice (up to 31), the frame
+// needs more slots than there are and splits none: the bits of the unsplit gather.
+TEST_F(FlareTest, CrowdedTilesSplitIntoSlicesMatchTheReference) {
+  for (VkFormat format : {kF16, kF32}) {
+    const std::string fmt = format == kF16 ? "rgba16f" : "rgba32f";
+    LensFlare flare(context(), format, {kW, kH});
+    const reference::FlareAtlas atlas = read_flare_atlas(flare);
+    const CpuImage background = as_stored(random_hdr(kW, kH, 87), format);
+    auto lights = random_instances(500, 41);
+    for (auto& g : lights) g.size_px = 2.0f + 0.2f * g.size_px;
+    const FlareConfig config;
+    FlareInputs in(lights, uint32_t(lights.size()), flare.groups_per_instance());
+    detail::LensFlareAccess::select_gather(flare, detail::FlareGatherPath::pre_pass);
+    detail::LensFlareAccess::set_split(flare, false);
+    const CpuImage unsplit = draw(flare, Path::compute, background, format, in, config);
+
+    detail::LensFlareAccess::set_split(flare, true, 200, 16, 8);
+    const detail::FlareGatherTile tile = detail::LensFlareAccess::gather_tile(flare, false);
+    const size_t tiles = size_t((kW + tile.width - 1) / tile.width) * ((kH + tile.height - 1) / tile.height);
+    const size_t used_word = 3 * tiles + GLINT_FLARE_SPLIT_SLOTS;
+    const CpuImage a = draw(flare, Path::compute, background, format, in, config);
+    const std::vector<uint32_t> first = read_words(detail::LensFlareAccess::split_words(flare));
+    const CpuImage b = draw(flare, Path::compute, background, format, in, config);
+    const std::vector<uint32_t> second = read_words(detail::LensFlareAccess::split_words(flare));
+    ASSERT_EQ(first.size(), used_word + 1) << fmt;
+    size_t split_tiles = 0, slots = 0;
+    for (size_t i = 0; i < tiles; ++i) {
+      const uint32_t slices = first[tiles + i] & 31u;
+      EXPECT_GE(slices, 1u) << fmt << ", tile " << i;
+      EXPECT_LE(slices, 8u) << fmt << ", tile " << i;
+      if (slices > 1) ++split_tiles, slots += slices;
+      EXPECT_EQ(first[i], 0u) << fmt << ": the count of tile " << i << " was not zeroed";
+      EXPECT_EQ(first[2 * tiles + i], 0u) << fmt << ": the finished slices of tile " << i << " were not zeroed";
+    }
+    EXPECT_GT(split_tiles, 0u) << fmt << ": no tile was split";
+    EXPECT_EQ(first[used_word], slots) << fmt;
+    EXPECT_LE(slots, GLINT_FLARE_SPLIT_SLOTS) << fmt;
+    EXPECT_EQ(first, second) << fmt << ": the second frame planned otherwise";
+    EXPECT_EQ(std::memcmp(a.rgba.data(), b.rgba.data(), a.rgba.size() * 4), 0) << fmt << ": frames differ";
+    const auto ref = reference::flare_composite(background, lights, uint32_t(lights.size()), config, atlas,
+                                                flare_sampler_precision());
+    const FlareDeviation d = compare_flare(a, ref, format);
+    EXPECT_EQ(d.outside, 0u) << fmt << ", " << split_tiles << " tiles split: " << d.first;
+
+    detail::LensFlareAccess::set_split(flare, true, 1, 1, 31);
+    const CpuImage c = draw(flare, Path::compute, background, format, in, config);
+    const std::vector<uint32_t> over = read_words(detail::LensFlareAccess::split_words(flare));
+    EXPECT_EQ(over[used_word], 0u) << fmt << ": a frame over the slots split tiles";
+    for (size_t i = 0; i < tiles; ++i) EXPECT_EQ(over[tiles + i], 1u) << fmt << ", tile " << i;
+    EXPECT_EQ(std::memcmp(c.rgba.data(), unsplit.rgba.data(), c.rgba.size() * 4), 0) << fmt;
+    EXPECT_THROW(detail::LensFlareAccess::set_split(flare, true, 1, 0, 8), Error);
+    EXPECT_THROW(detail::LensFlareAccess::set_split(flare, true, 1, 1, 32), Error);
   }
 }
 

@@ -6,6 +6,7 @@ set(GLINT_EFFECT_KERNELS
   "shaders/flare_atlas|main|"
   "shaders/flare_gather_args|main|"
   "shaders/flare_sprites|main|"
+  "shaders/flare_split_plan|main|"
   "shaders/flare_gather|rgba16f|DST_FORMAT=rgba16f"
   "shaders/flare_gather|rgba32f|DST_FORMAT=rgba32f"
   "shaders/flare.vert|main|"

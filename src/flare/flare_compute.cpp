@@ -11,12 +11,29 @@ detail::ComputePipeline LensFlare::Impl::make_gather(uint32_t beyond_store, uint
   const auto SB = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
   detail::PipelineDesc d;
   d.kernel_id = std::string("flare_gather_") + detail::format_variant(format);
-  d.bindings = {SB, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, SB, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, SB};
+  d.bindings = {SB, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, SB, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, SB, SB, SB};
   d.push_constant_bytes = sizeof(GlintFlarePush);
   d.workgroup = workgroup;
   const GatherTiles& tiles = one_dispatch ? tiles_one_dispatch : tiles_pre_pass;
-  d.specialization = {beyond_store, one_dispatch, tiles.rows, tiles.centre_first ? 1u : 0u};
+  d.specialization = {beyond_store, one_dispatch, tiles.rows, tiles.centre_first ? 1u : 0u,
+                      split && !one_dispatch ? 1u : 0u};
   return detail::ComputePipeline(*context, d);
+}
+
+void LensFlare::Impl::make_split_buffers() {
+  // (TRANSFER_SRC: tests read the plan back.)
+  const VkBufferUsageFlags usage =
+      VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT;
+  const VkDeviceSize words = GLINT_FLARE_SPLIT_WORDS(tiles_pre_pass.x * tiles_pre_pass.y);
+  split_buffer = detail::OwnedBuffer(*context, words * 4, usage, false);
+  split_state = Buffer{split_buffer.buffer(), 0, words * 4, usage, VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE};
+  split_cleared = false;
+  // A slot holds one slice's sums: one vec4 per pixel of a tile.
+  const VkDeviceSize partial_bytes =
+      split ? VkDeviceSize(GLINT_FLARE_SPLIT_SLOTS) * workgroup.x * workgroup.y * tiles_pre_pass.rows * 16 : 16;
+  partials_buffer = detail::OwnedBuffer(*context, partial_bytes, usage, false);
+  partials_state =
+      Buffer{partials_buffer.buffer(), 0, partial_bytes, usage, VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE};
 }
 
 LensFlare::Impl::GatherTiles LensFlare::Impl::gather_tiles(uint32_t rows, bool centre_first) const {
@@ -32,10 +49,20 @@ void LensFlare::Impl::make_compute_pipelines() {
   if (one_dispatch_limit > 0) gather_one_dispatch = make_gather(0, 1);
   detail::PipelineDesc sp;
   sp.kernel_id = "flare_sprites_main";
-  sp.bindings = {SB, SB, SB};
+  sp.bindings = {SB, SB, SB, SB};
   sp.push_constant_bytes = sizeof(GlintFlarePush);
   sp.workgroup = {GLINT_FLARE_SPRITES_SLOTS, GLINT_FLARE_SPRITES_INSTANCES};
+  sp.specialization = {split ? 1u : 0u};
   sprites = detail::ComputePipeline(*context, sp);
+  if (split && !split_plan) {
+    detail::PipelineDesc sd;
+    sd.kernel_id = "flare_split_plan_main";
+    sd.bindings = {SB, SB, SB};
+    sd.push_constant_bytes = sizeof(GlintFlareSplitPush);
+    sd.workgroup = {GLINT_FLARE_SPLIT_PLAN_THREADS, 1};
+    split_plan = detail::ComputePipeline(*context, sd);
+  }
+  make_split_buffers();
   detail::PipelineDesc a;
   a.kernel_id = "flare_gather_args_main";
   a.bindings = {SB, SB};
@@ -92,11 +119,20 @@ void LensFlare::record_compute(VkCommandBuffer cmd, Image& color, Buffer& instan
     b.use(m.atlas_image.state, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, kCompute, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT,
           GLINT_FLARE_ATLAS_LEVELS);
     b.use(color, VK_IMAGE_LAYOUT_GENERAL, kCompute, kStorageRW);
+    // Bound for the shader's declarations; this gather splits no tile and does not read them.
+    b.use(m.split_state, kCompute, kStorageRW);
+    b.use(m.partials_state, kCompute, kStorageRW);
     b.flush(cmd);
     p.tile_h = m.workgroup.y * m.tiles_one_dispatch.rows;
-    m.gather_one_dispatch.dispatch(
-        cmd, {instances, m.atlas_binding(), indirect_words, {color.view, VK_IMAGE_LAYOUT_GENERAL}, instances}, p,
-        m.tiles_one_dispatch.x * m.workgroup.x, m.tiles_one_dispatch.y * m.workgroup.y);
+    m.gather_one_dispatch.dispatch(cmd,
+                                   {instances,
+                                    m.atlas_binding(),
+                                    indirect_words,
+                                    {color.view, VK_IMAGE_LAYOUT_GENERAL},
+                                    instances,
+                                    m.split_state,
+                                    m.partials_state},
+                                   p, m.tiles_one_dispatch.x * m.workgroup.x, m.tiles_one_dispatch.y * m.workgroup.y);
     if (profiler) profiler->mark(cmd, "flare gather");
     return;
   }
@@ -132,23 +168,56 @@ void LensFlare::record_compute(VkCommandBuffer cmd, Image& color, Buffer& instan
   b.flush(cmd);
   m.gather_args.dispatch(cmd, {indirect_words, m.gather_args_state}, ap, 1, 1);
   if (profiler) profiler->mark(cmd, "flare arguments");
-  // 2. The sprite pre-pass: every sprite of every instance, once.
+  if (!m.split_cleared) {  // once per split buffer: the kernels zero what they used after each frame
+    b.use(m.split_state, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);  // fill = "transfer"
+    b.flush(cmd);
+    vkCmdFillBuffer(cmd, m.split_state.buffer, 0, VK_WHOLE_SIZE, 0);
+    m.split_cleared = true;
+  }
+  // 2. The sprite pre-pass: every sprite of every instance, once (with the split, each tile's
+  //    count of sprites too).
+  p.tile_h = m.workgroup.y * m.tiles_pre_pass.rows;
   b.use(m.gather_args_state, kIndirect, VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT);
   b.use(instances, kCompute, VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
   b.use(store, kCompute, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+  b.use(m.split_state, kCompute, kStorageRW);
   b.flush(cmd);
-  m.sprites.dispatch_indirect(cmd, {instances, indirect_words, store}, p, m.gather_args_buffer.buffer(), 16);
+  m.sprites.dispatch_indirect(cmd, {instances, indirect_words, store, m.split_state}, p, m.gather_args_buffer.buffer(),
+                              16);
   if (profiler) profiler->mark(cmd, "flare sprites");
-  // 3. The gather, one workgroup per tile.
+  if (m.split) {
+    // 2b. The split plan: each tile's slices, the slots, and the gather's launch with the slots'
+    //     workgroups (rewriting the gather's arguments).
+    GlintFlareSplitPush sp = m.split_params;
+    sp.indirect_word = p.indirect_word;
+    sp.tiles_x = m.tiles_pre_pass.x;
+    sp.tiles_y = m.tiles_pre_pass.y;
+    sp.capacity = ap.capacity;
+    b.use(m.split_state, kCompute, kStorageRW);
+    b.use(m.gather_args_state, kCompute, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+    b.flush(cmd);
+    m.split_plan.dispatch(cmd, {indirect_words, m.split_state, m.gather_args_state}, sp, GLINT_FLARE_SPLIT_PLAN_THREADS,
+                          1);
+    if (profiler) profiler->mark(cmd, "flare split plan");
+  }
+  // 3. The gather, one workgroup per tile (and per further slice of a split tile).
+  b.use(m.gather_args_state, kIndirect, VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT);
   b.use(store, kCompute, VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
   b.use(m.atlas_image.state, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, kCompute, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT,
         GLINT_FLARE_ATLAS_LEVELS);
   b.use(color, VK_IMAGE_LAYOUT_GENERAL, kCompute, kStorageRW);
+  b.use(m.split_state, kCompute, kStorageRW);
+  b.use(m.partials_state, kCompute, kStorageRW);
   b.flush(cmd);
-  p.tile_h = m.workgroup.y * m.tiles_pre_pass.rows;
   (beyond ? m.gather_beyond : m.gather)
       .dispatch_indirect(cmd,
-                         {instances, m.atlas_binding(), indirect_words, {color.view, VK_IMAGE_LAYOUT_GENERAL}, store},
+                         {instances,
+                          m.atlas_binding(),
+                          indirect_words,
+                          {color.view, VK_IMAGE_LAYOUT_GENERAL},
+                          store,
+                          m.split_state,
+                          m.partials_state},
                          p, m.gather_args_buffer.buffer(), 0);
   if (profiler) profiler->mark(cmd, "flare gather");
 }
@@ -172,7 +241,26 @@ void LensFlareAccess::set_pre_pass_tiles(LensFlare& flare, uint32_t rows, bool c
   m.tiles_pre_pass = m.gather_tiles(rows, centre_first);
   m.gather = m.make_gather(0, 0);
   m.gather_beyond = {};  // made again at its next use, with these tiles
+  m.make_split_buffers();
 }
+
+void LensFlareAccess::set_split(LensFlare& flare, bool on, uint32_t min_sprites, uint32_t sprites_per_slice,
+                                uint32_t max_slices) {
+  if (sprites_per_slice < 1 || max_slices < 1 || max_slices > 31) {
+    throw Error(ErrorCode::invalid_argument,
+                concat("LensFlareAccess::set_split: sprites_per_slice is ", sprites_per_slice, " and max_slices ",
+                       max_slices, "; accepted at least 1, and 1 to 31"));
+  }
+  LensFlare::Impl& m = *flare.impl_;
+  m.split = on;
+  m.split_params.min_sprites = min_sprites;
+  m.split_params.sprites_per_slice = sprites_per_slice;
+  m.split_params.max_slices = max_slices;
+  m.make_compute_pipelines();
+  m.gather_beyond = {};
+}
+
+Buffer LensFlareAccess::split_words(const LensFlare& flare) { return flare.impl_->split_state; }
 
 }  // namespace detail
 }  // namespace glint

@@ -47,15 +47,24 @@ struct LensFlare::Impl {
   uint32_t max_groups_x = 65535;         // maxComputeWorkGroupCount[0]
   VkDeviceSize storage_alignment = 256;  // minStorageBufferOffsetAlignment
   detail::Workgroup2D workgroup;         // the gather's workgroup
-  // The gather's tiles, workgroup x by workgroup y * rows pixels: the one-dispatch gather's
-  // (GLINT_FLARE_GATHER_ROWS) and the pre-pass gather's (GLINT_FLARE_GATHER_PRE_PASS_ROWS on GPUs).
-  // centre_first: the workgroups take the tiles from the image centre outwards (specialization
-  // constant 5; the pre-pass gather on GPUs).
+  // The gather's tiles, workgroup x by workgroup y * rows pixels (GLINT_FLARE_GATHER_ROWS unless a
+  // test sets the pre-pass gather's). centre_first: the workgroups take the tiles from the image
+  // centre outwards (specialization constant 5; the pre-pass gather on GPUs).
   struct GatherTiles {
     uint32_t rows = GLINT_FLARE_GATHER_ROWS, x = 0, y = 0;
     bool centre_first = false;
   };
   GatherTiles tiles_one_dispatch, tiles_pre_pass;
+  // The split of crowded tiles in the pre-pass gather (flare_params.h, "Crowded tiles"; on GPUs):
+  // the plan's parameters, the split words (counts, plans, finished slices, slots) for
+  // tiles_pre_pass, zeroed once at their first use (the kernels zero what they used after each
+  // frame), and the slots of partial sums (16 bytes when the split is off).
+  bool split = false;
+  GlintFlareSplitPush split_params{};
+  detail::OwnedBuffer split_buffer, partials_buffer;
+  Buffer split_state, partials_state;
+  bool split_cleared = false;
+  detail::ComputePipeline split_plan;
 
   // Atlas: one image with every level, a view of all levels (sampling) and one per level (storage).
   detail::OwnedImage atlas_image;      // state tracks all levels together
@@ -108,6 +117,7 @@ struct LensFlare::Impl {
   void make_atlas();
   void make_raster_pipeline();
   void make_compute_pipelines();
+  void make_split_buffers();  // for tiles_pre_pass and `split`
   detail::ComputePipeline make_gather(uint32_t beyond_store, uint32_t one_dispatch) const;
   GatherTiles gather_tiles(uint32_t rows, bool centre_first) const;
   // Instances per batch of the one-dispatch gather (one invocation per sprite).

@@ -5,6 +5,8 @@
 
 #include <cstdint>
 
+#include "flare/shaders/flare_params.h"
+
 namespace glint::detail {
 
 /// The dispatches LensFlare::record_compute() makes (docs/FLARE.md, "Compute (record_compute)").
@@ -38,6 +40,16 @@ struct LensFlareAccess {
   /// the image centre outwards or in their IDs' order (tests: every tile height and order gives
   /// the same bits).
   static void set_pre_pass_tiles(LensFlare& flare, uint32_t rows, bool centre_first);
+  /// Turns the split of crowded tiles in the pre-pass gather on or off (on by default on GPUs,
+  /// off on CPU devices); a tile counting at least `min_sprites` sprites gets
+  /// min(count / sprites_per_slice, max_slices) slices (flare_params.h, "Crowded tiles"; tests
+  /// split every tile with small values). max_slices is 1 to 31.
+  static void set_split(LensFlare& flare, bool on, uint32_t min_sprites = GLINT_FLARE_SPLIT_MIN_SPRITES,
+                        uint32_t sprites_per_slice = GLINT_FLARE_SPLIT_SPRITES,
+                        uint32_t max_slices = GLINT_FLARE_SPLIT_MAX_SLICES);
+  /// The split words (layout in flare_params.h) the last pre-pass draw planned with, and the
+  /// gather tiles they are for (tests read how many tiles were split).
+  static Buffer split_words(const LensFlare& flare);
 };
 
 }  // namespace glint::detail

@@ -24,7 +24,13 @@
 // 3. Shading: every invocation adds glint_flare_shade (the function flare.frag evaluates) of every
 //    listed sprite at each of its pixel centres, in fp32.
 // Finally a pixel that received light is read, gains the sum and is written once (alpha kept);
-// pixels that received none are not touched (bit-identical). docs/FLARE.md "The two paths" says
+// pixels that received none are not touched (bit-identical).
+// With kSplit (the pre-pass gather on GPUs), flare_split_plan.comp has given each tile slices: a
+// tile of one slice is drawn as above; a crowded one by one workgroup per slice, each drawing a
+// contiguous range of the instances into a slot of partial sums, and the last of them to finish
+// adds the slots in slice order (p0 + p1 + ...: the same order on every run) and writes the
+// pixels. Its sums are then grouped by slice, so a split tile's bits differ from an unsplit one's
+// by the fp32 rounding of that grouping, within the same bound. docs/FLARE.md "The two paths" says
 // why this replaced a per-sprite splat with a float compare-and-swap per pixel.
 layout(local_size_x_id = 0, local_size_y_id = 1) in;
 
@@ -85,15 +91,42 @@ GlintFlareSprite gather_sprite(uint i, uint slot, uint stored) {
 // pre-pass gather on GPUs; the one-dispatch gather (10 lights: 34.9 us against 36.6 centre first)
 // and lavapipe were faster in the IDs' order (docs/FLARE.md, "Speed").
 layout(constant_id = 5) const uint kCentreFirst = 0u;
+// 1: tiles are split as flare_split_plan.comp planned (the launch has the slots' workgroups below
+// the tiles' rows); 0: every tile is one slice (bindings 5 and 6 are not read).
+layout(constant_id = 6) const uint kSplit = 0u;
+layout(std430, binding = 5) coherent buffer Split { uint split_words[]; };  // layout in flare_params.h
+layout(std430, binding = 6) coherent buffer Partials { vec4 partials[]; };  // GLINT_FLARE_SPLIT_SLOTS slots
+shared bool s_last;  // this workgroup is the last of its tile's slices to finish
 uint centre_out(uint k, uint n) { return (k & 1u) == 0u ? (n >> 1u) + (k >> 1u) : (n >> 1u) - ((k + 1u) >> 1u); }
 
 void main() {
   const uint threads = gl_WorkGroupSize.x * gl_WorkGroupSize.y;
   const uint t = gl_LocalInvocationIndex;
   // The tile, and this invocation's column of pixels in it (rows gl_WorkGroupSize.y apart).
-  const uvec2 tile_id = kCentreFirst == 0u ? gl_WorkGroupID.xy
-                                           : uvec2(centre_out(gl_WorkGroupID.x, gl_NumWorkGroups.x),
-                                                   centre_out(gl_WorkGroupID.y, gl_NumWorkGroups.y));
+  const uint tiles_x = gl_NumWorkGroups.x;
+  const uint tiles_y = kSplit != 0u ? (uint(pc.viewport_h) + pc.tile_h - 1u) / pc.tile_h : gl_NumWorkGroups.y;
+  const uint tiles = tiles_x * tiles_y;
+  uvec2 tile_id;
+  uint slice = 0u;  // which of its tile's slices this workgroup draws
+  if (kSplit != 0u && gl_WorkGroupID.y >= tiles_y) {
+    // A slot's workgroup: it draws the slot's slice unless that is its tile's first.
+    const uint h = (gl_WorkGroupID.y - tiles_y) * tiles_x + gl_WorkGroupID.x;
+    if (h >= split_words[3u * tiles + GLINT_FLARE_SPLIT_SLOTS]) return;  // uniform
+    const uint e = split_words[3u * tiles + h];
+    slice = e & 31u;
+    if (slice == 0u) return;
+    tile_id = uvec2((e >> 5u) % tiles_x, (e >> 5u) / tiles_x);
+  } else {
+    tile_id = kCentreFirst == 0u ? gl_WorkGroupID.xy
+                                 : uvec2(centre_out(gl_WorkGroupID.x, tiles_x), centre_out(gl_WorkGroupID.y, tiles_y));
+  }
+  const uint tile_index = tile_id.y * tiles_x + tile_id.x;
+  uint slices = 1u, slot0 = 0u;
+  if (kSplit != 0u) {
+    const uint plan = split_words[tiles + tile_index];
+    slices = max(plan & 31u, 1u);
+    slot0 = plan >> 5u;
+  }
   const uvec2 tile0 = tile_id * uvec2(pc.tile_w, pc.tile_h);
   const vec2 tile_lo = vec2(tile0), tile_hi = vec2(tile0 + uvec2(pc.tile_w, pc.tile_h));
   const uvec2 p0 = tile0 + gl_LocalInvocationID.xy;
@@ -107,11 +140,18 @@ void main() {
   if (kBeyondStore == 0u && kFused == 0u) count = stored;
   // Instances per batch: one per invocation, or (kFused) one per GLINT_FLARE_SPRITES invocations.
   const uint batch = kFused != 0u ? threads / GLINT_FLARE_SPRITES : threads;
+  // This slice's instances: the count in `slices` near-equal contiguous ranges.
+  uint begin = 0u, end = count;
+  if (slices > 1u) {
+    const uint q = count / slices, rem = count % slices;
+    begin = slice * q + min(slice, rem);
+    end = begin + q + (slice < rem ? 1u : 0u);
+  }
 
   vec3 sum[GLINT_FLARE_GATHER_ROWS];  // indexed by unrolled loops only, so it stays in registers
   [[unroll]] for (uint r = 0u; r < kRows; ++r) sum[r] = vec3(0.0);
 
-  for (uint base = 0u; base < count; base += batch) {
+  for (uint base = begin; base < end; base += batch) {
     // 1. Binning: the instance's union rectangle, then each of its sprites, against the tile
     //    (kFused: this invocation's own sprite).
     uint i = base + t;
@@ -122,12 +162,12 @@ void main() {
       if (t < (threads + 31u) / 32u) s_hit[t] = 0u;
       const uint slot = t % GLINT_FLARE_SPRITES;
       i = base + t / GLINT_FLARE_SPRITES;
-      if (t / GLINT_FLARE_SPRITES < batch && i < count) {
+      if (t / GLINT_FLARE_SPRITES < batch && i < end) {
         mine = glint_flare_sprite(instances[i], slot, pc);
         vec4 b = glint_flare_sprite_bounds(mine);
         if (b.x < tile_hi.x && b.z > tile_lo.x && b.y < tile_hi.y && b.w > tile_lo.y) hits = 1u << slot;
       }
-    } else if (i < count) {
+    } else if (i < end) {
       vec4 u = kBeyondStore != 0u && i >= stored ? vec4(tile_lo, tile_hi) : blocks[i * GLINT_FLARE_BLOCK_VEC4S];
       if (u.x < tile_hi.x && u.z > tile_lo.x && u.y < tile_hi.y && u.w > tile_lo.y) {
         [[unroll]] for (uint slot = 0u; slot < GLINT_FLARE_SPRITES; ++slot) {
@@ -229,6 +269,25 @@ void main() {
     barrier();  // the list is consumed before the next batch resets it
   }
 
+  if (slices > 1u) {  // uniform: the tile's plan
+    // This slice's sums to its slot, then count the slice (the image barrier pattern of
+    // hiz_build.comp: the stores are made visible before the atomic that the last workgroup reads).
+    const uint slot_size = threads * kRows;
+    [[unroll]] for (uint r = 0u; r < kRows; ++r) partials[(slot0 + slice) * slot_size + r * threads + t] = vec4(sum[r], 0.0);
+    memoryBarrierBuffer();
+    barrier();
+    if (t == 0u) s_last = atomicAdd(split_words[2u * tiles + tile_index], 1u) == slices - 1u;
+    barrier();
+    if (!s_last) return;  // uniform: a shared value read after a barrier
+    memoryBarrierBuffer();
+    if (t == 0u) split_words[2u * tiles + tile_index] = 0u;  // for the next frame
+    [[unroll]] for (uint r = 0u; r < kRows; ++r) {
+      vec3 total = vec3(0.0);
+      for (uint k = 0u; k < slices; ++k)
+        total += k == slice ? sum[r] : partials[(slot0 + k) * slot_size + r * threads + t].rgb;
+      sum[r] = total;
+    }
+  }
   [[unroll]] for (uint r = 0u; r < kRows; ++r) {
     uvec2 p = uvec2(p0.x, p0.y + r * gl_WorkGroupSize.y);
     if (sum[r] == vec3(0.0) || p.x >= uint(pc.viewport_w) || p.y >= uint(pc.viewport_h)) continue;

@@ -79,8 +79,26 @@
 // Shared lists and the binning scan are sized for at most GLINT_FLARE_GATHER_MAX_THREADS
 // invocations (20 KiB).
 #define GLINT_FLARE_GATHER_ROWS 8u
-#define GLINT_FLARE_GATHER_PRE_PASS_ROWS 2u
 #define GLINT_FLARE_GATHER_MAX_THREADS 256u
+
+// Crowded tiles (the pre-pass gather on GPUs): every light's ghost at t = 1 lands on the image
+// centre, so with many lights a few tiles list a thousand sprites. The sprite pre-pass counts the
+// sprites whose conservative rectangle meets each tile; flare_split_plan.comp gives a tile that
+// counts at least GLINT_FLARE_SPLIT_MIN_SPRITES min(count / GLINT_FLARE_SPLIT_SPRITES,
+// GLINT_FLARE_SPLIT_MAX_SLICES) slices, each a contiguous range of the instances drawn by its own
+// workgroup, whose sums go to a slot of partial sums; the last of a tile's workgroups to finish
+// adds the slots in slice order. A frame whose split tiles would need more than
+// GLINT_FLARE_SPLIT_SLOTS slots splits none.
+#define GLINT_FLARE_SPLIT_MIN_SPRITES 256u
+#define GLINT_FLARE_SPLIT_SPRITES 64u
+#define GLINT_FLARE_SPLIT_MAX_SLICES 16u
+#define GLINT_FLARE_SPLIT_SLOTS 256u
+#define GLINT_FLARE_SPLIT_PLAN_THREADS 256u
+// The split words (a buffer the LensFlare owns), for T tiles: [0, T) the pre-pass's counts (the
+// plan zeroes them), [T, 2T) each tile's plan (slices | first slot << 5; slices 1: not split),
+// [2T, 3T) each split tile's finished slices (the last one zeroes it), [3T, 3T + SLOTS) the slots'
+// (tile << 5 | slice), [3T + SLOTS] the slots used.
+#define GLINT_FLARE_SPLIT_WORDS(tiles) (3u * (tiles) + GLINT_FLARE_SPLIT_SLOTS + 1u)
 
 // The sprite pre-pass (flare_sprites.comp) evaluates every sprite once per frame into a buffer the
 // LensFlare owns, one block of GLINT_FLARE_BLOCK_VEC4S vec4 per instance:
@@ -129,6 +147,20 @@ struct GlintFlareGatherArgsPush {
   GLINT_UINT tiles_y;
   GLINT_UINT capacity;       // instances the bound instance and sprite buffers hold
   GLINT_UINT max_groups_x;   // maxComputeWorkGroupCount[0]: the pre-pass's groups go in rows of it
+};
+
+// Push constants of flare_split_plan.comp (32 bytes). It rewrites the gather's
+// VkDispatchIndirectCommand (words 0..2 of the arguments) with the split tiles' extra workgroups:
+// rows of tiles_x workgroups below the tiles' rows.
+struct GlintFlareSplitPush {
+  GLINT_UINT indirect_word;      // index of instance_count in the bound indirect words
+  GLINT_UINT tiles_x;            // the gather's tiles
+  GLINT_UINT tiles_y;
+  GLINT_UINT capacity;           // instances the bound instance and sprite buffers hold
+  GLINT_UINT min_sprites;        // GLINT_FLARE_SPLIT_MIN_SPRITES (smaller in tests)
+  GLINT_UINT sprites_per_slice;  // GLINT_FLARE_SPLIT_SPRITES
+  GLINT_UINT max_slices;         // GLINT_FLARE_SPLIT_MAX_SLICES (at most 31)
+  GLINT_UINT pad;
 };
 
 // Push constants of flare_atlas.comp (12 bytes).

@@ -15,6 +15,14 @@ layout(local_size_x = GLINT_FLARE_SPRITES_SLOTS, local_size_y = GLINT_FLARE_SPRI
 layout(std430, binding = 0) readonly buffer Instances { GlintFlareInstance instances[]; };
 layout(std430, binding = 1) readonly buffer Indirect { uint indirect_words[]; };  // GlintFlareIndirect
 layout(std430, binding = 2) writeonly buffer Sprites { vec4 blocks[]; };
+// With kCount (the pre-pass gather splits crowded tiles: flare_params.h), each sprite adds 1 to
+// the count of every gather tile (pc.tile_w x pc.tile_h) its conservative rectangle meets, as the
+// gather's binning test does; a sprite meeting more than kCountMaxTiles tiles adds to none (it
+// weighs about the same on every tile it meets, so it makes no tile more crowded than the
+// others). The counts are integers: the same in any order.
+layout(constant_id = 2) const uint kCount = 0u;
+layout(std430, binding = 3) buffer Split { uint split_words[]; };  // [0, tiles): the counts
+const uint kCountMaxTiles = 64u;
 layout(push_constant) uniform Push { GlintFlarePush pc; };
 
 shared vec4 s_bounds[GLINT_FLARE_SPRITES_INSTANCES][GLINT_FLARE_SPRITES_SLOTS];
@@ -32,6 +40,19 @@ void main() {
     blocks[i * GLINT_FLARE_BLOCK_VEC4S + 1u + 2u * slot] = vec4(s.lo, s.size);
     blocks[i * GLINT_FLARE_BLOCK_VEC4S + 2u + 2u * slot] = vec4(s.rgb, s.lod);
     bounds = glint_flare_sprite_bounds(s);
+    if (kCount != 0u && bounds.x <= bounds.z && bounds.y <= bounds.w) {
+      // Tiles i with bounds.x < (i + 1) tile_w and bounds.z > i tile_w, clamped to the image's.
+      const uvec2 tiles = (uvec2(pc.viewport_w, pc.viewport_h) + uvec2(pc.tile_w, pc.tile_h) - 1u) /
+                          uvec2(pc.tile_w, pc.tile_h);
+      const vec2 size = vec2(pc.tile_w, pc.tile_h), hi = vec2(tiles) - 1.0;
+      const uvec2 lo_tile = uvec2(clamp(floor(bounds.xy / size), vec2(0.0), hi));
+      const uvec2 hi_tile = uvec2(clamp(ceil(bounds.zw / size) - 1.0, vec2(0.0), hi));
+      if (all(lessThanEqual(lo_tile, hi_tile)) &&
+          (hi_tile.x - lo_tile.x + 1u) * (hi_tile.y - lo_tile.y + 1u) <= kCountMaxTiles) {
+        for (uint y = lo_tile.y; y <= hi_tile.y; ++y)
+          for (uint x = lo_tile.x; x <= hi_tile.x; ++x) atomicAdd(split_words[y * tiles.x + x], 1u);
+      }
+    }
   }
   s_bounds[gl_LocalInvocationID.y][slot] = bounds;
   barrier();
