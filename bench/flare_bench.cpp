@@ -112,9 +112,10 @@ TileLoad tile_load(const std::vector<reference::FlareSprite>& sprites, uint32_t 
 }
 
 // The draw of `lights` instances (an instances buffer of exactly that many) into a width x height
-// RGBA16F image, the compute path with its dispatches chosen by `path`.
+// RGBA16F image, the compute path with its dispatches chosen by `path`; `split` 0 or 1 makes every
+// pre-pass draw split no tile or the crowded ones (-1: as the device and buffer choose).
 void run_flare_draw(benchmark::State& state, uint32_t width, uint32_t height, uint32_t lights, bool compute, bool mixed,
-                    detail::FlareGatherPath path) {
+                    detail::FlareGatherPath path, int split = -1) {
   const Context& ctx = context();
   const VkFormat format = VK_FORMAT_R16G16B16A16_SFLOAT;
 
@@ -122,6 +123,7 @@ void run_flare_draw(benchmark::State& state, uint32_t width, uint32_t height, ui
   detail::upload(ctx, color.state, random_hdr(width, height, 7));
   LensFlare flare(ctx, format, {width, height});
   detail::LensFlareAccess::select_gather(flare, path);
+  if (split >= 0) detail::LensFlareAccess::set_split(flare, split == 1);
   const FlareConfig config = FlareConfig::preset(FlarePreset::cinematic);
 
   const std::vector<GlintFlareInstance> list = bench_lights(lights, width, height, mixed);
@@ -183,17 +185,24 @@ void run_flare_draw(benchmark::State& state, uint32_t width, uint32_t height, ui
   state.counters["fill_pixels_per_second"] = benchmark::Counter(pixels, benchmark::Counter::kIsIterationInvariantRate);
   // As record_compute() decides: a gather workgroup of fewer than GLINT_FLARE_SPRITES invocations
   // (ContextOptions::workgroup_2d can force one) holds no instance's sprites and takes the pre-pass.
-  const detail::FlareGatherTile one_tile = detail::LensFlareAccess::gather_tile(flare, true);
+  const detail::FlareGatherTile one_tile = detail::LensFlareAccess::gather_tile(flare, true, lights);
   const bool one_dispatch = one_tile.width * one_tile.row_step >= GLINT_FLARE_SPRITES &&
                             (path == detail::FlareGatherPath::one_dispatch ||
                              (path == detail::FlareGatherPath::device && lights <= flare.one_dispatch_instances()));
   if (compute) {
-    const TileLoad load = tile_load(sprites, width, height, detail::LensFlareAccess::gather_tile(flare, one_dispatch));
+    const TileLoad load =
+        tile_load(sprites, width, height, detail::LensFlareAccess::gather_tile(flare, one_dispatch, lights));
     state.counters["tile_sprites_max"] = load.sprites_max;
     state.counters["tile_sprites_mean"] = load.sprites_mean;
     state.counters["invocation_samples_max"] = load.samples_max;
   }
-  state.SetLabel(std::string(compute ? (one_dispatch ? "compute, one dispatch" : "compute, pre-pass") : "raster") +
+  const detail::FlareGatherTile pre_tile = detail::LensFlareAccess::gather_tile(flare, false, lights);
+  const bool splits = detail::LensFlareAccess::gather_tile(flare, false, 0).height != pre_tile.height ||
+                      split == 1;  // (a CPU device's tiles are the same with and without the split)
+  state.SetLabel(std::string(compute ? (one_dispatch ? "compute, one dispatch"
+                                        : splits     ? "compute, pre-pass, crowded tiles split"
+                                                     : "compute, pre-pass")
+                                     : "raster") +
                  (mixed ? " mixed sizes" : "") + " rgba16f on " + ctx.info().name);
 }
 
@@ -227,6 +236,19 @@ void BM_FlareGatherPath(benchmark::State& state) {
 BENCHMARK(BM_FlareGatherPath)
     ->ArgsProduct({{10, 28, 64, 128, 256, 1000}, {1, 2}})
     ->ArgNames({"lights", "path"})
+    ->UseManualTime()
+    ->Unit(benchmark::kMicrosecond);
+
+// The pre-pass draw without and with the split of crowded tiles (1920x1080, mixed sizes), whatever
+// the instances buffer would choose (GLINT_FLARE_SPLIT_FROM_INSTANCES).
+void BM_FlareSplit(benchmark::State& state) {
+  run_flare_draw(state, 1920, 1080, static_cast<uint32_t>(state.range(0)), true, true,
+                 detail::FlareGatherPath::pre_pass, static_cast<int>(state.range(1)));
+}
+
+BENCHMARK(BM_FlareSplit)
+    ->ArgsProduct({{256, 512, 1000}, {0, 1}})
+    ->ArgNames({"lights", "split"})
     ->UseManualTime()
     ->Unit(benchmark::kMicrosecond);
 

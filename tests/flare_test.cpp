@@ -622,23 +622,27 @@ TEST_F(FlareTest, OneDispatchDrawGivesTheBitsOfThePrePass) {
   }
 }
 
-// The pre-pass gather's tile height (rows per invocation: 8 on every device, as in the
-// one-dispatch gather) and the order its workgroups take the tiles in (from the image centre on
-// GPUs, the IDs' order on CPU devices and in the one-dispatch gather) change which workgroup
-// shades a pixel and when, not the list it sums nor its order (without the split of crowded
-// tiles, which groups a split tile's sums by slice: the next test): 500 small lights, whose
-// ghosts at t = 1 all land on the image centre (hundreds of sprites on its pixels, several chunks
-// of the shared list), both formats, give the same bits at 1, 2, 4 and 8 rows (an odd count of
-// tiles at 4 rows on lavapipe, 5 columns on GPUs), in both orders, and match the float64
-// reference.
+// The pre-pass gather's tile height (rows per invocation: 2 on GPUs for buffers of fewer than
+// GLINT_FLARE_SPLIT_FROM_INSTANCES instances, else 8, as in the one-dispatch gather) and the order its workgroups take
+// the tiles in (from the image centre on GPUs, the IDs' order on CPU devices and in the one-dispatch gather) change
+// which workgroup shades a pixel and when, not the list it sums nor its order (without the split of crowded tiles,
+// which groups a split tile's sums by slice: the next test): 500 small lights, whose ghosts at t = 1 all land on the
+// image centre (hundreds of sprites on its pixels, several chunks of the shared list), both formats, give the same bits
+// at 1, 2, 4 and 8 rows (an odd count of tiles at 4 rows on lavapipe, 5 columns on GPUs), in both orders, and match the
+// float64 reference.
 TEST_F(FlareTest, PrePassGatherGivesTheSameBitsAtEveryTileHeight) {
   const DeviceInfo& info = context().info();
   for (VkFormat format : {kF16, kF32}) {
     const std::string fmt = format == kF16 ? "rgba16f" : "rgba32f";
     LensFlare flare(context(), format, {kW, kH});
-    const detail::FlareGatherTile pre = detail::LensFlareAccess::gather_tile(flare, false);
-    const detail::FlareGatherTile one = detail::LensFlareAccess::gather_tile(flare, true);
-    EXPECT_EQ(pre.height, GLINT_FLARE_GATHER_ROWS * pre.row_step) << fmt;
+    const detail::FlareGatherTile pre = detail::LensFlareAccess::gather_tile(flare, false, 500);
+    const detail::FlareGatherTile one = detail::LensFlareAccess::gather_tile(flare, true, 500);
+    const detail::FlareGatherTile split =
+        detail::LensFlareAccess::gather_tile(flare, false, GLINT_FLARE_SPLIT_FROM_INSTANCES);
+    const bool cpu = info.type == VK_PHYSICAL_DEVICE_TYPE_CPU;
+    EXPECT_EQ(pre.height, (cpu ? GLINT_FLARE_GATHER_ROWS : GLINT_FLARE_GATHER_PRE_PASS_ROWS) * pre.row_step) << fmt;
+    EXPECT_EQ(split.height, GLINT_FLARE_GATHER_ROWS * split.row_step) << fmt;
+    EXPECT_EQ(split.centre_first, !cpu) << fmt;
     EXPECT_EQ(one.height, GLINT_FLARE_GATHER_ROWS * one.row_step) << fmt;
     EXPECT_EQ(pre.centre_first, info.type != VK_PHYSICAL_DEVICE_TYPE_CPU) << fmt;
     EXPECT_FALSE(one.centre_first) << fmt;
@@ -708,7 +712,7 @@ TEST_F(FlareTest, CrowdedTilesSplitIntoSlicesMatchTheReference) {
     const CpuImage unsplit = draw(flare, Path::compute, background, format, in, config);
 
     detail::LensFlareAccess::set_split(flare, true, 200, 16, 8);
-    const detail::FlareGatherTile tile = detail::LensFlareAccess::gather_tile(flare, false);
+    const detail::FlareGatherTile tile = detail::LensFlareAccess::gather_tile(flare, false, lights.size());
     const size_t tiles = size_t((kW + tile.width - 1) / tile.width) * ((kH + tile.height - 1) / tile.height);
     const size_t used_word = 3 * tiles + GLINT_FLARE_SPLIT_SLOTS;
     const CpuImage a = draw(flare, Path::compute, background, format, in, config);
@@ -788,7 +792,7 @@ TEST_F(FlareTest, ComputeDrawsInstancesBeyondItsSpriteStore) {
   // The gather beyond the store at another tile height (made again when the rows change): the
   // same bits. 4 rows where the device takes 8 (CPU devices: half as many tiles again to bin the
   // 441 k instances in, where 2 rows would triple them), else 8.
-  const detail::FlareGatherTile tile = detail::LensFlareAccess::gather_tile(flare, false);
+  const detail::FlareGatherTile tile = detail::LensFlareAccess::gather_tile(flare, false, n);
   const uint32_t other = tile.height / tile.row_step == GLINT_FLARE_GATHER_ROWS ? 4u : GLINT_FLARE_GATHER_ROWS;
   detail::LensFlareAccess::set_pre_pass_tiles(flare, other, true);
   const CpuImage e = draw(flare, Path::compute, background, kF32, big, config);

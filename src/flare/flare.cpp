@@ -201,12 +201,14 @@ LensFlare::LensFlare(const Context& context, VkFormat color_format, VkExtent2D e
   if (m.workgroup.x * m.workgroup.y > GLINT_FLARE_GATHER_MAX_THREADS) m.workgroup = {16, 16};
   m.one_dispatch_limit = cpu ? 0 : m.one_dispatch_batch();
   // The tiles of each gather, as measured (docs/FLARE.md, "Speed"; flare_params.h): on GPUs the
-  // pre-pass gather splits crowded tiles and starts from the image centre, where every light's
-  // ghost at t = 1 piles up; the one-dispatch gather and CPU devices take the tiles in the
-  // workgroup IDs' order and split none, which was faster there.
+  // pre-pass gather starts from the image centre, where every light's ghost at t = 1 piles up, in
+  // tiles 4 times shorter, or, for instances buffers of GLINT_FLARE_SPLIT_FROM_INSTANCES and more,
+  // in full tiles with the crowded ones split; the one-dispatch gather and CPU devices take full
+  // tiles in the workgroup IDs' order and split none, which was faster there.
   m.tiles_one_dispatch = m.gather_tiles(GLINT_FLARE_GATHER_ROWS, false);
-  m.tiles_pre_pass = m.gather_tiles(GLINT_FLARE_GATHER_ROWS, !cpu);
-  m.split = !cpu;
+  m.tiles_pre_pass = m.gather_tiles(cpu ? GLINT_FLARE_GATHER_ROWS : GLINT_FLARE_GATHER_PRE_PASS_ROWS, !cpu);
+  m.tiles_split = m.gather_tiles(GLINT_FLARE_GATHER_ROWS, !cpu);
+  m.split_from = cpu ? UINT32_MAX : GLINT_FLARE_SPLIT_FROM_INSTANCES;
   m.split_params = {0, 0, 0, 0, GLINT_FLARE_SPLIT_MIN_SPRITES, GLINT_FLARE_SPLIT_SPRITES, GLINT_FLARE_SPLIT_MAX_SLICES,
                     0};
   m.make_atlas();

@@ -7,16 +7,15 @@ namespace glint {
 using namespace flare_detail;
 using detail::concat;
 
-detail::ComputePipeline LensFlare::Impl::make_gather(uint32_t beyond_store, uint32_t one_dispatch) const {
+detail::ComputePipeline LensFlare::Impl::make_gather(uint32_t beyond_store, uint32_t one_dispatch, bool split) const {
   const auto SB = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
   detail::PipelineDesc d;
   d.kernel_id = std::string("flare_gather_") + detail::format_variant(format);
   d.bindings = {SB, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, SB, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, SB, SB, SB};
   d.push_constant_bytes = sizeof(GlintFlarePush);
   d.workgroup = workgroup;
-  const GatherTiles& tiles = one_dispatch ? tiles_one_dispatch : tiles_pre_pass;
-  d.specialization = {beyond_store, one_dispatch, tiles.rows, tiles.centre_first ? 1u : 0u,
-                      split && !one_dispatch ? 1u : 0u};
+  const GatherTiles& tiles = one_dispatch ? tiles_one_dispatch : split ? tiles_split : tiles_pre_pass;
+  d.specialization = {beyond_store, one_dispatch, tiles.rows, tiles.centre_first ? 1u : 0u, split ? 1u : 0u};
   return detail::ComputePipeline(*context, d);
 }
 
@@ -24,13 +23,13 @@ void LensFlare::Impl::make_split_buffers() {
   // (TRANSFER_SRC: tests read the plan back.)
   const VkBufferUsageFlags usage =
       VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT;
-  const VkDeviceSize words = GLINT_FLARE_SPLIT_WORDS(tiles_pre_pass.x * tiles_pre_pass.y);
+  const VkDeviceSize words = GLINT_FLARE_SPLIT_WORDS(tiles_split.x * tiles_split.y);
   split_buffer = detail::OwnedBuffer(*context, words * 4, usage, false);
   split_state = Buffer{split_buffer.buffer(), 0, words * 4, usage, VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE};
   split_cleared = false;
   // A slot holds one slice's sums: one vec4 per pixel of a tile.
   const VkDeviceSize partial_bytes =
-      split ? VkDeviceSize(GLINT_FLARE_SPLIT_SLOTS) * workgroup.x * workgroup.y * tiles_pre_pass.rows * 16 : 16;
+      split() ? VkDeviceSize(GLINT_FLARE_SPLIT_SLOTS) * workgroup.x * workgroup.y * tiles_split.rows * 16 : 16;
   partials_buffer = detail::OwnedBuffer(*context, partial_bytes, usage, false);
   partials_state =
       Buffer{partials_buffer.buffer(), 0, partial_bytes, usage, VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE};
@@ -52,9 +51,12 @@ void LensFlare::Impl::make_compute_pipelines() {
   sp.bindings = {SB, SB, SB, SB};
   sp.push_constant_bytes = sizeof(GlintFlarePush);
   sp.workgroup = {GLINT_FLARE_SPRITES_SLOTS, GLINT_FLARE_SPRITES_INSTANCES};
-  sp.specialization = {split ? 1u : 0u};
+  sp.specialization = {0u};
   sprites = detail::ComputePipeline(*context, sp);
-  if (split && !split_plan) {
+  if (split()) {  // the split's pipelines (the one beyond the sprite store at its first use)
+    sp.specialization = {1u};
+    sprites_count = detail::ComputePipeline(*context, sp);
+    gather_split = make_gather(0, 0, true);
     detail::PipelineDesc sd;
     sd.kernel_id = "flare_split_plan_main";
     sd.bindings = {SB, SB, SB};
@@ -157,10 +159,14 @@ void LensFlare::record_compute(VkCommandBuffer cmd, Image& color, Buffer& instan
   Buffer& store = sprite_store.state;
   // The instances buffer holds more than the store: the gather evaluates the rest itself.
   const bool beyond = instances.size / sizeof(GlintFlareInstance) > sprite_store.capacity;
-  if (beyond && !m.gather_beyond) m.gather_beyond = m.make_gather(1, 0);
+  // Crowded tiles split (in full tiles) for buffers of split_from instances and more.
+  const bool split = instances.size / sizeof(GlintFlareInstance) >= m.split_from;
+  const Impl::GatherTiles& tiles = split ? m.tiles_split : m.tiles_pre_pass;
+  detail::ComputePipeline& beyond_gather = split ? m.gather_beyond_split : m.gather_beyond;
+  if (beyond && !beyond_gather) beyond_gather = m.make_gather(1, 0, split);
 
-  GlintFlareGatherArgsPush ap{p.indirect_word, m.tiles_pre_pass.x, m.tiles_pre_pass.y,
-                              std::min(capacity, sprite_store.capacity), m.max_groups_x};
+  GlintFlareGatherArgsPush ap{p.indirect_word, tiles.x, tiles.y, std::min(capacity, sprite_store.capacity),
+                              m.max_groups_x};
   // 1. The launch arguments: every tile when any instance is visible, none otherwise; the
   //    pre-pass's groups for the instances.
   b.use(indirect, kCompute, VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
@@ -168,7 +174,7 @@ void LensFlare::record_compute(VkCommandBuffer cmd, Image& color, Buffer& instan
   b.flush(cmd);
   m.gather_args.dispatch(cmd, {indirect_words, m.gather_args_state}, ap, 1, 1);
   if (profiler) profiler->mark(cmd, "flare arguments");
-  if (!m.split_cleared) {  // once per split buffer: the kernels zero what they used after each frame
+  if (split && !m.split_cleared) {  // once per split buffer: the kernels zero what they used after each frame
     b.use(m.split_state, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);  // fill = "transfer"
     b.flush(cmd);
     vkCmdFillBuffer(cmd, m.split_state.buffer, 0, VK_WHOLE_SIZE, 0);
@@ -176,22 +182,22 @@ void LensFlare::record_compute(VkCommandBuffer cmd, Image& color, Buffer& instan
   }
   // 2. The sprite pre-pass: every sprite of every instance, once (with the split, each tile's
   //    count of sprites too).
-  p.tile_h = m.workgroup.y * m.tiles_pre_pass.rows;
+  p.tile_h = m.workgroup.y * tiles.rows;
   b.use(m.gather_args_state, kIndirect, VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT);
   b.use(instances, kCompute, VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
   b.use(store, kCompute, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
   b.use(m.split_state, kCompute, kStorageRW);
   b.flush(cmd);
-  m.sprites.dispatch_indirect(cmd, {instances, indirect_words, store, m.split_state}, p, m.gather_args_buffer.buffer(),
-                              16);
+  (split ? m.sprites_count : m.sprites)
+      .dispatch_indirect(cmd, {instances, indirect_words, store, m.split_state}, p, m.gather_args_buffer.buffer(), 16);
   if (profiler) profiler->mark(cmd, "flare sprites");
-  if (m.split) {
+  if (split) {
     // 2b. The split plan: each tile's slices, the slots, and the gather's launch with the slots'
     //     workgroups (rewriting the gather's arguments).
     GlintFlareSplitPush sp = m.split_params;
     sp.indirect_word = p.indirect_word;
-    sp.tiles_x = m.tiles_pre_pass.x;
-    sp.tiles_y = m.tiles_pre_pass.y;
+    sp.tiles_x = tiles.x;
+    sp.tiles_y = tiles.y;
     sp.capacity = ap.capacity;
     b.use(m.split_state, kCompute, kStorageRW);
     b.use(m.gather_args_state, kCompute, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
@@ -209,7 +215,9 @@ void LensFlare::record_compute(VkCommandBuffer cmd, Image& color, Buffer& instan
   b.use(m.split_state, kCompute, kStorageRW);
   b.use(m.partials_state, kCompute, kStorageRW);
   b.flush(cmd);
-  (beyond ? m.gather_beyond : m.gather)
+  (beyond  ? beyond_gather
+   : split ? m.gather_split
+           : m.gather)
       .dispatch_indirect(cmd,
                          {instances,
                           m.atlas_binding(),
@@ -226,9 +234,11 @@ namespace detail {
 
 void LensFlareAccess::select_gather(LensFlare& flare, FlareGatherPath path) { flare.impl_->gather_path = path; }
 
-FlareGatherTile LensFlareAccess::gather_tile(const LensFlare& flare, bool one_dispatch) {
+FlareGatherTile LensFlareAccess::gather_tile(const LensFlare& flare, bool one_dispatch, uint64_t instances) {
   const LensFlare::Impl& m = *flare.impl_;
-  const LensFlare::Impl::GatherTiles& t = one_dispatch ? m.tiles_one_dispatch : m.tiles_pre_pass;
+  const LensFlare::Impl::GatherTiles& t = one_dispatch                ? m.tiles_one_dispatch
+                                          : instances >= m.split_from ? m.tiles_split
+                                                                      : m.tiles_pre_pass;
   return {m.workgroup.x, m.workgroup.y * t.rows, m.workgroup.y, t.centre_first};
 }
 
@@ -238,9 +248,11 @@ void LensFlareAccess::set_pre_pass_tiles(LensFlare& flare, uint32_t rows, bool c
                                                     "; accepted 1 to ", GLINT_FLARE_GATHER_ROWS));
   }
   LensFlare::Impl& m = *flare.impl_;
-  m.tiles_pre_pass = m.gather_tiles(rows, centre_first);
+  m.tiles_pre_pass = m.tiles_split = m.gather_tiles(rows, centre_first);
   m.gather = m.make_gather(0, 0);
-  m.gather_beyond = {};  // made again at its next use, with these tiles
+  if (m.split()) m.gather_split = m.make_gather(0, 0, true);
+  m.gather_beyond = {};  // both made again at their next use, with these tiles
+  m.gather_beyond_split = {};
   m.make_split_buffers();
 }
 
@@ -252,12 +264,15 @@ void LensFlareAccess::set_split(LensFlare& flare, bool on, uint32_t min_sprites,
                        max_slices, "; accepted at least 1, and 1 to 31"));
   }
   LensFlare::Impl& m = *flare.impl_;
-  m.split = on;
+  const bool made = m.split();
+  m.split_from = on ? 0 : UINT32_MAX;
   m.split_params.min_sprites = min_sprites;
   m.split_params.sprites_per_slice = sprites_per_slice;
   m.split_params.max_slices = max_slices;
-  m.make_compute_pipelines();
-  m.gather_beyond = {};
+  if (on && !made) {  // the split's pipelines and slots (a CPU device)
+    m.make_compute_pipelines();
+    m.gather_beyond = {};
+  }
 }
 
 Buffer LensFlareAccess::split_words(const LensFlare& flare) { return flare.impl_->split_state; }

@@ -54,17 +54,21 @@ struct LensFlare::Impl {
     uint32_t rows = GLINT_FLARE_GATHER_ROWS, x = 0, y = 0;
     bool centre_first = false;
   };
-  GatherTiles tiles_one_dispatch, tiles_pre_pass;
-  // The split of crowded tiles in the pre-pass gather (flare_params.h, "Crowded tiles"; on GPUs):
-  // the plan's parameters, the split words (counts, plans, finished slices, slots) for
-  // tiles_pre_pass, zeroed once at their first use (the kernels zero what they used after each
-  // frame), and the slots of partial sums (16 bytes when the split is off).
-  bool split = false;
+  // tiles_split: the pre-pass gather's when it splits crowded tiles.
+  GatherTiles tiles_one_dispatch, tiles_pre_pass, tiles_split;
+  // The split of crowded tiles in the pre-pass gather (flare_params.h, "Crowded tiles"): taken for
+  // instances buffers of at least split_from instances (GLINT_FLARE_SPLIT_FROM_INSTANCES on GPUs;
+  // never on CPU devices: UINT32_MAX). The plan's parameters, the split words (counts, plans,
+  // finished slices, slots) for tiles_split, zeroed once at their first use (the kernels zero what
+  // they used after each frame), and the slots of partial sums (16 bytes without the split).
+  uint32_t split_from = UINT32_MAX;
+  bool split() const { return split_from != UINT32_MAX; }
   GlintFlareSplitPush split_params{};
   detail::OwnedBuffer split_buffer, partials_buffer;
   Buffer split_state, partials_state;
   bool split_cleared = false;
-  detail::ComputePipeline split_plan;
+  detail::ComputePipeline split_plan, sprites_count;          // sprites_count: the pre-pass that counts tiles' sprites
+  detail::ComputePipeline gather_split, gather_beyond_split;  // kSplit (the second made at its first use)
 
   // Atlas: one image with every level, a view of all levels (sampling) and one per level (storage).
   detail::OwnedImage atlas_image;      // state tracks all levels together
@@ -117,8 +121,8 @@ struct LensFlare::Impl {
   void make_atlas();
   void make_raster_pipeline();
   void make_compute_pipelines();
-  void make_split_buffers();  // for tiles_pre_pass and `split`
-  detail::ComputePipeline make_gather(uint32_t beyond_store, uint32_t one_dispatch) const;
+  void make_split_buffers();  // for tiles_split, when split()
+  detail::ComputePipeline make_gather(uint32_t beyond_store, uint32_t one_dispatch, bool split = false) const;
   GatherTiles gather_tiles(uint32_t rows, bool centre_first) const;
   // Instances per batch of the one-dispatch gather (one invocation per sprite).
   uint32_t one_dispatch_batch() const { return workgroup.x * workgroup.y / GLINT_FLARE_SPRITES; }

@@ -33,15 +33,19 @@ struct FlareGatherTile {
 struct LensFlareAccess {
   /// Selects the path `flare` records from now on.
   static void select_gather(LensFlare& flare, FlareGatherPath path);
-  /// The tile of the one-dispatch or of the pre-pass gather (workgroup x by workgroup y * rows).
-  static FlareGatherTile gather_tile(const LensFlare& flare, bool one_dispatch);
-  /// Makes the pre-pass gather (and the one beyond the sprite store) shade `rows` pixels per
+  /// The tile of the one-dispatch gather, or of the pre-pass gather for an instances buffer of
+  /// `instances` instances (workgroup x by workgroup y * rows; full tiles with the split of crowded
+  /// tiles from GLINT_FLARE_SPLIT_FROM_INSTANCES on GPUs).
+  static FlareGatherTile gather_tile(const LensFlare& flare, bool one_dispatch, uint64_t instances);
+  /// Makes the pre-pass gathers, with and without the split (and those beyond the sprite store),
+  /// shade `rows` pixels per
   /// invocation from now on, 1 to GLINT_FLARE_GATHER_ROWS, its workgroups taking the tiles from
   /// the image centre outwards or in their IDs' order (tests: every tile height and order gives
   /// the same bits).
   static void set_pre_pass_tiles(LensFlare& flare, uint32_t rows, bool centre_first);
-  /// Turns the split of crowded tiles in the pre-pass gather on or off (on by default on GPUs,
-  /// off on CPU devices); a tile counting at least `min_sprites` sprites gets
+  /// Makes every pre-pass draw split crowded tiles, or none (by default GPUs split them for
+  /// instances buffers of GLINT_FLARE_SPLIT_FROM_INSTANCES and more, CPU devices never); a tile
+  /// counting at least `min_sprites` sprites gets
   /// min(count / sprites_per_slice, max_slices) slices (flare_params.h, "Crowded tiles"; tests
   /// split every tile with small values). max_slices is 1 to 31.
   static void set_split(LensFlare& flare, bool on, uint32_t min_sprites = GLINT_FLARE_SPLIT_MIN_SPRITES,

@@ -72,16 +72,21 @@
 // One workgroup per screen tile; each invocation shades `rows` pixels of one column (rows a
 // workgroup height apart; specialization constant 4), so a 32x8 workgroup with 8 rows gathers a
 // 32x64 tile (1020 tiles at 1080p). Larger tiles bin each instance against fewer tiles; the rows
-// share one binning and one sprite setup per tile. The one-dispatch gather (few instances) and CPU
-// devices take GLINT_FLARE_GATHER_ROWS; the pre-pass gather on GPUs GLINT_FLARE_GATHER_PRE_PASS_ROWS,
-// so that the sprites piled on one spot (every light's ghost at t = 1 lands on the image centre)
-// are shaded by four times as many workgroups (docs/FLARE.md, "Speed").
+// share one binning and one sprite setup per tile. The one-dispatch gather (few instances), CPU
+// devices and the split gather take GLINT_FLARE_GATHER_ROWS; the pre-pass gather without the
+// split on GPUs GLINT_FLARE_GATHER_PRE_PASS_ROWS, so that the sprites piled on one spot (every
+// light's ghost at t = 1 lands on the image centre) are shaded by four times as many workgroups
+// (docs/FLARE.md, "Speed").
 // Shared lists and the binning scan are sized for at most GLINT_FLARE_GATHER_MAX_THREADS
 // invocations (20 KiB).
 #define GLINT_FLARE_GATHER_ROWS 8u
+#define GLINT_FLARE_GATHER_PRE_PASS_ROWS 2u
 #define GLINT_FLARE_GATHER_MAX_THREADS 256u
 
-// Crowded tiles (the pre-pass gather on GPUs): every light's ghost at t = 1 lands on the image
+// Crowded tiles (the pre-pass gather on GPUs for instances buffers of at least
+// GLINT_FLARE_SPLIT_FROM_INSTANCES instances, in tiles of GLINT_FLARE_GATHER_ROWS rows; smaller
+// buffers take GLINT_FLARE_GATHER_PRE_PASS_ROWS rows and no split, which measured faster for up to
+// 256 lights: docs/FLARE.md, "Speed"): every light's ghost at t = 1 lands on the image
 // centre, so with many lights a few tiles list a thousand sprites. The sprite pre-pass counts the
 // sprites whose conservative rectangle meets each tile; flare_split_plan.comp gives a tile that
 // counts at least GLINT_FLARE_SPLIT_MIN_SPRITES min(count / GLINT_FLARE_SPLIT_SPRITES,
@@ -89,6 +94,7 @@
 // workgroup, whose sums go to a slot of partial sums; the last of a tile's workgroups to finish
 // adds the slots in slice order. A frame whose split tiles would need more than
 // GLINT_FLARE_SPLIT_SLOTS slots splits none.
+#define GLINT_FLARE_SPLIT_FROM_INSTANCES 512u
 #define GLINT_FLARE_SPLIT_MIN_SPRITES 256u
 #define GLINT_FLARE_SPLIT_SPRITES 64u
 #define GLINT_FLARE_SPLIT_MAX_SLICES 16u
