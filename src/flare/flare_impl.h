@@ -47,9 +47,10 @@ struct LensFlare::Impl {
   uint32_t max_groups_x = 65535;         // maxComputeWorkGroupCount[0]
   VkDeviceSize storage_alignment = 256;  // minStorageBufferOffsetAlignment
   detail::Workgroup2D workgroup;         // the gather's workgroup
-  // The gather's tiles, workgroup x by workgroup y * rows pixels (GLINT_FLARE_GATHER_ROWS unless a
-  // test sets the pre-pass gather's). centre_first: the workgroups take the tiles from the image
-  // centre outwards (specialization constant 5; the pre-pass gather on GPUs).
+  // The gather's tiles, workgroup x by workgroup y * rows pixels (GLINT_FLARE_GATHER_ROWS, except
+  // the pre-pass gather's without the split on GPUs: GLINT_FLARE_GATHER_PRE_PASS_ROWS; tests may
+  // set others). centre_first: the workgroups take the tiles from the image centre outwards
+  // (specialization constant 5; the pre-pass gathers on GPUs).
   struct GatherTiles {
     uint32_t rows = GLINT_FLARE_GATHER_ROWS, x = 0, y = 0;
     bool centre_first = false;

@@ -38,21 +38,21 @@ struct LensFlareAccess {
   /// tiles from GLINT_FLARE_SPLIT_FROM_INSTANCES on GPUs).
   static FlareGatherTile gather_tile(const LensFlare& flare, bool one_dispatch, uint64_t instances);
   /// Makes the pre-pass gathers, with and without the split (and those beyond the sprite store),
-  /// shade `rows` pixels per
-  /// invocation from now on, 1 to GLINT_FLARE_GATHER_ROWS, its workgroups taking the tiles from
-  /// the image centre outwards or in their IDs' order (tests: every tile height and order gives
-  /// the same bits).
+  /// shade `rows` pixels per invocation from now on, 1 to GLINT_FLARE_GATHER_ROWS, their
+  /// workgroups taking the tiles from the image centre outwards or in their IDs' order (tests:
+  /// every tile height and order gives the same bits). Remakes pipelines and buffers: call it only
+  /// while no command buffer recorded with `flare` is pending.
   static void set_pre_pass_tiles(LensFlare& flare, uint32_t rows, bool centre_first);
   /// Makes every pre-pass draw split crowded tiles, or none (by default GPUs split them for
   /// instances buffers of GLINT_FLARE_SPLIT_FROM_INSTANCES and more, CPU devices never); a tile
-  /// counting at least `min_sprites` sprites gets
-  /// min(count / sprites_per_slice, max_slices) slices (flare_params.h, "Crowded tiles"; tests
-  /// split every tile with small values). max_slices is 1 to 31.
+  /// counting at least `min_sprites` sprites gets min(count / sprites_per_slice, max_slices)
+  /// slices (flare_params.h, "Crowded tiles"; tests split many tiles with small values).
+  /// max_slices is 1 to 31. May remake pipelines and buffers, as set_pre_pass_tiles().
   static void set_split(LensFlare& flare, bool on, uint32_t min_sprites = GLINT_FLARE_SPLIT_MIN_SPRITES,
                         uint32_t sprites_per_slice = GLINT_FLARE_SPLIT_SPRITES,
                         uint32_t max_slices = GLINT_FLARE_SPLIT_MAX_SLICES);
-  /// The split words (layout in flare_params.h) the last pre-pass draw planned with, and the
-  /// gather tiles they are for (tests read how many tiles were split).
+  /// The split words (layout in flare_params.h, for the tiles gather_tile() gives for a split
+  /// draw) as the last split pre-pass draw left them (tests read the plan back).
   static Buffer split_words(const LensFlare& flare);
 };
 

@@ -3,7 +3,8 @@
 #extension GL_EXT_control_flow_attributes : require
 // Lens flares for compute-only engines (docs/FLARE.md, "The two paths": compute), accumulated by gathering: one
 // workgroup per screen tile of workgroup x by (workgroup y * kRows) pixels (each invocation keeps
-// its column's kRows pixels in registers), no atomics on the image or on any global buffer. The sprites
+// its column's kRows pixels in registers), no atomics on the image (with kSplit, one counter per
+// split tile counts its finished slices). The sprites
 // were evaluated once for the frame by flare_sprites.comp (layout in flare_params.h), or, for few
 // instances (kFused), by the gather's own invocations, one sprite each: the whole draw is then
 // this one dispatch.
@@ -26,7 +27,8 @@
 // Finally a pixel that received light is read, gains the sum and is written once (alpha kept);
 // pixels that received none are not touched (bit-identical).
 // With kSplit (the pre-pass gather on GPUs), flare_split_plan.comp has given each tile slices: a
-// tile of one slice is drawn as above; a crowded one by one workgroup per slice, each drawing a
+// tile of one slice is drawn as above; a crowded one by one workgroup per slice (the slots'
+// workgroups come first in the launch, then the tiles'), each drawing a
 // contiguous range of the instances into a slot of partial sums, and the last of them to finish
 // adds the slots in slice order (p0 + p1 + ...: the same order on every run) and writes the
 // pixels. Its sums are then grouped by slice, so a split tile's bits differ from an unsplit one's
@@ -91,8 +93,8 @@ GlintFlareSprite gather_sprite(uint i, uint slot, uint stored) {
 // pre-pass gather on GPUs; the one-dispatch gather (10 lights: 34.9 us against 36.6 centre first)
 // and lavapipe were faster in the IDs' order (docs/FLARE.md, "Speed").
 layout(constant_id = 5) const uint kCentreFirst = 0u;
-// 1: tiles are split as flare_split_plan.comp planned (the launch has the slots' workgroups below
-// the tiles' rows); 0: every tile is one slice (bindings 5 and 6 are not read).
+// 1: tiles are split as flare_split_plan.comp planned (the launch has rows of the slots'
+// workgroups before the tiles' rows); 0: every tile is one slice (bindings 5 and 6 are not read).
 layout(constant_id = 6) const uint kSplit = 0u;
 layout(std430, binding = 5) coherent buffer Split { uint split_words[]; };  // layout in flare_params.h
 layout(std430, binding = 6) coherent buffer Partials { vec4 partials[]; };  // GLINT_FLARE_SPLIT_SLOTS slots
@@ -108,17 +110,21 @@ void main() {
   const uint tiles = tiles_x * tiles_y;
   uvec2 tile_id;
   uint slice = 0u;  // which of its tile's slices this workgroup draws
-  if (kSplit != 0u && gl_WorkGroupID.y >= tiles_y) {
+  // With kSplit the launch's first rows are the slots' workgroups, so that the slices of the
+  // crowded tiles start first; the tiles' workgroups follow.
+  const uint slots_used = kSplit != 0u ? split_words[3u * tiles + GLINT_FLARE_SPLIT_SLOTS] : 0u;
+  const uint slot_rows = (slots_used + tiles_x - 1u) / tiles_x;
+  if (gl_WorkGroupID.y < slot_rows) {  // (only with kSplit)
     // A slot's workgroup: it draws the slot's slice unless that is its tile's first.
-    const uint h = (gl_WorkGroupID.y - tiles_y) * tiles_x + gl_WorkGroupID.x;
-    if (h >= split_words[3u * tiles + GLINT_FLARE_SPLIT_SLOTS]) return;  // uniform
+    const uint h = gl_WorkGroupID.y * tiles_x + gl_WorkGroupID.x;
+    if (h >= slots_used) return;  // uniform
     const uint e = split_words[3u * tiles + h];
     slice = e & 31u;
     if (slice == 0u) return;
     tile_id = uvec2((e >> 5u) % tiles_x, (e >> 5u) / tiles_x);
   } else {
-    tile_id = kCentreFirst == 0u ? gl_WorkGroupID.xy
-                                 : uvec2(centre_out(gl_WorkGroupID.x, tiles_x), centre_out(gl_WorkGroupID.y, tiles_y));
+    const uvec2 id = uvec2(gl_WorkGroupID.x, gl_WorkGroupID.y - slot_rows);
+    tile_id = kCentreFirst == 0u ? id : uvec2(centre_out(id.x, tiles_x), centre_out(id.y, tiles_y));
   }
   const uint tile_index = tile_id.y * tiles_x + tile_id.x;
   uint slices = 1u, slot0 = 0u;
@@ -280,7 +286,8 @@ void main() {
     barrier();
     if (!s_last) return;  // uniform: a shared value read after a barrier
     memoryBarrierBuffer();
-    if (t == 0u) split_words[2u * tiles + tile_index] = 0u;  // for the next frame
+    // (The counter is zeroed by the next frame's plan, not here: a counter left wrong, by a frame
+    // that did not finish, cannot outlive one frame.)
     [[unroll]] for (uint r = 0u; r < kRows; ++r) {
       vec3 total = vec3(0.0);
       for (uint k = 0u; k < slices; ++k)

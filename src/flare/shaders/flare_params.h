@@ -157,7 +157,7 @@ struct GlintFlareGatherArgsPush {
 
 // Push constants of flare_split_plan.comp (32 bytes). It rewrites the gather's
 // VkDispatchIndirectCommand (words 0..2 of the arguments) with the split tiles' extra workgroups:
-// rows of tiles_x workgroups below the tiles' rows.
+// rows of tiles_x workgroups before the tiles' rows.
 struct GlintFlareSplitPush {
   GLINT_UINT indirect_word;      // index of instance_count in the bound indirect words
   GLINT_UINT tiles_x;            // the gather's tiles

@@ -3,9 +3,11 @@
 // The split of crowded tiles (flare_params.h, "Crowded tiles"; docs/FLARE.md, "Speed"): one
 // workgroup reads the sprite pre-pass's count of every tile, gives each tile its slices and the
 // split tiles their slots of partial sums in tile order (an exclusive prefix sum, so the plan is
-// the same on every run), zeroes the counts for the next frame and writes the gather's launch:
-// every tile, then rows of tiles_x workgroups for the slots (a slot's workgroup draws its slice
-// when the slice is not the tile's first, which the tile's own workgroup draws).
+// the same on every run), zeroes the counts and every tile's count of finished slices (which the
+// gather's last slice reads) for this frame and the next, and writes the gather's launch:
+// rows of tiles_x workgroups for the slots, then every tile (a slot's workgroup draws its slice
+// when the slice is not the tile's first, which the tile's own workgroup draws; the slots come
+// first so that the crowded tiles' slices start first).
 #include "flare_params.h"
 
 layout(local_size_x = GLINT_FLARE_SPLIT_PLAN_THREADS) in;
@@ -22,38 +24,69 @@ uint slices_of(uint sprites) {
   return sprites >= pc.min_sprites ? clamp(sprites / pc.sprites_per_slice, 1u, pc.max_slices) : 1u;
 }
 
+// The slices of tile i when every tile keeps 1 / scale of its own (rounded down); a tile left with
+// fewer than 2 is not split.
+uint slices_scaled(uint i, uint scale) {
+  const uint s = slices_of(split_words[i]) / scale;
+  return s > 1u ? s : 1u;
+}
+
+// The slots of the run of tiles [first, last) (a split tile takes one per slice).
+uint run_slots(uint first, uint last, uint scale) {
+  uint slots = 0u;
+  for (uint i = first; i < last; ++i) {
+    const uint s = slices_scaled(i, scale);
+    if (s > 1u) slots += s;
+  }
+  return slots;
+}
+
+// Inclusive scan of one value per invocation (Hillis & Steele 1986); `total` gets the sum of all.
+uint scan(uint v, out uint total) {
+  const uint t = gl_LocalInvocationIndex;
+  s_scan[0][t] = v;
+  barrier();
+  uint src = 0u;
+  for (uint d = 1u; d < kThreads; d <<= 1u) {
+    uint w = s_scan[src][t];
+    if (t >= d) w += s_scan[src][t - d];
+    s_scan[src ^ 1u][t] = w;
+    barrier();
+    src ^= 1u;
+  }
+  total = s_scan[src][kThreads - 1u];
+  const uint inclusive = s_scan[src][t];
+  barrier();  // read before a next scan writes
+  return inclusive;
+}
+
 void main() {
   const uint t = gl_LocalInvocationIndex;
   const uint tiles = pc.tiles_x * pc.tiles_y;
   // Invocation t plans a run of consecutive tiles.
   const uint per = (tiles + kThreads - 1u) / kThreads;
   const uint first = min(tiles, t * per), last = min(tiles, first + per);
-  uint slots = 0u;  // slots of this run's split tiles (a split tile takes one per slice)
-  for (uint i = first; i < last; ++i) {
-    const uint s = slices_of(split_words[i]);
-    if (s > 1u) slots += s;
+  uint slots = run_slots(first, last, 1u);
+  uint total;
+  uint inclusive = scan(slots, total);
+  // More slots than there are: every tile keeps 1 / scale of its slices, scale = ceil(total /
+  // GLINT_FLARE_SPLIT_SLOTS), so that the slots add up to at most total / scale (each tile's
+  // floor(s / scale) <= s / scale). One scale for all tiles: the plan stays a function of the counts.
+  uint scale = 1u;
+  if (total > GLINT_FLARE_SPLIT_SLOTS) {  // uniform
+    scale = (total + GLINT_FLARE_SPLIT_SLOTS - 1u) / GLINT_FLARE_SPLIT_SLOTS;
+    slots = run_slots(first, last, scale);
+    inclusive = scan(slots, total);
   }
-  // Inclusive scan of the runs' slots (Hillis & Steele 1986).
-  s_scan[0][t] = slots;
-  barrier();
-  uint src = 0u;
-  for (uint d = 1u; d < kThreads; d <<= 1u) {
-    uint v = s_scan[src][t];
-    if (t >= d) v += s_scan[src][t - d];
-    s_scan[src ^ 1u][t] = v;
-    barrier();
-    src ^= 1u;
-  }
-  const uint total = s_scan[src][kThreads - 1u];
-  const bool split = total <= GLINT_FLARE_SPLIT_SLOTS;  // else no tile is split this frame
-  uint slot = s_scan[src][t] - slots;
+  const bool split = total <= GLINT_FLARE_SPLIT_SLOTS;  // always, by the bound above
+  uint slot = inclusive - slots;
   for (uint i = first; i < last; ++i) {
-    uint s = slices_of(split_words[i]);
-    if (!split) s = 1u;
+    const uint s = split ? slices_scaled(i, scale) : 1u;
     split_words[tiles + i] = s > 1u ? (slot << 5u) | s : 1u;
     for (uint k = 0u; k < s && s > 1u; ++k) split_words[3u * tiles + slot + k] = (i << 5u) | k;
     if (s > 1u) slot += s;
-    split_words[i] = 0u;  // the next frame's pre-pass counts from zero
+    split_words[i] = 0u;              // the next frame's pre-pass counts from zero
+    split_words[2u * tiles + i] = 0u;  // the gather's count of finished slices, from zero
   }
   if (t == 0u) {
     const uint used = split ? total : 0u;

@@ -16,8 +16,9 @@ layout(std430, binding = 0) readonly buffer Instances { GlintFlareInstance insta
 layout(std430, binding = 1) readonly buffer Indirect { uint indirect_words[]; };  // GlintFlareIndirect
 layout(std430, binding = 2) writeonly buffer Sprites { vec4 blocks[]; };
 // With kCount (the pre-pass gather splits crowded tiles: flare_params.h), each sprite adds 1 to
-// the count of every gather tile (pc.tile_w x pc.tile_h) its conservative rectangle meets, as the
-// gather's binning test does; a sprite meeting more than kCountMaxTiles tiles adds to none (it
+// the count of every gather tile (pc.tile_w x pc.tile_h) its conservative rectangle meets (the
+// gather's binning test; a tile that the rectangle only touches may count it too: the counts
+// only choose the plan); a sprite meeting more than kCountMaxTiles tiles adds to none (it
 // weighs about the same on every tile it meets, so it makes no tile more crowded than the
 // others). The counts are integers: the same in any order.
 layout(constant_id = 2) const uint kCount = 0u;
@@ -40,7 +41,10 @@ void main() {
     blocks[i * GLINT_FLARE_BLOCK_VEC4S + 1u + 2u * slot] = vec4(s.lo, s.size);
     blocks[i * GLINT_FLARE_BLOCK_VEC4S + 2u + 2u * slot] = vec4(s.rgb, s.lod);
     bounds = glint_flare_sprite_bounds(s);
-    if (kCount != 0u && bounds.x <= bounds.z && bounds.y <= bounds.w) {
+    // (A rectangle outside the image meets no tile: the clamps below would count it on an edge tile.)
+    const bool on_image =
+        bounds.z > 0.0 && bounds.w > 0.0 && bounds.x < pc.viewport_w && bounds.y < pc.viewport_h;
+    if (kCount != 0u && on_image && bounds.x <= bounds.z && bounds.y <= bounds.w) {
       // Tiles i with bounds.x < (i + 1) tile_w and bounds.z > i tile_w, clamped to the image's.
       const uvec2 tiles = (uvec2(pc.viewport_w, pc.viewport_h) + uvec2(pc.tile_w, pc.tile_h) - 1u) /
                           uvec2(pc.tile_w, pc.tile_h);
