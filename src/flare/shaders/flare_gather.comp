@@ -110,21 +110,26 @@ void main() {
   const uint tiles = tiles_x * tiles_y;
   uvec2 tile_id;
   uint slice = 0u;  // which of its tile's slices this workgroup draws
-  // With kSplit the launch's first rows are the slots' workgroups, so that the slices of the
-  // crowded tiles start first; the tiles' workgroups follow.
-  const uint slots_used = kSplit != 0u ? split_words[3u * tiles + GLINT_FLARE_SPLIT_SLOTS] : 0u;
-  const uint slot_rows = (slots_used + tiles_x - 1u) / tiles_x;
-  if (gl_WorkGroupID.y < slot_rows) {  // (only with kSplit)
-    // A slot's workgroup: it draws the slot's slice unless that is its tile's first.
-    const uint h = gl_WorkGroupID.y * tiles_x + gl_WorkGroupID.x;
-    if (h >= slots_used) return;  // uniform
-    const uint e = split_words[3u * tiles + h];
-    slice = e & 31u;
-    if (slice == 0u) return;
-    tile_id = uvec2((e >> 5u) % tiles_x, (e >> 5u) / tiles_x);
+  if (kSplit != 0u) {  // (a specialization constant: the gathers that split nothing keep none of this)
+    // The launch's first rows are the slots' workgroups, so that the slices of the crowded tiles
+    // start first; the tiles' workgroups follow.
+    const uint slots_used = split_words[3u * tiles + GLINT_FLARE_SPLIT_SLOTS];
+    const uint slot_rows = (slots_used + tiles_x - 1u) / tiles_x;
+    if (gl_WorkGroupID.y < slot_rows) {
+      // A slot's workgroup: it draws the slot's slice unless that is its tile's first.
+      const uint h = gl_WorkGroupID.y * tiles_x + gl_WorkGroupID.x;
+      if (h >= slots_used) return;  // uniform
+      const uint e = split_words[3u * tiles + h];
+      slice = e & 31u;
+      if (slice == 0u) return;
+      tile_id = uvec2((e >> 5u) % tiles_x, (e >> 5u) / tiles_x);
+    } else {
+      const uvec2 id = uvec2(gl_WorkGroupID.x, gl_WorkGroupID.y - slot_rows);
+      tile_id = kCentreFirst == 0u ? id : uvec2(centre_out(id.x, tiles_x), centre_out(id.y, tiles_y));
+    }
   } else {
-    const uvec2 id = uvec2(gl_WorkGroupID.x, gl_WorkGroupID.y - slot_rows);
-    tile_id = kCentreFirst == 0u ? id : uvec2(centre_out(id.x, tiles_x), centre_out(id.y, tiles_y));
+    tile_id = kCentreFirst == 0u ? gl_WorkGroupID.xy
+                                 : uvec2(centre_out(gl_WorkGroupID.x, tiles_x), centre_out(gl_WorkGroupID.y, tiles_y));
   }
   const uint tile_index = tile_id.y * tiles_x + tile_id.x;
   uint slices = 1u, slot0 = 0u;
