@@ -60,8 +60,9 @@ struct LensFlare::Impl {
   // The split of crowded tiles in the pre-pass gather (flare_params.h, "Crowded tiles"): taken for
   // instances buffers of at least split_from instances (GLINT_FLARE_SPLIT_FROM_INSTANCES on GPUs;
   // never on CPU devices: UINT32_MAX). The plan's parameters, the split words (counts, plans,
-  // finished slices, slots) for tiles_split, zeroed once at their first use (the kernels zero what
-  // they used after each frame), and the slots of partial sums (16 bytes without the split).
+  // finished slices, slots) for tiles_split, zeroed once at their first use (then the plan zeroes
+  // the counts after reading them and the finished slices before the gather), and the slots of
+  // partial sums (16 bytes without the split).
   uint32_t split_from = UINT32_MAX;
   bool split() const { return split_from != UINT32_MAX; }
   GlintFlareSplitPush split_params{};

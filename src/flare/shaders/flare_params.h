@@ -93,7 +93,8 @@
 // GLINT_FLARE_SPLIT_MAX_SLICES) slices, each a contiguous range of the instances drawn by its own
 // workgroup, whose sums go to a slot of partial sums; the last of a tile's workgroups to finish
 // adds the slots in slice order. A frame whose split tiles would need more than
-// GLINT_FLARE_SPLIT_SLOTS slots splits none.
+// GLINT_FLARE_SPLIT_SLOTS slots keeps 1 / scale of every tile's slices, scale = ceil(slots needed /
+// GLINT_FLARE_SPLIT_SLOTS), within the slots.
 #define GLINT_FLARE_SPLIT_FROM_INSTANCES 512u
 #define GLINT_FLARE_SPLIT_MIN_SPRITES 256u
 #define GLINT_FLARE_SPLIT_SPRITES 64u
@@ -102,8 +103,8 @@
 #define GLINT_FLARE_SPLIT_PLAN_THREADS 256u
 // The split words (a buffer the LensFlare owns), for T tiles: [0, T) the pre-pass's counts (the
 // plan zeroes them), [T, 2T) each tile's plan (slices | first slot << 5; slices 1: not split),
-// [2T, 3T) each split tile's finished slices (the last one zeroes it), [3T, 3T + SLOTS) the slots'
-// (tile << 5 | slice), [3T + SLOTS] the slots used.
+// [2T, 3T) each split tile's finished slices (the plan zeroes them before the gather counts),
+// [3T, 3T + SLOTS) the slots' (tile << 5 | slice), [3T + SLOTS] the slots used.
 #define GLINT_FLARE_SPLIT_WORDS(tiles) (3u * (tiles) + GLINT_FLARE_SPLIT_SLOTS + 1u)
 
 // The sprite pre-pass (flare_sprites.comp) evaluates every sprite once per frame into a buffer the
