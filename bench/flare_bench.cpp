@@ -196,9 +196,7 @@ void run_flare_draw(benchmark::State& state, uint32_t width, uint32_t height, ui
     state.counters["tile_sprites_mean"] = load.sprites_mean;
     state.counters["invocation_samples_max"] = load.samples_max;
   }
-  const detail::FlareGatherTile pre_tile = detail::LensFlareAccess::gather_tile(flare, false, lights);
-  const bool splits = detail::LensFlareAccess::gather_tile(flare, false, 0).height != pre_tile.height ||
-                      split == 1;  // (a CPU device's tiles are the same with and without the split)
+  const bool splits = detail::LensFlareAccess::splits(flare, lights);
   state.SetLabel(std::string(compute ? (one_dispatch ? "compute, one dispatch"
                                         : splits     ? "compute, pre-pass, crowded tiles split"
                                                      : "compute, pre-pass")

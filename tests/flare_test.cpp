@@ -137,6 +137,14 @@ std::vector<GlintFlareInstance> random_instances(uint32_t n, uint32_t stream) {
   return out;
 }
 
+// 500 small lights (2 to 14 px): every light's ghost at t = 1 lands on the image centre, so
+// hundreds of sprites pile on its tiles.
+std::vector<GlintFlareInstance> piled_lights(uint32_t stream) {
+  auto lights = random_instances(500, stream);
+  for (auto& g : lights) g.size_px = 2.0f + 0.2f * g.size_px;
+  return lights;
+}
+
 // ---- Config ---------------------------------------------------------------------------------------
 
 TEST_F(FlareTest, PresetsHaveTheSeedsValues) {
@@ -648,8 +656,7 @@ TEST_F(FlareTest, PrePassGatherGivesTheSameBitsAtEveryTileHeight) {
     EXPECT_FALSE(one.centre_first) << fmt;
     const reference::FlareAtlas atlas = read_flare_atlas(flare);
     const CpuImage background = as_stored(random_hdr(kW, kH, 83), format);
-    auto lights = random_instances(500, 37);
-    for (auto& g : lights) g.size_px = 2.0f + 0.2f * g.size_px;
+    const auto lights = piled_lights(37);
     const FlareConfig config;
     FlareInputs in(lights, uint32_t(lights.size()), flare.groups_per_instance());
     detail::LensFlareAccess::select_gather(flare, detail::FlareGatherPath::pre_pass);
@@ -705,8 +712,7 @@ TEST_F(FlareTest, CrowdedTilesSplitIntoSlicesMatchTheReference) {
     LensFlare flare(context(), format, {kW, kH});
     const reference::FlareAtlas atlas = read_flare_atlas(flare);
     const CpuImage background = as_stored(random_hdr(kW, kH, 87), format);
-    auto lights = random_instances(500, 41);
-    for (auto& g : lights) g.size_px = 2.0f + 0.2f * g.size_px;
+    const auto lights = piled_lights(41);
     const FlareConfig config;
     FlareInputs in(lights, uint32_t(lights.size()), flare.groups_per_instance());
     detail::LensFlareAccess::select_gather(flare, detail::FlareGatherPath::pre_pass);
@@ -727,7 +733,13 @@ TEST_F(FlareTest, CrowdedTilesSplitIntoSlicesMatchTheReference) {
       const uint32_t slices = first[tiles + i] & 31u;
       EXPECT_GE(slices, 1u) << fmt << ", tile " << i;
       EXPECT_LE(slices, 8u) << fmt << ", tile " << i;
-      if (slices > 1) ++split_tiles, slots += slices;
+      if (slices > 1) {
+        ++split_tiles, slots += slices;
+        // The tile's slots name it and its slices in order.
+        const uint32_t slot0 = first[tiles + i] >> 5u;
+        for (uint32_t k = 0; k < slices && slot0 + k < GLINT_FLARE_SPLIT_SLOTS; ++k)
+          EXPECT_EQ(first[3 * tiles + slot0 + k], (uint32_t(i) << 5u) | k) << fmt << ", tile " << i << " slot " << k;
+      }
       EXPECT_EQ(first[i], 0u) << fmt << ": the count of tile " << i << " was not zeroed";
       // Every slice of a split tile finished once (the next frame's plan zeroes the count).
       EXPECT_EQ(first[2 * tiles + i], slices > 1 ? slices : 0u) << fmt << ": the finished slices of tile " << i;

@@ -160,7 +160,7 @@ void LensFlare::record_compute(VkCommandBuffer cmd, Image& color, Buffer& instan
   // The instances buffer holds more than the store: the gather evaluates the rest itself.
   const bool beyond = instances.size / sizeof(GlintFlareInstance) > sprite_store.capacity;
   // Crowded tiles split (in full tiles) for buffers of split_from instances and more.
-  const bool split = instances.size / sizeof(GlintFlareInstance) >= m.split_from;
+  const bool split = m.splits(instances.size / sizeof(GlintFlareInstance));
   const Impl::GatherTiles& tiles = split ? m.tiles_split : m.tiles_pre_pass;
   detail::ComputePipeline& beyond_gather = split ? m.gather_beyond_split : m.gather_beyond;
   if (beyond && !beyond_gather) beyond_gather = m.make_gather(1, 0, split);
@@ -236,9 +236,9 @@ void LensFlareAccess::select_gather(LensFlare& flare, FlareGatherPath path) { fl
 
 FlareGatherTile LensFlareAccess::gather_tile(const LensFlare& flare, bool one_dispatch, uint64_t instances) {
   const LensFlare::Impl& m = *flare.impl_;
-  const LensFlare::Impl::GatherTiles& t = one_dispatch                ? m.tiles_one_dispatch
-                                          : instances >= m.split_from ? m.tiles_split
-                                                                      : m.tiles_pre_pass;
+  const LensFlare::Impl::GatherTiles& t = one_dispatch          ? m.tiles_one_dispatch
+                                          : m.splits(instances) ? m.tiles_split
+                                                                : m.tiles_pre_pass;
   return {m.workgroup.x, m.workgroup.y * t.rows, m.workgroup.y, t.centre_first};
 }
 
@@ -274,6 +274,8 @@ void LensFlareAccess::set_split(LensFlare& flare, bool on, uint32_t min_sprites,
     m.gather_beyond = {};
   }
 }
+
+bool LensFlareAccess::splits(const LensFlare& flare, uint64_t instances) { return flare.impl_->splits(instances); }
 
 Buffer LensFlareAccess::split_words(const LensFlare& flare) { return flare.impl_->split_state; }
 

@@ -65,6 +65,8 @@ struct LensFlare::Impl {
   // partial sums (16 bytes without the split).
   uint32_t split_from = UINT32_MAX;
   bool split() const { return split_from != UINT32_MAX; }
+  // Whether a pre-pass draw from an instances buffer of `instances` instances splits crowded tiles.
+  bool splits(uint64_t instances) const { return instances >= split_from; }
   GlintFlareSplitPush split_params{};
   detail::OwnedBuffer split_buffer, partials_buffer;
   Buffer split_state, partials_state;

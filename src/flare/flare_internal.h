@@ -51,6 +51,9 @@ struct LensFlareAccess {
   static void set_split(LensFlare& flare, bool on, uint32_t min_sprites = GLINT_FLARE_SPLIT_MIN_SPRITES,
                         uint32_t sprites_per_slice = GLINT_FLARE_SPLIT_SPRITES,
                         uint32_t max_slices = GLINT_FLARE_SPLIT_MAX_SLICES);
+  /// Whether record_compute() splits crowded tiles in a pre-pass draw from an instances buffer of
+  /// `instances` instances.
+  static bool splits(const LensFlare& flare, uint64_t instances);
   /// The split words (layout in flare_params.h, for the tiles gather_tile() gives for a split
   /// draw) as the last split pre-pass draw left them (tests read the plan back).
   static Buffer split_words(const LensFlare& flare);

@@ -30,29 +30,9 @@ layout(std430, binding = COMPACT_GROUPS_BINDING)
 uint compact_pack_counts(uvec4 c) { return c.x | (c.y << 8u) | (c.z << 16u) | (c.w << 24u); }
 
 #ifndef COMPACT_NO_SCAN
-shared uint s_compact_sum[2][GLINT_COMPACT_SCAN_MAX_THREADS];
+#define GLINT_WORKGROUP_SCAN_MAX_THREADS GLINT_COMPACT_SCAN_MAX_THREADS
+#include "workgroup_scan.glsl"
 shared uint s_compact_counts[4][32];  // the tile's counts, spread over 32 words each
-
-// Inclusive prefix sum of `n` over the workgroup's invocations (all must call it); returns this
-// invocation's sum, `total` the workgroup's.
-uint compact_workgroup_scan(uint n, out uint total) {
-  const uint threads = gl_WorkGroupSize.x * gl_WorkGroupSize.y;
-  const uint t = gl_LocalInvocationIndex;
-  s_compact_sum[0][t] = n;
-  barrier();
-  uint src = 0u;
-  for (uint d = 1u; d < threads; d <<= 1u) {
-    uint v = s_compact_sum[src][t];
-    if (t >= d) v += s_compact_sum[src][t - d];
-    s_compact_sum[src ^ 1u][t] = v;
-    barrier();
-    src ^= 1u;
-  }
-  const uint mine = s_compact_sum[src][t];
-  total = s_compact_sum[src][threads - 1u];
-  barrier();  // the arrays are rewritten by the next call
-  return mine;
-}
 
 #ifndef COMPACT_GROUPS_READONLY
 // Level 1: workgroup k takes the tile of `threads` consecutive groups, invocation t group
@@ -72,7 +52,7 @@ uint compact_tile_scan_counts(uint count) {
     packed = v.z;
   }
   uint total;
-  const uint sum = compact_workgroup_scan(n, total);  // its barriers order the zeroing above
+  const uint sum = workgroup_scan(n, total);  // its barriers order the zeroing above
   if (g < group_count) groups[g].z = sum - n;
   if (t == 0u) groups[g].w = total;
   for (uint f = 0u; f < 4u; ++f) {
@@ -108,7 +88,7 @@ uint compact_top_scan(uint count, uint tile_groups) {
     const uint k = base + t;
     const uint n = k < tiles ? groups[k * tile_groups].w : 0u;
     uint total;
-    const uint sum = compact_workgroup_scan(n, total);
+    const uint sum = workgroup_scan(n, total);
     if (k < tiles) groups[k * tile_groups].w = carry + sum - n;
     carry += total;
   }

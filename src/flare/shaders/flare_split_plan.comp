@@ -18,7 +18,8 @@ layout(std430, binding = 2) writeonly buffer Args { uint args[8]; };            
 layout(push_constant) uniform Push { GlintFlareSplitPush pc; };
 
 const uint kThreads = GLINT_FLARE_SPLIT_PLAN_THREADS;
-shared uint s_scan[2][kThreads];
+#define GLINT_WORKGROUP_SCAN_MAX_THREADS GLINT_FLARE_SPLIT_PLAN_THREADS
+#include "workgroup_scan.glsl"
 
 uint slices_of(uint sprites) {
   return sprites >= pc.min_sprites ? clamp(sprites / pc.sprites_per_slice, 1u, pc.max_slices) : 1u;
@@ -41,25 +42,6 @@ uint run_slots(uint first, uint last, uint scale) {
   return slots;
 }
 
-// Inclusive scan of one value per invocation (Hillis & Steele 1986); `total` gets the sum of all.
-uint scan(uint v, out uint total) {
-  const uint t = gl_LocalInvocationIndex;
-  s_scan[0][t] = v;
-  barrier();
-  uint src = 0u;
-  for (uint d = 1u; d < kThreads; d <<= 1u) {
-    uint w = s_scan[src][t];
-    if (t >= d) w += s_scan[src][t - d];
-    s_scan[src ^ 1u][t] = w;
-    barrier();
-    src ^= 1u;
-  }
-  total = s_scan[src][kThreads - 1u];
-  const uint inclusive = s_scan[src][t];
-  barrier();  // read before a next scan writes
-  return inclusive;
-}
-
 void main() {
   const uint t = gl_LocalInvocationIndex;
   const uint tiles = pc.tiles_x * pc.tiles_y;
@@ -68,7 +50,7 @@ void main() {
   const uint first = min(tiles, t * per), last = min(tiles, first + per);
   uint slots = run_slots(first, last, 1u);
   uint total;
-  uint inclusive = scan(slots, total);
+  uint inclusive = workgroup_scan(slots, total);
   // More slots than there are: every tile keeps 1 / scale of its slices, scale = ceil(total /
   // GLINT_FLARE_SPLIT_SLOTS), so that the slots add up to at most total / scale (each tile's
   // floor(s / scale) <= s / scale). One scale for all tiles: the plan stays a function of the counts.
@@ -76,7 +58,7 @@ void main() {
   if (total > GLINT_FLARE_SPLIT_SLOTS) {  // uniform
     scale = (total + GLINT_FLARE_SPLIT_SLOTS - 1u) / GLINT_FLARE_SPLIT_SLOTS;
     slots = run_slots(first, last, scale);
-    inclusive = scan(slots, total);
+    inclusive = workgroup_scan(slots, total);
   }
   const bool split = total <= GLINT_FLARE_SPLIT_SLOTS;  // always, by the bound above
   uint slot = inclusive - slots;
