@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <memory>
 #include <random>
+#include <string>
 
 #include "bench_support.h"
 #include "bloom/bloom_internal.h"
@@ -23,17 +24,10 @@ namespace {
 
 constexpr int kFramesPerIteration = 16;
 
-void BM_Bloom(benchmark::State& state) {
-  const auto width = static_cast<uint32_t>(state.range(0));
-  const auto height = static_cast<uint32_t>(state.range(1));
-  const auto filter = static_cast<BloomFilter>(state.range(2));
-  const auto precision = static_cast<Precision>(state.range(3));
-  const auto guard = static_cast<FireflyGuard>(state.range(4));
-  const auto level0_height = static_cast<uint32_t>(state.range(5));
-  // fused: bit 0 the small levels in one dispatch, bit 1 the last upsample in the composite, bit 2
-  // the tiled composite instead of the 2:1 one, bit 3 the tiled upsample steps instead of the 2:1
-  // ones (src/bloom/bloom_internal.h, docs/BLOOM.md "Dispatches"); 0 is the default.
-  const auto fused = static_cast<uint32_t>(state.range(6));
+// One bloom configuration at width x height with the dispatch structure `path`; `variant` names
+// the path in the label.
+void run_bloom(benchmark::State& state, uint32_t width, uint32_t height, BloomFilter filter, Precision precision,
+               FireflyGuard guard, uint32_t level0_height, const detail::BloomPath& path, const std::string& variant) {
   const Context& ctx = context();
   const VkFormat format = VK_FORMAT_R16G16B16A16_SFLOAT;
 
@@ -47,7 +41,7 @@ void BM_Bloom(benchmark::State& state) {
   config.firefly_guard = guard;
   config.level0_height = level0_height;
   Bloom bloom(ctx, config);
-  detail::BloomAccess::set_path(bloom, {(fused & 1u) != 0, (fused & 2u) != 0, (fused & 4u) == 0, (fused & 8u) == 0});
+  detail::BloomAccess::set_path(bloom, path);
   bloom.prepare({width, height});
   Profiler profiler(ctx, kFramesPerIteration + 1);
 
@@ -90,8 +84,24 @@ void BM_Bloom(benchmark::State& state) {
   state.counters["rel_l2_vs_f64"] = error;
   state.counters["levels"] = bloom.levels();
   state.SetLabel(std::string(bloom_filter_name(filter)) + (precision == Precision::fp16 ? "/fp16/" : "/fp32/") +
-                 firefly_guard_name(guard) + (level0_height ? "/l0h" + std::to_string(level0_height) : "") + "/fused" +
-                 std::to_string(fused) + " on " + ctx.info().name);
+                 firefly_guard_name(guard) + (level0_height ? "/l0h" + std::to_string(level0_height) : "") + "/" +
+                 variant + " on " + ctx.info().name);
+}
+
+void BM_Bloom(benchmark::State& state) {
+  // fused: bit 0 the small levels in one dispatch, bit 1 the last upsample in the composite, bit 2
+  // the tiled composite instead of the 2:1 one, bit 3 the tiled upsample steps instead of the 2:1
+  // ones (src/bloom/bloom_internal.h, docs/BLOOM.md "Dispatches"); 0 is the default.
+  const auto fused = static_cast<uint32_t>(state.range(6));
+  detail::BloomPath path;
+  path.fuse_small_levels = (fused & 1u) != 0;
+  path.fuse_last_up = (fused & 2u) != 0;
+  path.composite_2x = (fused & 4u) == 0;
+  path.up_2x = (fused & 8u) == 0;
+  run_bloom(state, static_cast<uint32_t>(state.range(0)), static_cast<uint32_t>(state.range(1)),
+            static_cast<BloomFilter>(state.range(2)), static_cast<Precision>(state.range(3)),
+            static_cast<FireflyGuard>(state.range(4)), static_cast<uint32_t>(state.range(5)), path,
+            "fused" + std::to_string(fused));
 }
 
 void bloom_args(benchmark::internal::Benchmark* b) {
@@ -117,6 +127,38 @@ void bloom_args(benchmark::internal::Benchmark* b) {
 }
 
 BENCHMARK(BM_Bloom)->Apply(bloom_args);
+
+// The default bloom (cod13, fp16 levels, karis_smooth) with the kernels after the first stage in
+// other workgroup shapes than the bloom's own (BloomPath's down_workgroup, up_workgroup and
+// composite_workgroup): shape 0 the default; 1 / 2 the downsamples in 32x8 / 64x4; 3 / 4 the
+// upsamples; 5 / 6 the composite; 7 / 8 all three. A shape the device cannot run is skipped.
+void BM_BloomShapes(benchmark::State& state) {
+  const auto shape = static_cast<int>(state.range(2));
+  const detail::Workgroup2D wide = shape % 2 == 1 ? detail::Workgroup2D{32, 8} : detail::Workgroup2D{64, 4};
+  detail::BloomPath path;
+  if (shape == 1 || shape == 2 || shape >= 7) path.down_workgroup = wide;
+  if (shape == 3 || shape == 4 || shape >= 7) path.up_workgroup = wide;
+  if (shape == 5 || shape == 6 || shape >= 7) path.composite_workgroup = wide;
+  if (shape != 0 && wide.x * wide.y > context().info().max_workgroup_invocations) {
+    state.SkipWithError("the shape exceeds the device's maxComputeWorkGroupInvocations");
+    return;
+  }
+  const std::string name = shape == 0 ? "default shapes"
+                                      : std::string(shape >= 7   ? "all"
+                                                    : shape >= 5 ? "composite"
+                                                    : shape >= 3 ? "up"
+                                                                 : "down") +
+                                            " " + std::to_string(wide.x) + "x" + std::to_string(wide.y);
+  run_bloom(state, static_cast<uint32_t>(state.range(0)), static_cast<uint32_t>(state.range(1)), BloomFilter::cod13,
+            Precision::fp16, FireflyGuard::karis_smooth, 0, path, name);
+}
+
+BENCHMARK(BM_BloomShapes)
+    ->ArgsProduct({{1920}, {1080}, {0, 1, 2, 3, 4, 5, 6, 7, 8}})
+    ->ArgsProduct({{3840}, {2160}, {0, 1, 2, 3, 4, 5, 6, 7, 8}})
+    ->ArgNames({"w", "h", "shape"})
+    ->UseManualTime()
+    ->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 }  // namespace glint::bench

@@ -179,5 +179,71 @@ BENCHMARK(BM_CopyFloorMethods)
     ->UseManualTime()
     ->Unit(benchmark::kMicrosecond);
 
+// What a dispatch costs beyond its work: one frame of `dispatches` copies of a small image, in the
+// device's 2D workgroup. Dependent (dependent:1): each copy reads what the one before it wrote (A
+// to B, B to A, ...), with the barrier between them, as the stages of an effect chain do.
+// Independent (dependent:0): every copy reads the same image into an image of its own, all their
+// barriers recorded before the first, so nothing waits between them. median_us / dispatches is
+// the launch (independent) or the launch, drain and barrier (dependent) of one small dispatch: the
+// fixed part of each stage of bloom's and the culls' chains (docs/PERF.md, "The floor").
+void BM_DispatchChain(benchmark::State& state) {
+  const bool dependent = state.range(0) != 0;
+  const auto dispatches = static_cast<uint32_t>(state.range(1));
+  const auto width = static_cast<uint32_t>(state.range(2));
+  const auto height = static_cast<uint32_t>(state.range(3));
+  const Context& ctx = context();
+  auto images = rgba16f_pair(ctx, {width, height}, 7);
+  std::vector<detail::OwnedImage> outs;
+  for (uint32_t i = 1; !dependent && i < dispatches; ++i) {
+    outs.emplace_back(ctx, VkExtent2D{width, height}, VK_FORMAT_R16G16B16A16_SFLOAT, detail::kToolImageUsage);
+  }
+  const detail::ComputePipeline copy = copy_pipeline(ctx, detail::choose_workgroup_2d(ctx));
+  BloomPush push{};
+  push.dst_width = static_cast<int32_t>(width);
+  push.dst_height = static_cast<int32_t>(height);
+  auto frame = [&](VkCommandBuffer cmd) {
+    if (dependent) {
+      for (uint32_t i = 0; i < dispatches; ++i) {
+        record_copy(cmd, images, copy, width, height);
+        std::swap(images.src, images.dst);
+      }
+      return;
+    }
+    detail::Barriers b;
+    b.use(images.src.state, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+          VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
+    b.use(images.dst.state, VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+          VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+    for (detail::OwnedImage& o : outs) {
+      b.use(o.state, VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+            VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+    }
+    b.flush(cmd);
+    for (uint32_t i = 0; i < dispatches; ++i) {
+      const VkImageView dst = i == 0 ? images.dst.state.view : outs[i - 1].state.view;
+      copy.dispatch(cmd,
+                    {{images.src.state.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL}, {dst, VK_IMAGE_LAYOUT_GENERAL}},
+                    push, width, height);
+    }
+  };
+  Profiler profiler(ctx, kCopies + 1);
+  std::vector<double> all;
+  for (auto _ : state) {
+    const double m = median_frame_ms(ctx, profiler, kCopies, frame);
+    all.push_back(m);
+    state.SetIterationTime(m * 1e-3);
+  }
+  state.counters["median_us"] = median_of(all) * 1e3;
+  state.counters["us_per_dispatch"] = median_of(all) * 1e3 / dispatches;
+  state.SetLabel(std::string(dependent ? "dependent" : "independent") + " RGBA16F copies on " + ctx.info().name);
+}
+
+BENCHMARK(BM_DispatchChain)
+    ->ArgsProduct({{0, 1}, {1, 4, 16}, {64}, {64}})
+    ->ArgsProduct({{0, 1}, {1, 4, 16}, {480}, {270}})
+    ->ArgNames({"dependent", "dispatches", "w", "h"})
+    ->UseManualTime()
+    ->Unit(benchmark::kMicrosecond);
+
 }  // namespace
 }  // namespace glint::bench

@@ -253,6 +253,48 @@ TEST_F(BloomTest, TwoToOneUpsampleAndCompositeMatchReferenceAtEveryRadius) {
   }
 }
 
+// The kernels after the first stage in other workgroup shapes (BloomPath's down_workgroup,
+// up_workgroup and composite_workgroup, which the benchmarks compare per device): every output
+// is computed by the same expression from the same texels whatever the tile, so the images agree
+// to the rounding that the compiler's choice of FMA contraction may change (SPIR-V lets it fuse
+// a multiply and an add in one pipeline and not in another): 2^-20 relative, a few fp32 ulps.
+// Sizes with 2:1 steps throughout (96x64: bloom_up_2x, bloom_composite_2x) and without (100x70:
+// the tiled bloom_up and bloom_composite), a wide and a tall shape (32x4, 4x32: within the 32 KiB
+// of shared memory that lavapipe has), 3x5 (partial tiles everywhere) and one no device can run.
+TEST_F(BloomTest, LaterKernelsInOtherWorkgroupShapesGiveTheSameImage) {
+  for (BloomFilter filter : {BloomFilter::cod13, BloomFilter::dual, BloomFilter::gauss9}) {
+    const BloomConfig config = added_light_config(filter);
+    Bloom base(context(), config), other(context(), config);
+    for (detail::Workgroup2D g : {detail::Workgroup2D{32, 4}, detail::Workgroup2D{4, 32}, detail::Workgroup2D{3, 5}}) {
+      detail::BloomPath path;
+      path.down_workgroup = path.up_workgroup = path.composite_workgroup = g;
+      detail::BloomAccess::set_path(other, path);
+      for (VkExtent2D size : {VkExtent2D{96, 64}, VkExtent2D{100, 70}}) {
+        const CpuImage input = random_hdr(size.width, size.height, size.width + 7 * size.height);
+        const CpuImage a = run_bloom(base, input, kF32, kF32), b = run_bloom(other, input, kF32, kF32);
+        const std::string what = std::string(bloom_filter_name(filter)) + " " + std::to_string(size.width) + "x" +
+                                 std::to_string(size.height) + " in " + std::to_string(g.x) + "x" + std::to_string(g.y);
+        ASSERT_EQ(a.rgba.size(), b.rgba.size());
+        size_t differ = 0;
+        for (size_t i = 0; i < a.rgba.size(); ++i)
+          differ += !(std::abs(a.rgba[i] - b.rgba[i]) <= 0x1p-20f * std::max(1.0f, std::abs(a.rgba[i])));
+        EXPECT_EQ(differ, 0u) << what << ": values where the shapes differ";
+        EXPECT_LT(added_light_error(b, input, config), 1e-3) << what;
+      }
+    }
+  }
+  Bloom bloom(context(), added_light_config(BloomFilter::cod13));
+  detail::BloomPath path;
+  path.up_workgroup = {64, 64};
+  try {
+    detail::BloomAccess::set_path(bloom, path);
+    ADD_FAILURE() << "a 64x64 upsample workgroup was accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::invalid_argument);
+    EXPECT_NE(std::string(e.what()).find("BloomPath::up_workgroup = 64x64"), std::string::npos) << e.what();
+  }
+}
+
 // The karis_smooth first step at an exact 2:1 reduction with cod13 and dual runs its own kernel
 // on GPUs and wherever ContextOptions::workgroup_2d is set (src/bloom/shaders/bloom_prefilter_boxes.comp:
 // the box means of the binomially filtered source as one 12-tap binomial pass per axis, a

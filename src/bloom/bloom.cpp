@@ -163,12 +163,13 @@ struct Bloom::Impl {
     return config.precision == Precision::fp32 ? VK_FORMAT_R32G32B32A32_SFLOAT : VK_FORMAT_R16G16B16A16_SFLOAT;
   }
 
-  detail::PipelineDesc desc(const std::string& kernel, std::vector<VkDescriptorType> bindings) const {
+  detail::PipelineDesc desc(const std::string& kernel, std::vector<VkDescriptorType> bindings,
+                            detail::Workgroup2D shape = {0, 0}) const {
     detail::PipelineDesc d;
     d.kernel_id = kernel;
     d.bindings = std::move(bindings);
     d.push_constant_bytes = sizeof(BloomPush);
-    d.workgroup = workgroup;
+    d.workgroup = shape.x != 0 ? shape : workgroup;
     // Constant 3: prefetch the tiled loads on GPUs only (src/bloom/shaders/bloom.glsl, PREFETCH).
     const uint32_t prefetch = context->info().type == VK_PHYSICAL_DEVICE_TYPE_CPU ? 0u : 1u;
     d.specialization = {static_cast<uint32_t>(config.filter), prefetch};
@@ -178,8 +179,9 @@ struct Bloom::Impl {
   // desc() of the 2:1 upsample and composite kernels, with constant 4: their outputs stored in copy
   // order through shared memory, on GPUs unless the path says otherwise
   // (src/bloom/shaders/bloom_up_2x.glsl, COPY_ORDER).
-  detail::PipelineDesc desc_2x(const std::string& kernel, std::vector<VkDescriptorType> bindings) const {
-    detail::PipelineDesc d = desc(kernel, std::move(bindings));
+  detail::PipelineDesc desc_2x(const std::string& kernel, std::vector<VkDescriptorType> bindings,
+                               detail::Workgroup2D shape) const {
+    detail::PipelineDesc d = desc(kernel, std::move(bindings), shape);
     using Order = detail::BloomPath::CopyOrder;
     const bool on = path.copy_order_2x == Order::device ? detail::copy_order_by_default(context->info())
                                                         : path.copy_order_2x == Order::on;
@@ -197,12 +199,12 @@ struct Bloom::Impl {
     prefilter_boxes = smooth_boxes_kernel(*context, config)
                           ? detail::ComputePipeline(*context, desc("bloom_prefilter_boxes_" + lv, {S, W}))
                           : detail::ComputePipeline();
-    down = detail::ComputePipeline(*context, desc("bloom_down_" + lv, {S, W}));
+    down = detail::ComputePipeline(*context, desc("bloom_down_" + lv, {S, W}, path.down_workgroup));
     blur = config.filter == BloomFilter::gauss9 ? detail::ComputePipeline(*context, desc("bloom_blur_" + lv, {S, W}))
                                                 : detail::ComputePipeline();
-    up = detail::ComputePipeline(*context, desc("bloom_up_" + lv, {S, W}));
+    up = detail::ComputePipeline(*context, desc("bloom_up_" + lv, {S, W}, path.up_workgroup));
     up_2x = path.up_2x && config.filter != BloomFilter::dual
-                ? detail::ComputePipeline(*context, desc_2x("bloom_up_2x_" + lv, {S, W}))
+                ? detail::ComputePipeline(*context, desc_2x("bloom_up_2x_" + lv, {S, W}, path.up_workgroup))
                 : detail::ComputePipeline();
     if (path.fuse_small_levels) {
       detail::PipelineDesc d = desc("bloom_tail_" + lv, {S, W});
@@ -231,15 +233,17 @@ struct Bloom::Impl {
     const auto W = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
     auto c = composite.find(v);
     if (c == composite.end()) {
-      detail::PipelineDesc d =
-          path.fuse_last_up ? desc("bloom_composite_up_" + v, {S, S, W, S}) : desc("bloom_composite_" + v, {S, S, W});
+      detail::PipelineDesc d = path.fuse_last_up ? desc("bloom_composite_up_" + v, {S, S, W, S})
+                                                 : desc("bloom_composite_" + v, {S, S, W}, path.composite_workgroup);
       c = composite.emplace(v, detail::ComputePipeline(*context, d)).first;
     }
     detail::ComputePipeline* c2 = nullptr;
     if (!path.fuse_last_up && path.composite_2x && config.filter != BloomFilter::dual) {
       auto it = composite_2x.find(v);
       if (it == composite_2x.end()) {
-        it = composite_2x.emplace(v, detail::ComputePipeline(*context, desc_2x("bloom_composite_2x_" + v, {S, S, W})))
+        it = composite_2x
+                 .emplace(v, detail::ComputePipeline(
+                                 *context, desc_2x("bloom_composite_2x_" + v, {S, S, W}, path.composite_workgroup)))
                  .first;
       }
       c2 = &it->second;
@@ -590,6 +594,25 @@ uint64_t Bloom::min_bytes_moved(VkFormat input_format, VkFormat output_format) c
 namespace detail {
 
 void BloomAccess::set_path(Bloom& bloom, const BloomPath& path) {
+  // The shared memory of each kind's kernels at its shape (bloom_shared_bytes() has the layouts):
+  // bloom_down's tiles; bloom_up's (and bloom_composite's) tiles and the 2:1 kernels' output tile.
+  const DeviceInfo& info = bloom.impl_->context->info();
+  auto check = [&](const char* kind, Workgroup2D g, uint32_t bytes) {
+    if (g.x == 0) return;
+    if (g.y == 0 || g.x * g.y > info.max_workgroup_invocations || bytes > info.max_shared_memory_bytes) {
+      throw Error(ErrorCode::invalid_argument,
+                  concat("BloomPath::", kind, " = ", g.x, "x", g.y, ": needs ", g.x * g.y, " invocations and ", bytes,
+                         " bytes of shared memory; device '", info.name, "' has ", info.max_workgroup_invocations,
+                         " and ", info.max_shared_memory_bytes));
+    }
+  };
+  auto down_bytes = [](Workgroup2D g) { return ((2 * g.x + 4) * (2 * g.y + 4) + (2 * g.x + 3) * (2 * g.y + 3)) * 16; };
+  auto up_bytes = [](Workgroup2D g) {
+    return std::max(((g.x + 10) * (g.y + 10) + g.x * (g.y + 10)) * 16, 4 * g.x * g.y * 16);
+  };
+  check("down_workgroup", path.down_workgroup, down_bytes(path.down_workgroup));
+  check("up_workgroup", path.up_workgroup, up_bytes(path.up_workgroup));
+  check("composite_workgroup", path.composite_workgroup, up_bytes(path.composite_workgroup));
   bloom.impl_->path = path;
   bloom.impl_->make_pipelines();
 }

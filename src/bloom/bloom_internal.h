@@ -5,6 +5,8 @@
 
 #include <glint/bloom.h>
 
+#include "core/pipeline.h"
+
 namespace glint::detail {
 
 struct BloomPath {
@@ -24,6 +26,12 @@ struct BloomPath {
   /// devices no), or forced either way (tests reach both forms on any device).
   enum class CopyOrder { device, on, off };
   CopyOrder copy_order_2x = CopyOrder::device;
+  /// Workgroup shapes of the kernels after the first stage, per kind: the downsamples
+  /// (bloom_down), the upsamples (bloom_up, bloom_up_2x) and the composite (bloom_composite,
+  /// bloom_composite_2x). {0, 0}: the bloom's own shape, which the first stage always runs in.
+  Workgroup2D down_workgroup{0, 0};
+  Workgroup2D up_workgroup{0, 0};
+  Workgroup2D composite_workgroup{0, 0};
 };
 
 struct BloomAccess {
