@@ -29,6 +29,7 @@
 
 #include "bench_support.h"
 #include "core/barriers.h"
+#include "core/pipeline.h"
 #include "core/resources.h"
 #include "flare/flare_internal.h"
 #include "flare/shaders/flare_params.h"
@@ -115,7 +116,8 @@ TileLoad tile_load(const std::vector<reference::FlareSprite>& sprites, uint32_t 
 // RGBA16F image, the compute path with its dispatches chosen by `path`; `split` 0 or 1 makes every
 // pre-pass draw split no tile or the crowded ones (-1: as the device and buffer choose).
 void run_flare_draw(benchmark::State& state, uint32_t width, uint32_t height, uint32_t lights, bool compute, bool mixed,
-                    detail::FlareGatherPath path, int split = -1) {
+                    detail::FlareGatherPath path, int split = -1, detail::Workgroup2D gather_workgroup = {0, 0},
+                    const uint32_t* split_params = nullptr) {
   const Context& ctx = context();
   const VkFormat format = VK_FORMAT_R16G16B16A16_SFLOAT;
 
@@ -124,6 +126,9 @@ void run_flare_draw(benchmark::State& state, uint32_t width, uint32_t height, ui
   LensFlare flare(ctx, format, {width, height});
   detail::LensFlareAccess::select_gather(flare, path);
   if (split >= 0) detail::LensFlareAccess::set_split(flare, split == 1);
+  if (split_params) detail::LensFlareAccess::set_split(flare, true, split_params[0], split_params[1], split_params[2]);
+  if (gather_workgroup.x != 0)
+    detail::LensFlareAccess::set_gather_workgroup(flare, gather_workgroup.x, gather_workgroup.y);
   const FlareConfig config = FlareConfig::preset(FlarePreset::cinematic);
 
   const std::vector<GlintFlareInstance> list = bench_lights(lights, width, height, mixed);
@@ -247,6 +252,49 @@ void BM_FlareSplit(benchmark::State& state) {
 BENCHMARK(BM_FlareSplit)
     ->ArgsProduct({{256, 512, 1000}, {0, 1}})
     ->ArgNames({"lights", "split"})
+    ->UseManualTime()
+    ->Unit(benchmark::kMicrosecond);
+
+// The compute draw (1920x1080, mixed sizes unless `mixed` is 0) with the gather in other workgroup
+// shapes: 0 the device's (32x8 on GPUs), 1 16x8, 2 16x16, 3 64x4, 4 8x16; each tile as many rows
+// per invocation as the path takes by default, the split as the instances buffer decides.
+void BM_FlareGatherShape(benchmark::State& state) {
+  static const detail::Workgroup2D kShapes[] = {{0, 0}, {16, 8}, {16, 16}, {64, 4}, {8, 16}};
+  const detail::Workgroup2D g = kShapes[state.range(2)];
+  if (g.x * g.y > context().info().max_workgroup_invocations) {
+    state.SkipWithError("the shape exceeds the device's maxComputeWorkGroupInvocations");
+    return;
+  }
+  run_flare_draw(state, 1920, 1080, static_cast<uint32_t>(state.range(0)), true, state.range(1) != 0,
+                 detail::FlareGatherPath::device, -1, g);
+}
+
+BENCHMARK(BM_FlareGatherShape)
+    ->ArgsProduct({{10, 1000}, {0}, {0, 1, 2, 3, 4}})
+    ->ArgsProduct({{256, 1000}, {1}, {0, 1, 2, 3, 4}})
+    ->ArgNames({"lights", "mixed", "shape"})
+    ->UseManualTime()
+    ->Unit(benchmark::kMicrosecond);
+
+// The split draw of 1000 lights (1920x1080; mixed sizes with mixed:1) under other split
+// parameters (tiles of min_sprites sprites and more split, sprites per slice, most slices): 0 the
+// defaults (flare_params.h), then {128, 64, 16}, {256, 32, 16}, {256, 32, 31}, {128, 32, 31},
+// {512, 64, 16}.
+void BM_FlareSplitParams(benchmark::State& state) {
+  static const uint32_t kParams[][3] = {
+      {GLINT_FLARE_SPLIT_MIN_SPRITES, GLINT_FLARE_SPLIT_SPRITES, GLINT_FLARE_SPLIT_MAX_SLICES},
+      {128, 64, 16},
+      {256, 32, 16},
+      {256, 32, 31},
+      {128, 32, 31},
+      {512, 64, 16}};
+  run_flare_draw(state, 1920, 1080, 1000, true, state.range(0) != 0, detail::FlareGatherPath::pre_pass, 1, {0, 0},
+                 kParams[state.range(1)]);
+}
+
+BENCHMARK(BM_FlareSplitParams)
+    ->ArgsProduct({{0, 1}, {0, 1, 2, 3, 4, 5}})
+    ->ArgNames({"mixed", "params"})
     ->UseManualTime()
     ->Unit(benchmark::kMicrosecond);
 

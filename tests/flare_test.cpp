@@ -670,6 +670,15 @@ TEST_F(FlareTest, PrePassGatherGivesTheSameBitsAtEveryTileHeight) {
             << fmt << ", " << r << " rows" << (centre_first ? ", centre first" : "") << " against 1 row";
       }
     }
+    // Other workgroup shapes (the benchmarks compare them per device): other tiles, the same sums.
+    for (detail::Workgroup2D g : {detail::Workgroup2D{16, 8}, detail::Workgroup2D{8, 16}, detail::Workgroup2D{64, 4},
+                                  detail::Workgroup2D{4, 4}}) {
+      detail::LensFlareAccess::set_gather_workgroup(flare, g.x, g.y);
+      EXPECT_EQ(detail::LensFlareAccess::gather_tile(flare, false, 500).width, g.x) << fmt;
+      const CpuImage image = draw(flare, Path::compute, background, format, in, config);
+      EXPECT_EQ(std::memcmp(image.rgba.data(), images.front().rgba.data(), images.front().rgba.size() * 4), 0)
+          << fmt << ", workgroup " << g.x << "x" << g.y << " against the device's";
+    }
     EXPECT_NE(std::memcmp(images[0].rgba.data(), background.rgba.data(), background.rgba.size() * 4), 0)
         << fmt << ": drew nothing";
     const auto ref = reference::flare_composite(background, lights, uint32_t(lights.size()), config, atlas,
@@ -678,6 +687,8 @@ TEST_F(FlareTest, PrePassGatherGivesTheSameBitsAtEveryTileHeight) {
     EXPECT_EQ(d.outside, 0u) << fmt << ": " << d.first;
     EXPECT_THROW(detail::LensFlareAccess::set_pre_pass_tiles(flare, 0, false), Error);
     EXPECT_THROW(detail::LensFlareAccess::set_pre_pass_tiles(flare, GLINT_FLARE_GATHER_ROWS + 1, true), Error);
+    EXPECT_THROW(detail::LensFlareAccess::set_gather_workgroup(flare, 2, 4), Error);
+    EXPECT_THROW(detail::LensFlareAccess::set_gather_workgroup(flare, 32, 16), Error);
   }
 }
 

@@ -256,6 +256,27 @@ void LensFlareAccess::set_pre_pass_tiles(LensFlare& flare, uint32_t rows, bool c
   m.make_split_buffers();
 }
 
+void LensFlareAccess::set_gather_workgroup(LensFlare& flare, uint32_t x, uint32_t y) {
+  LensFlare::Impl& m = *flare.impl_;
+  const uint64_t threads = uint64_t(x) * y;
+  if (x < 1 || y < 1 || threads < GLINT_FLARE_SPRITES || threads > GLINT_FLARE_GATHER_MAX_THREADS ||
+      threads > m.context->info().max_workgroup_invocations) {
+    throw Error(
+        ErrorCode::invalid_argument,
+        concat("LensFlareAccess::set_gather_workgroup: ", x, "x", y, " is out of range: accepted ", GLINT_FLARE_SPRITES,
+               " to ", std::min<uint32_t>(GLINT_FLARE_GATHER_MAX_THREADS, m.context->info().max_workgroup_invocations),
+               " invocations"));
+  }
+  m.workgroup = {x, y};
+  m.tiles_one_dispatch = m.gather_tiles(m.tiles_one_dispatch.rows, m.tiles_one_dispatch.centre_first);
+  m.tiles_pre_pass = m.gather_tiles(m.tiles_pre_pass.rows, m.tiles_pre_pass.centre_first);
+  m.tiles_split = m.gather_tiles(m.tiles_split.rows, m.tiles_split.centre_first);
+  if (m.one_dispatch_limit > 0) m.one_dispatch_limit = m.one_dispatch_batch();
+  m.make_compute_pipelines();
+  m.gather_beyond = {};
+  m.gather_beyond_split = {};
+}
+
 void LensFlareAccess::set_split(LensFlare& flare, bool on, uint32_t min_sprites, uint32_t sprites_per_slice,
                                 uint32_t max_slices) {
   if (sprites_per_slice < 1 || max_slices < 1 || max_slices > 31) {
