@@ -117,7 +117,7 @@ TileLoad tile_load(const std::vector<reference::FlareSprite>& sprites, uint32_t 
 // pre-pass draw split no tile or the crowded ones (-1: as the device and buffer choose).
 void run_flare_draw(benchmark::State& state, uint32_t width, uint32_t height, uint32_t lights, bool compute, bool mixed,
                     detail::FlareGatherPath path, int split = -1, detail::Workgroup2D gather_workgroup = {0, 0},
-                    const uint32_t* split_params = nullptr) {
+                    const uint32_t* split_params = nullptr, uint32_t one_dispatch_rows = 0) {
   const Context& ctx = context();
   const VkFormat format = VK_FORMAT_R16G16B16A16_SFLOAT;
 
@@ -127,8 +127,13 @@ void run_flare_draw(benchmark::State& state, uint32_t width, uint32_t height, ui
   detail::LensFlareAccess::select_gather(flare, path);
   if (split >= 0) detail::LensFlareAccess::set_split(flare, split == 1);
   if (split_params) detail::LensFlareAccess::set_split(flare, true, split_params[0], split_params[1], split_params[2]);
-  if (gather_workgroup.x != 0)
-    detail::LensFlareAccess::set_gather_workgroup(flare, gather_workgroup.x, gather_workgroup.y);
+  if (gather_workgroup.x != 0 || one_dispatch_rows != 0) {
+    // The one-dispatch gather's shape when that path is forced, else the pre-pass gathers'.
+    const bool one = path == detail::FlareGatherPath::one_dispatch;
+    const detail::FlareGatherTile t = detail::LensFlareAccess::gather_tile(flare, one, lights);
+    const detail::Workgroup2D g = gather_workgroup.x != 0 ? gather_workgroup : detail::Workgroup2D{t.width, t.row_step};
+    detail::LensFlareAccess::set_gather_workgroup(flare, g.x, g.y, one, one_dispatch_rows);
+  }
   const FlareConfig config = FlareConfig::preset(FlarePreset::cinematic);
 
   const std::vector<GlintFlareInstance> list = bench_lights(lights, width, height, mixed);
@@ -255,24 +260,29 @@ BENCHMARK(BM_FlareSplit)
     ->UseManualTime()
     ->Unit(benchmark::kMicrosecond);
 
-// The compute draw (1920x1080, mixed sizes unless `mixed` is 0) with the gather in other workgroup
-// shapes: 0 the device's (32x8 on GPUs), 1 16x8, 2 16x16, 3 64x4, 4 8x16; each tile as many rows
-// per invocation as the path takes by default, the split as the instances buffer decides.
+// The compute draw (1920x1080, mixed sizes unless `mixed` is 0) with a gather in other workgroup
+// shapes: the pre-pass gathers (one:0) or the one-dispatch gather (one:1, with `rows` rows per
+// invocation, 0 its default) in shape 0 the device's (32x8 and 16x16 on GPUs), 1 16x8, 2 16x16,
+// 3 64x4, 4 8x16, 5 32x8, 6 8x32; the split as the instances buffer decides.
 void BM_FlareGatherShape(benchmark::State& state) {
-  static const detail::Workgroup2D kShapes[] = {{0, 0}, {16, 8}, {16, 16}, {64, 4}, {8, 16}};
-  const detail::Workgroup2D g = kShapes[state.range(2)];
+  static const detail::Workgroup2D kShapes[] = {{0, 0}, {16, 8}, {16, 16}, {64, 4}, {8, 16}, {32, 8}, {8, 32}};
+  const detail::Workgroup2D g = kShapes[state.range(3)];
   if (g.x * g.y > context().info().max_workgroup_invocations) {
     state.SkipWithError("the shape exceeds the device's maxComputeWorkGroupInvocations");
     return;
   }
+  const bool one = state.range(2) != 0;
   run_flare_draw(state, 1920, 1080, static_cast<uint32_t>(state.range(0)), true, state.range(1) != 0,
-                 detail::FlareGatherPath::device, -1, g);
+                 one ? detail::FlareGatherPath::one_dispatch : detail::FlareGatherPath::device, -1, g, nullptr,
+                 static_cast<uint32_t>(state.range(4)));
 }
 
 BENCHMARK(BM_FlareGatherShape)
-    ->ArgsProduct({{10, 1000}, {0}, {0, 1, 2, 3, 4}})
-    ->ArgsProduct({{256, 1000}, {1}, {0, 1, 2, 3, 4}})
-    ->ArgNames({"lights", "mixed", "shape"})
+    ->ArgsProduct({{10, 1000}, {0}, {0}, {0, 1, 2, 3, 4}, {0}})
+    ->ArgsProduct({{256, 1000}, {1}, {0}, {0, 1, 2, 3, 4}, {0}})
+    ->ArgsProduct({{10}, {0}, {1}, {0, 2, 5, 6}, {0, 2, 4}})
+    ->ArgsProduct({{16}, {1}, {1}, {0, 5}, {0}})
+    ->ArgNames({"lights", "mixed", "one", "shape", "rows"})
     ->UseManualTime()
     ->Unit(benchmark::kMicrosecond);
 

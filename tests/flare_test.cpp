@@ -679,6 +679,19 @@ TEST_F(FlareTest, PrePassGatherGivesTheSameBitsAtEveryTileHeight) {
       EXPECT_EQ(std::memcmp(image.rgba.data(), images.front().rgba.data(), images.front().rgba.size() * 4), 0)
           << fmt << ", workgroup " << g.x << "x" << g.y << " against the device's";
     }
+    // The one-dispatch gather (several batches of 37 instances) in other shapes and rows.
+    detail::LensFlareAccess::select_gather(flare, detail::FlareGatherPath::one_dispatch);
+    for (auto [g, rows] : {std::pair{detail::Workgroup2D{16, 16}, 8u}, std::pair{detail::Workgroup2D{32, 8}, 2u},
+                           std::pair{detail::Workgroup2D{8, 32}, 4u}}) {
+      detail::LensFlareAccess::set_gather_workgroup(flare, g.x, g.y, true, rows);
+      const detail::FlareGatherTile tile = detail::LensFlareAccess::gather_tile(flare, true, 37);
+      EXPECT_EQ(tile.width, g.x) << fmt;
+      EXPECT_EQ(tile.height, g.y * rows) << fmt;
+      const CpuImage image = draw(flare, Path::compute, background, format, in, config);
+      EXPECT_EQ(std::memcmp(image.rgba.data(), images.front().rgba.data(), images.front().rgba.size() * 4), 0)
+          << fmt << ", one dispatch in " << g.x << "x" << g.y << ", " << rows << " rows, against the pre-pass";
+    }
+    detail::LensFlareAccess::select_gather(flare, detail::FlareGatherPath::pre_pass);
     EXPECT_NE(std::memcmp(images[0].rgba.data(), background.rgba.data(), background.rgba.size() * 4), 0)
         << fmt << ": drew nothing";
     const auto ref = reference::flare_composite(background, lights, uint32_t(lights.size()), config, atlas,
@@ -689,6 +702,8 @@ TEST_F(FlareTest, PrePassGatherGivesTheSameBitsAtEveryTileHeight) {
     EXPECT_THROW(detail::LensFlareAccess::set_pre_pass_tiles(flare, GLINT_FLARE_GATHER_ROWS + 1, true), Error);
     EXPECT_THROW(detail::LensFlareAccess::set_gather_workgroup(flare, 2, 4), Error);
     EXPECT_THROW(detail::LensFlareAccess::set_gather_workgroup(flare, 32, 16), Error);
+    EXPECT_THROW(detail::LensFlareAccess::set_gather_workgroup(flare, 16, 16, true, GLINT_FLARE_GATHER_ROWS + 1),
+                 Error);
   }
 }
 

@@ -138,8 +138,8 @@ GlintFlarePush LensFlare::Impl::push(const FlareConfig& c) const {
   p.ghost_pos2 = c.ghost_positions[2];
   p.ghost_pos3 = c.ghost_positions[3];
   p.ghost_pos4 = c.ghost_positions[4];
-  p.tile_w = workgroup.x;
-  p.tile_h = 0;         // record_compute sets its path's (0 would draw nothing)
+  p.tile_w = 0;  // record_compute sets its path's tile (0 would draw nothing)
+  p.tile_h = 0;
   p.indirect_word = 0;  // set by record_compute
   return p;
 }
@@ -190,24 +190,25 @@ LensFlare::LensFlare(const Context& context, VkFormat color_format, VkExtent2D e
   m.max_stored_instances = uint32_t(props.limits.maxStorageBufferRange / kBlockBytes);
   m.max_groups_x = props.limits.maxComputeWorkGroupCount[0];
   m.storage_alignment = std::max<VkDeviceSize>(1, props.limits.minStorageBufferOffsetAlignment);
-  // The gather's workgroup: 32x8 on GPUs (on the H100 it beat 16x8 when both gathered 8 rows, 16x8's
-  // tiles binning every instance twice as often: docs/FLARE.md), the device's 2D choice (8x8) on CPU
-  // devices.
+  // The gathers' workgroups, as measured (docs/FLARE.md, "Speed"): on GPUs 32x8 for the pre-pass
+  // gathers (on the H100 it beat 16x8 when both gathered 8 rows, 16x8's tiles binning every
+  // instance twice as often; on the H200 16x8, 16x16, 64x4 and 8x16 were slower with and without
+  // the split) and GLINT_FLARE_ONE_DISPATCH_GROUP for the one-dispatch gather; the device's 2D
+  // choice (8x8, or ContextOptions::workgroup_2d) on CPU devices.
   const bool cpu = context.info().type == VK_PHYSICAL_DEVICE_TYPE_CPU;
-  m.workgroup = detail::choose_workgroup_2d(context);
-  if (!cpu && context.info().max_workgroup_invocations >= 256 && context.info().subgroup_size >= 32) {
-    m.workgroup = {32, 8};
-  }
-  if (m.workgroup.x * m.workgroup.y > GLINT_FLARE_GATHER_MAX_THREADS) m.workgroup = {16, 16};
+  const bool gpu_shapes = !cpu && context.info().max_workgroup_invocations >= 256 && context.info().subgroup_size >= 32;
+  detail::Workgroup2D group = detail::choose_workgroup_2d(context), one_group = group;
+  if (gpu_shapes) group = {32, 8}, one_group = {GLINT_FLARE_ONE_DISPATCH_GROUP_X, GLINT_FLARE_ONE_DISPATCH_GROUP_Y};
+  if (group.x * group.y > GLINT_FLARE_GATHER_MAX_THREADS) group = one_group = {16, 16};
+  // The tiles of each gather (flare_params.h): on GPUs the pre-pass gather starts from the image
+  // centre, where every light's ghost at t = 1 piles up, in tiles 4 times shorter, or, for
+  // instances buffers of GLINT_FLARE_SPLIT_FROM_INSTANCES and more, in full tiles with the crowded
+  // ones split; the one-dispatch gather and CPU devices take full tiles in the workgroup IDs' order
+  // and split none, which was faster there.
+  m.tiles_one_dispatch = m.gather_tiles(GLINT_FLARE_GATHER_ROWS, false, one_group);
+  m.tiles_pre_pass = m.gather_tiles(cpu ? GLINT_FLARE_GATHER_ROWS : GLINT_FLARE_GATHER_PRE_PASS_ROWS, !cpu, group);
+  m.tiles_split = m.gather_tiles(GLINT_FLARE_GATHER_ROWS, !cpu, group);
   m.one_dispatch_limit = cpu ? 0 : m.one_dispatch_batch();
-  // The tiles of each gather, as measured (docs/FLARE.md, "Speed"; flare_params.h): on GPUs the
-  // pre-pass gather starts from the image centre, where every light's ghost at t = 1 piles up, in
-  // tiles 4 times shorter, or, for instances buffers of GLINT_FLARE_SPLIT_FROM_INSTANCES and more,
-  // in full tiles with the crowded ones split; the one-dispatch gather and CPU devices take full
-  // tiles in the workgroup IDs' order and split none, which was faster there.
-  m.tiles_one_dispatch = m.gather_tiles(GLINT_FLARE_GATHER_ROWS, false);
-  m.tiles_pre_pass = m.gather_tiles(cpu ? GLINT_FLARE_GATHER_ROWS : GLINT_FLARE_GATHER_PRE_PASS_ROWS, !cpu);
-  m.tiles_split = m.gather_tiles(GLINT_FLARE_GATHER_ROWS, !cpu);
   m.split_from = cpu ? UINT32_MAX : GLINT_FLARE_SPLIT_FROM_INSTANCES;
   m.split_params = {0, 0, 0, 0, GLINT_FLARE_SPLIT_MIN_SPRITES, GLINT_FLARE_SPLIT_SPRITES, GLINT_FLARE_SPLIT_MAX_SLICES,
                     0};

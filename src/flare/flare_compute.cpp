@@ -13,8 +13,8 @@ detail::ComputePipeline LensFlare::Impl::make_gather(uint32_t beyond_store, uint
   d.kernel_id = std::string("flare_gather_") + detail::format_variant(format);
   d.bindings = {SB, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, SB, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, SB, SB, SB};
   d.push_constant_bytes = sizeof(GlintFlarePush);
-  d.workgroup = workgroup;
   const GatherTiles& tiles = one_dispatch ? tiles_one_dispatch : split ? tiles_split : tiles_pre_pass;
+  d.workgroup = tiles.group;
   d.specialization = {beyond_store, one_dispatch, tiles.rows, tiles.centre_first ? 1u : 0u, split ? 1u : 0u};
   return detail::ComputePipeline(*context, d);
 }
@@ -28,16 +28,18 @@ void LensFlare::Impl::make_split_buffers() {
   split_state = Buffer{split_buffer.buffer(), 0, words * 4, usage, VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE};
   split_cleared = false;
   // A slot holds one slice's sums: one vec4 per pixel of a tile.
-  const VkDeviceSize partial_bytes =
-      split() ? VkDeviceSize(GLINT_FLARE_SPLIT_SLOTS) * workgroup.x * workgroup.y * tiles_split.rows * 16 : 16;
+  const VkDeviceSize partial_bytes = split() ? VkDeviceSize(GLINT_FLARE_SPLIT_SLOTS) * tiles_split.group.x *
+                                                   tiles_split.group.y * tiles_split.rows * 16
+                                             : 16;
   partials_buffer = detail::OwnedBuffer(*context, partial_bytes, usage, false);
   partials_state =
       Buffer{partials_buffer.buffer(), 0, partial_bytes, usage, VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE};
 }
 
-LensFlare::Impl::GatherTiles LensFlare::Impl::gather_tiles(uint32_t rows, bool centre_first) const {
-  const uint32_t tile_h = workgroup.y * rows;
-  return {rows, (extent.width + workgroup.x - 1) / workgroup.x, (extent.height + tile_h - 1) / tile_h, centre_first};
+LensFlare::Impl::GatherTiles LensFlare::Impl::gather_tiles(uint32_t rows, bool centre_first,
+                                                           detail::Workgroup2D group) const {
+  const uint32_t tile_h = group.y * rows;
+  return {rows, (extent.width + group.x - 1) / group.x, (extent.height + tile_h - 1) / tile_h, centre_first, group};
 }
 
 void LensFlare::Impl::make_compute_pipelines() {
@@ -125,7 +127,9 @@ void LensFlare::record_compute(VkCommandBuffer cmd, Image& color, Buffer& instan
     b.use(m.split_state, kCompute, kStorageRW);
     b.use(m.partials_state, kCompute, kStorageRW);
     b.flush(cmd);
-    p.tile_h = m.workgroup.y * m.tiles_one_dispatch.rows;
+    const Impl::GatherTiles& tiles = m.tiles_one_dispatch;
+    p.tile_w = tiles.group.x;
+    p.tile_h = tiles.group.y * tiles.rows;
     m.gather_one_dispatch.dispatch(cmd,
                                    {instances,
                                     m.atlas_binding(),
@@ -134,7 +138,7 @@ void LensFlare::record_compute(VkCommandBuffer cmd, Image& color, Buffer& instan
                                     instances,
                                     m.split_state,
                                     m.partials_state},
-                                   p, m.tiles_one_dispatch.x * m.workgroup.x, m.tiles_one_dispatch.y * m.workgroup.y);
+                                   p, tiles.x * tiles.group.x, tiles.y * tiles.group.y);
     if (profiler) profiler->mark(cmd, "flare gather");
     return;
   }
@@ -182,7 +186,8 @@ void LensFlare::record_compute(VkCommandBuffer cmd, Image& color, Buffer& instan
   }
   // 2. The sprite pre-pass: every sprite of every instance, once (with the split, each tile's
   //    count of sprites too).
-  p.tile_h = m.workgroup.y * tiles.rows;
+  p.tile_w = tiles.group.x;
+  p.tile_h = tiles.group.y * tiles.rows;
   b.use(m.gather_args_state, kIndirect, VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT);
   b.use(instances, kCompute, VK_ACCESS_2_SHADER_STORAGE_READ_BIT);
   b.use(store, kCompute, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
@@ -239,7 +244,7 @@ FlareGatherTile LensFlareAccess::gather_tile(const LensFlare& flare, bool one_di
   const LensFlare::Impl::GatherTiles& t = one_dispatch          ? m.tiles_one_dispatch
                                           : m.splits(instances) ? m.tiles_split
                                                                 : m.tiles_pre_pass;
-  return {m.workgroup.x, m.workgroup.y * t.rows, m.workgroup.y, t.centre_first};
+  return {t.group.x, t.group.y * t.rows, t.group.y, t.centre_first};
 }
 
 void LensFlareAccess::set_pre_pass_tiles(LensFlare& flare, uint32_t rows, bool centre_first) {
@@ -248,7 +253,7 @@ void LensFlareAccess::set_pre_pass_tiles(LensFlare& flare, uint32_t rows, bool c
                                                     "; accepted 1 to ", GLINT_FLARE_GATHER_ROWS));
   }
   LensFlare::Impl& m = *flare.impl_;
-  m.tiles_pre_pass = m.tiles_split = m.gather_tiles(rows, centre_first);
+  m.tiles_pre_pass = m.tiles_split = m.gather_tiles(rows, centre_first, m.tiles_pre_pass.group);
   m.gather = m.make_gather(0, 0);
   if (m.split()) m.gather_split = m.make_gather(0, 0, true);
   m.gather_beyond = {};  // both made again at their next use, with these tiles
@@ -256,22 +261,26 @@ void LensFlareAccess::set_pre_pass_tiles(LensFlare& flare, uint32_t rows, bool c
   m.make_split_buffers();
 }
 
-void LensFlareAccess::set_gather_workgroup(LensFlare& flare, uint32_t x, uint32_t y) {
+void LensFlareAccess::set_gather_workgroup(LensFlare& flare, uint32_t x, uint32_t y, bool one_dispatch, uint32_t rows) {
   LensFlare::Impl& m = *flare.impl_;
   const uint64_t threads = uint64_t(x) * y;
   if (x < 1 || y < 1 || threads < GLINT_FLARE_SPRITES || threads > GLINT_FLARE_GATHER_MAX_THREADS ||
-      threads > m.context->info().max_workgroup_invocations) {
-    throw Error(
-        ErrorCode::invalid_argument,
-        concat("LensFlareAccess::set_gather_workgroup: ", x, "x", y, " is out of range: accepted ", GLINT_FLARE_SPRITES,
-               " to ", std::min<uint32_t>(GLINT_FLARE_GATHER_MAX_THREADS, m.context->info().max_workgroup_invocations),
-               " invocations"));
+      threads > m.context->info().max_workgroup_invocations || rows > GLINT_FLARE_GATHER_ROWS) {
+    throw Error(ErrorCode::invalid_argument,
+                concat("LensFlareAccess::set_gather_workgroup: ", x, "x", y, " with ", rows,
+                       " rows is out of range: accepted ", GLINT_FLARE_SPRITES, " to ",
+                       std::min<uint32_t>(GLINT_FLARE_GATHER_MAX_THREADS, m.context->info().max_workgroup_invocations),
+                       " invocations and 0 (unchanged) to ", GLINT_FLARE_GATHER_ROWS, " rows"));
   }
-  m.workgroup = {x, y};
-  m.tiles_one_dispatch = m.gather_tiles(m.tiles_one_dispatch.rows, m.tiles_one_dispatch.centre_first);
-  m.tiles_pre_pass = m.gather_tiles(m.tiles_pre_pass.rows, m.tiles_pre_pass.centre_first);
-  m.tiles_split = m.gather_tiles(m.tiles_split.rows, m.tiles_split.centre_first);
-  if (m.one_dispatch_limit > 0) m.one_dispatch_limit = m.one_dispatch_batch();
+  LensFlare::Impl::GatherTiles& one = m.tiles_one_dispatch;
+  if (one_dispatch) {
+    one = m.gather_tiles(rows != 0 ? rows : one.rows, one.centre_first, {x, y});
+    if (m.one_dispatch_limit > 0) m.one_dispatch_limit = m.one_dispatch_batch();
+  } else {
+    m.tiles_pre_pass = m.gather_tiles(m.tiles_pre_pass.rows, m.tiles_pre_pass.centre_first, {x, y});
+    m.tiles_split = m.gather_tiles(m.tiles_split.rows, m.tiles_split.centre_first, {x, y});
+  }
+  m.gather_one_dispatch = {};  // made again by make_compute_pipelines() on GPUs, else at its next use
   m.make_compute_pipelines();
   m.gather_beyond = {};
   m.gather_beyond_split = {};

@@ -46,14 +46,15 @@ struct LensFlare::Impl {
   uint32_t max_stored_instances = 0;     // instances whose sprite blocks one descriptor can hold
   uint32_t max_groups_x = 65535;         // maxComputeWorkGroupCount[0]
   VkDeviceSize storage_alignment = 256;  // minStorageBufferOffsetAlignment
-  detail::Workgroup2D workgroup;         // the gather's workgroup
-  // The gather's tiles, workgroup x by workgroup y * rows pixels (GLINT_FLARE_GATHER_ROWS, except
-  // the pre-pass gather's without the split on GPUs: GLINT_FLARE_GATHER_PRE_PASS_ROWS; tests may
-  // set others). centre_first: the workgroups take the tiles from the image centre outwards
-  // (specialization constant 5; the pre-pass gathers on GPUs).
+  // Each gather's tiles: `group` x by group.y * rows pixels (GLINT_FLARE_GATHER_ROWS, except the
+  // pre-pass gather's without the split on GPUs: GLINT_FLARE_GATHER_PRE_PASS_ROWS; tests may set
+  // others), x by y of them; `group` is the gather's workgroup. centre_first: the workgroups take
+  // the tiles from the image centre outwards (specialization constant 5; the pre-pass gathers on
+  // GPUs).
   struct GatherTiles {
     uint32_t rows = GLINT_FLARE_GATHER_ROWS, x = 0, y = 0;
     bool centre_first = false;
+    detail::Workgroup2D group;
   };
   // tiles_split: the pre-pass gather's when it splits crowded tiles.
   GatherTiles tiles_one_dispatch, tiles_pre_pass, tiles_split;
@@ -127,9 +128,11 @@ struct LensFlare::Impl {
   void make_compute_pipelines();
   void make_split_buffers();  // for tiles_split, when split()
   detail::ComputePipeline make_gather(uint32_t beyond_store, uint32_t one_dispatch, bool split = false) const;
-  GatherTiles gather_tiles(uint32_t rows, bool centre_first) const;
+  GatherTiles gather_tiles(uint32_t rows, bool centre_first, detail::Workgroup2D group) const;
   // Instances per batch of the one-dispatch gather (one invocation per sprite).
-  uint32_t one_dispatch_batch() const { return workgroup.x * workgroup.y / GLINT_FLARE_SPRITES; }
+  uint32_t one_dispatch_batch() const {
+    return tiles_one_dispatch.group.x * tiles_one_dispatch.group.y / GLINT_FLARE_SPRITES;
+  }
   // The most instances for which record_compute() takes the one-dispatch gather by itself: one
   // batch on GPUs; none on CPU devices, which run a tile's invocations one after another, so that
   // every tile evaluating the sprites itself costs more than the two dispatches it saves (lavapipe,

@@ -51,11 +51,14 @@ struct LensFlareAccess {
   static void set_split(LensFlare& flare, bool on, uint32_t min_sprites = GLINT_FLARE_SPLIT_MIN_SPRITES,
                         uint32_t sprites_per_slice = GLINT_FLARE_SPLIT_SPRITES,
                         uint32_t max_slices = GLINT_FLARE_SPLIT_MAX_SLICES);
-  /// Makes every gather run in workgroups of `g` (tiles g.x wide, each invocation shading as many
-  /// rows as before) from now on: the benchmarks compare shapes per device. The one-dispatch limit
-  /// follows the workgroup's size (GPUs). g.x * g.y is 16 (one instance's sprites) to
-  /// GLINT_FLARE_GATHER_MAX_THREADS. Remakes pipelines and buffers, as set_pre_pass_tiles().
-  static void set_gather_workgroup(LensFlare& flare, uint32_t x, uint32_t y);
+  /// Makes the pre-pass gathers (with and without the split), or with `one_dispatch` the
+  /// one-dispatch gather, run in workgroups of x by y (tiles x wide) from now on, each invocation
+  /// shading as many rows as before, or (one-dispatch gather) `rows` if not 0: the benchmarks
+  /// compare shapes per device. The one-dispatch limit follows its workgroup's size (GPUs). x * y
+  /// is 16 (one instance's sprites) to GLINT_FLARE_GATHER_MAX_THREADS, rows at most
+  /// GLINT_FLARE_GATHER_ROWS. Remakes pipelines and buffers, as set_pre_pass_tiles().
+  static void set_gather_workgroup(LensFlare& flare, uint32_t x, uint32_t y, bool one_dispatch = false,
+                                   uint32_t rows = 0);
   /// Whether record_compute() splits crowded tiles in a pre-pass draw from an instances buffer of
   /// `instances` instances.
   static bool splits(const LensFlare& flare, uint64_t instances);
