@@ -193,7 +193,7 @@ LensFlare::LensFlare(const Context& context, VkFormat color_format, VkExtent2D e
   // The gathers' workgroups, as measured (docs/FLARE.md, "Speed"): on GPUs 32x8 for the pre-pass
   // gathers (on the H100 it beat 16x8 when both gathered 8 rows, 16x8's tiles binning every
   // instance twice as often; on the H200 16x8, 16x16, 64x4 and 8x16 were slower with and without
-  // the split) and GLINT_FLARE_ONE_DISPATCH_GROUP for the one-dispatch gather; the device's 2D
+  // the split) and GLINT_FLARE_ONE_DISPATCH_GROUP_X/Y (the same) for the one-dispatch gather; the device's 2D
   // choice (8x8, or ContextOptions::workgroup_2d) on CPU devices.
   const bool cpu = context.info().type == VK_PHYSICAL_DEVICE_TYPE_CPU;
   const bool gpu_shapes = !cpu && context.info().max_workgroup_invocations >= 256 && context.info().subgroup_size >= 32;

@@ -82,11 +82,11 @@
 #define GLINT_FLARE_GATHER_ROWS 8u
 #define GLINT_FLARE_GATHER_PRE_PASS_ROWS 2u
 #define GLINT_FLARE_GATHER_MAX_THREADS 256u
-// The one-dispatch gather's workgroup on GPUs (the pre-pass gathers take 32x8): 16x16, tiles of
-// 16x128 pixels. On the H200, 10 lights at 1080p: 34.1 us against 34.8 in 32x8, 37.9 in 64x4
-// (docs/FLARE.md, "Speed").
-#define GLINT_FLARE_ONE_DISPATCH_GROUP_X 16u
-#define GLINT_FLARE_ONE_DISPATCH_GROUP_Y 16u
+// The one-dispatch gather's workgroup on GPUs, as the pre-pass gathers': 32x8 (32x64 tiles). On
+// the H200 16x16 drew BM_FlareDraw's 10 lights in 34.1 us against 34.7, but 16 mixed lights in
+// 30.3 against 27.7 and the 10-light frame in 33.9 against 33.7 (docs/FLARE.md, "Speed").
+#define GLINT_FLARE_ONE_DISPATCH_GROUP_X 32u
+#define GLINT_FLARE_ONE_DISPATCH_GROUP_Y 8u
 
 // Crowded tiles (the pre-pass gather on GPUs for instances buffers of at least
 // GLINT_FLARE_SPLIT_FROM_INSTANCES instances, in tiles of GLINT_FLARE_GATHER_ROWS rows; smaller
