@@ -97,6 +97,19 @@ Buffer buffer_view(const detail::OwnedBuffer& b, VkBufferUsageFlags usage, bool 
   return v;
 }
 
+std::vector<double> time_frames(benchmark::State& state, int frames,
+                                const std::function<void(VkCommandBuffer)>& record_frame) {
+  const Context& ctx = context();
+  Profiler profiler(ctx, frames + 1);
+  std::vector<double> frame_ms;
+  for (auto _ : state) {
+    const double median = median_frame_ms(ctx, profiler, frames, record_frame);
+    frame_ms.push_back(median);
+    state.SetIterationTime(median * 1e-3);
+  }
+  return frame_ms;
+}
+
 ImagePair rgba16f_pair(const Context& ctx, VkExtent2D extent, uint32_t stream) {
   const VkFormat format = VK_FORMAT_R16G16B16A16_SFLOAT;
   ImagePair pair{detail::OwnedImage(ctx, extent, format, detail::kToolImageUsage),

@@ -1,6 +1,7 @@
 // Shared benchmark helpers: one Context per process (GLINT_DEVICE picks it), inputs, medians.
 #pragma once
 
+#include <benchmark/benchmark.h>
 #include <glint/glint.h>
 
 #include <functional>
@@ -42,6 +43,11 @@ detail::OwnedImage depth_image(const Context& context, const reference::DepthIma
 /// marks of capacity.
 double median_frame_ms(const Context& context, Profiler& profiler, int frames,
                        const std::function<void(VkCommandBuffer)>& record_frame);
+
+/// Times `record_frame` once per benchmark iteration: the median of `frames` frames
+/// (median_frame_ms()) as the iteration's manual time. Returns those medians in milliseconds.
+std::vector<double> time_frames(benchmark::State& state, int frames,
+                                const std::function<void(VkCommandBuffer)>& record_frame);
 
 /// Records one frame with `record_frame` given a profiler (its own marks after each step, at most
 /// `capacity` - 1 of them), runs it, and returns the time between consecutive marks. The marks

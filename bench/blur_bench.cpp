@@ -89,22 +89,6 @@ reference::DoubleImage own_reference(const GaussianBlur& blur, const CpuImage& i
   }
 }
 
-// Times `record` once per benchmark iteration (the median frame of frames_per_iteration(), as
-// manual time) and returns those medians in milliseconds.
-template <typename Record>
-std::vector<double> time_frames(benchmark::State& state, Record record) {
-  const Context& ctx = context();
-  const int frames = frames_per_iteration();
-  Profiler profiler(ctx, frames + 1);
-  std::vector<double> frame_ms;
-  for (auto _ : state) {
-    const double median = median_frame_ms(ctx, profiler, frames, record);
-    frame_ms.push_back(median);
-    state.SetIterationTime(median * 1e-3);
-  }
-  return frame_ms;
-}
-
 // The counter of a stage mark: "us_" and the step's label, "gauss " dropped, every run of other
 // characters than letters and digits one '_' ("gauss pyramid level 1 (down)" ->
 // "us_pyramid_level_1_down").
@@ -143,7 +127,7 @@ void run_gauss_benchmark(benchmark::State& state, BlurMethod method, bool linear
   GaussianBlur blur(ctx, config);
   blur.prepare({width, height});
   const std::vector<double> frame_ms =
-      time_frames(state, [&](VkCommandBuffer cmd) { blur.record(cmd, in.state, dst.state); });
+      time_frames(state, frames_per_iteration(), [&](VkCommandBuffer cmd) { blur.record(cmd, in.state, dst.state); });
   add_stage_counters(state, [&](VkCommandBuffer cmd, Profiler* p) { blur.record(cmd, in.state, dst.state, p); });
 
   // Accuracy of the method the timed run chose (auto resolved), fp32 storage so that the method's
@@ -234,7 +218,7 @@ void BM_BlurLevelKernel(benchmark::State& state) {
     BlurPyramid pyramid(ctx, config);
     detail::BlurAccess::select_separable(pyramid, kernel);
     pyramid.prepare({width, height});
-    frame_ms = time_frames(state, [&](VkCommandBuffer cmd) { pyramid.record(cmd, in.state); });
+    frame_ms = time_frames(state, frames_per_iteration(), [&](VkCommandBuffer cmd) { pyramid.record(cmd, in.state); });
     streamed = detail::BlurAccess::streamed(pyramid);
     state.counters["gpu_ordered"] = detail::BlurAccess::gpu_ordered(pyramid);
     label = "BlurPyramid";
@@ -245,7 +229,8 @@ void BM_BlurLevelKernel(benchmark::State& state) {
     GaussianBlur blur(ctx, config);
     detail::BlurAccess::select_separable(blur, kernel);
     blur.prepare({width, height});
-    frame_ms = time_frames(state, [&](VkCommandBuffer cmd) { blur.record(cmd, in.state, dst.state); });
+    frame_ms =
+        time_frames(state, frames_per_iteration(), [&](VkCommandBuffer cmd) { blur.record(cmd, in.state, dst.state); });
     add_stage_counters(state, [&](VkCommandBuffer cmd, Profiler* p) { blur.record(cmd, in.state, dst.state, p); });
     streamed = detail::BlurAccess::streamed(blur);
     state.counters["gpu_ordered"] = detail::BlurAccess::gpu_ordered(blur);

@@ -226,13 +226,7 @@ void BM_DispatchChain(benchmark::State& state) {
                     push, width, height);
     }
   };
-  Profiler profiler(ctx, kCopies + 1);
-  std::vector<double> all;
-  for (auto _ : state) {
-    const double m = median_frame_ms(ctx, profiler, kCopies, frame);
-    all.push_back(m);
-    state.SetIterationTime(m * 1e-3);
-  }
+  const std::vector<double> all = time_frames(state, kCopies, frame);
   state.counters["median_us"] = median_of(all) * 1e3;
   state.counters["us_per_dispatch"] = median_of(all) * 1e3 / dispatches;
   state.SetLabel(std::string(dependent ? "dependent" : "independent") + " RGBA16F copies on " + ctx.info().name);
