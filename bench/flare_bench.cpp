@@ -261,9 +261,11 @@ BENCHMARK(BM_FlareSplit)
     ->Unit(benchmark::kMicrosecond);
 
 // The compute draw (1920x1080, mixed sizes unless `mixed` is 0) with a gather in other workgroup
-// shapes: the pre-pass gathers (one:0) or the one-dispatch gather (one:1, with `rows` rows per
-// invocation, 0 its default) in shape 0 the device's (32x8 and 16x16 on GPUs), 1 16x8, 2 16x16,
-// 3 64x4, 4 8x16, 5 32x8, 6 8x32; the split as the instances buffer decides.
+// shapes: the pre-pass gathers (one:0; light counts that take them) or the one-dispatch gather
+// (one:1, forced, with `rows` rows per invocation, 0 its default) in shape 0 the device's (32x8 on
+// GPUs), 1 16x8, 2 16x16, 3 64x4, 4 8x16, 5 32x8, 6 8x32; the split as the instances buffer
+// decides. (Before the gathers had shapes of their own, e784eea's one:0 rows of 10 lights set the
+// one-dispatch gather's shape too.)
 void BM_FlareGatherShape(benchmark::State& state) {
   static const detail::Workgroup2D kShapes[] = {{0, 0}, {16, 8}, {16, 16}, {64, 4}, {8, 16}, {32, 8}, {8, 32}};
   const detail::Workgroup2D g = kShapes[state.range(3)];
@@ -278,7 +280,7 @@ void BM_FlareGatherShape(benchmark::State& state) {
 }
 
 BENCHMARK(BM_FlareGatherShape)
-    ->ArgsProduct({{10, 1000}, {0}, {0}, {0, 1, 2, 3, 4}, {0}})
+    ->ArgsProduct({{1000}, {0}, {0}, {0, 1, 2, 3, 4}, {0}})
     ->ArgsProduct({{256, 1000}, {1}, {0}, {0, 1, 2, 3, 4}, {0}})
     ->ArgsProduct({{10}, {0}, {1}, {0, 2, 5, 6}, {0, 2, 4}})
     ->ArgsProduct({{16}, {1}, {1}, {0, 5}, {0}})

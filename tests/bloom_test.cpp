@@ -258,28 +258,36 @@ TEST_F(BloomTest, TwoToOneUpsampleAndCompositeMatchReferenceAtEveryRadius) {
 // is computed by the same expression from the same texels whatever the tile, so the images agree
 // to the rounding that the compiler's choice of FMA contraction may change (SPIR-V lets it fuse
 // a multiply and an add in one pipeline and not in another): 2^-20 relative, a few fp32 ulps.
-// Sizes with 2:1 steps throughout (96x64: bloom_up_2x, bloom_composite_2x) and without (100x70:
-// the tiled bloom_up and bloom_composite), a wide and a tall shape (32x4, 4x32: within the 32 KiB
-// of shared memory that lavapipe has), 3x5 (partial tiles everywhere) and one no device can run.
+// Sizes with 2:1 steps throughout (96x64) and with odd levels (100x70: the tiled bloom_up where a
+// level is not twice the next), each with the 2:1 upsample and composite kernels where they apply
+// and with the tiled ones everywhere (BloomPath's composite_2x and up_2x off); a wide and a tall
+// shape (32x4, 4x32: within the 32 KiB of shared memory that lavapipe has), 3x5 (partial tiles
+// everywhere) and one no device can run.
 TEST_F(BloomTest, LaterKernelsInOtherWorkgroupShapesGiveTheSameImage) {
   for (BloomFilter filter : {BloomFilter::cod13, BloomFilter::dual, BloomFilter::gauss9}) {
     const BloomConfig config = added_light_config(filter);
     Bloom base(context(), config), other(context(), config);
-    for (detail::Workgroup2D g : {detail::Workgroup2D{32, 4}, detail::Workgroup2D{4, 32}, detail::Workgroup2D{3, 5}}) {
-      detail::BloomPath path;
-      path.down_workgroup = path.up_workgroup = path.composite_workgroup = g;
-      detail::BloomAccess::set_path(other, path);
-      for (VkExtent2D size : {VkExtent2D{96, 64}, VkExtent2D{100, 70}}) {
-        const CpuImage input = random_hdr(size.width, size.height, size.width + 7 * size.height);
-        const CpuImage a = run_bloom(base, input, kF32, kF32), b = run_bloom(other, input, kF32, kF32);
-        const std::string what = std::string(bloom_filter_name(filter)) + " " + std::to_string(size.width) + "x" +
-                                 std::to_string(size.height) + " in " + std::to_string(g.x) + "x" + std::to_string(g.y);
-        ASSERT_EQ(a.rgba.size(), b.rgba.size());
-        size_t differ = 0;
-        for (size_t i = 0; i < a.rgba.size(); ++i)
-          differ += !(std::abs(a.rgba[i] - b.rgba[i]) <= 0x1p-20f * std::max(1.0f, std::abs(a.rgba[i])));
-        EXPECT_EQ(differ, 0u) << what << ": values where the shapes differ";
-        EXPECT_LT(added_light_error(b, input, config), 1e-3) << what;
+    for (bool tiled : {false, true}) {
+      for (detail::Workgroup2D g :
+           {detail::Workgroup2D{32, 4}, detail::Workgroup2D{4, 32}, detail::Workgroup2D{3, 5}}) {
+        detail::BloomPath path;
+        path.composite_2x = path.up_2x = !tiled;
+        detail::BloomAccess::set_path(base, path);
+        path.down_workgroup = path.up_workgroup = path.composite_workgroup = g;
+        detail::BloomAccess::set_path(other, path);
+        for (VkExtent2D size : {VkExtent2D{96, 64}, VkExtent2D{100, 70}}) {
+          const CpuImage input = random_hdr(size.width, size.height, size.width + 7 * size.height);
+          const CpuImage a = run_bloom(base, input, kF32, kF32), b = run_bloom(other, input, kF32, kF32);
+          const std::string what = std::string(bloom_filter_name(filter)) + " " + std::to_string(size.width) + "x" +
+                                   std::to_string(size.height) + " in " + std::to_string(g.x) + "x" +
+                                   std::to_string(g.y) + (tiled ? ", tiled kernels" : "");
+          ASSERT_EQ(a.rgba.size(), b.rgba.size());
+          size_t differ = 0;
+          for (size_t i = 0; i < a.rgba.size(); ++i)
+            differ += !(std::abs(a.rgba[i] - b.rgba[i]) <= 0x1p-20f * std::max(1.0f, std::abs(a.rgba[i])));
+          EXPECT_EQ(differ, 0u) << what << ": values where the shapes differ";
+          EXPECT_LT(added_light_error(b, input, config), 1e-3) << what;
+        }
       }
     }
   }

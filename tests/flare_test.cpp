@@ -679,7 +679,7 @@ TEST_F(FlareTest, PrePassGatherGivesTheSameBitsAtEveryTileHeight) {
       EXPECT_EQ(std::memcmp(image.rgba.data(), images.front().rgba.data(), images.front().rgba.size() * 4), 0)
           << fmt << ", workgroup " << g.x << "x" << g.y << " against the device's";
     }
-    // The one-dispatch gather (several batches of 37 instances) in other shapes and rows.
+    // The one-dispatch gather (forced: the piled lights make several batches) in other shapes and rows.
     detail::LensFlareAccess::select_gather(flare, detail::FlareGatherPath::one_dispatch);
     for (auto [g, rows] : {std::pair{detail::Workgroup2D{16, 16}, 8u}, std::pair{detail::Workgroup2D{32, 8}, 2u},
                            std::pair{detail::Workgroup2D{8, 32}, 4u}}) {
@@ -704,6 +704,7 @@ TEST_F(FlareTest, PrePassGatherGivesTheSameBitsAtEveryTileHeight) {
     EXPECT_THROW(detail::LensFlareAccess::set_gather_workgroup(flare, 32, 16), Error);
     EXPECT_THROW(detail::LensFlareAccess::set_gather_workgroup(flare, 16, 16, true, GLINT_FLARE_GATHER_ROWS + 1),
                  Error);
+    EXPECT_THROW(detail::LensFlareAccess::set_gather_workgroup(flare, 32, 8, false, 2), Error);
   }
 }
 

@@ -597,18 +597,23 @@ void BloomAccess::set_path(Bloom& bloom, const BloomPath& path) {
   // The shared memory of each kind's kernels at its shape (bloom_shared_bytes() has the layouts):
   // bloom_down's tiles; bloom_up's (and bloom_composite's) tiles and the 2:1 kernels' output tile.
   const DeviceInfo& info = bloom.impl_->context->info();
-  auto check = [&](const char* kind, Workgroup2D g, uint32_t bytes) {
-    if (g.x == 0) return;
-    if (g.y == 0 || g.x * g.y > info.max_workgroup_invocations || bytes > info.max_shared_memory_bytes) {
+  auto check = [&](const char* kind, Workgroup2D g, uint64_t bytes) {
+    if (g.x == 0 && g.y == 0) return;
+    if (g.x == 0 || g.y == 0 || uint64_t(g.x) * g.y > info.max_workgroup_invocations ||
+        bytes > info.max_shared_memory_bytes) {
       throw Error(ErrorCode::invalid_argument,
-                  concat("BloomPath::", kind, " = ", g.x, "x", g.y, ": needs ", g.x * g.y, " invocations and ", bytes,
-                         " bytes of shared memory; device '", info.name, "' has ", info.max_workgroup_invocations,
-                         " and ", info.max_shared_memory_bytes));
+                  concat("BloomPath::", kind, " = ", g.x, "x", g.y, ": needs ", uint64_t(g.x) * g.y,
+                         " invocations and ", bytes, " bytes of shared memory; device '", info.name, "' has ",
+                         info.max_workgroup_invocations, " and ", info.max_shared_memory_bytes));
     }
   };
-  auto down_bytes = [](Workgroup2D g) { return ((2 * g.x + 4) * (2 * g.y + 4) + (2 * g.x + 3) * (2 * g.y + 3)) * 16; };
+  auto down_bytes = [](Workgroup2D g) {
+    const uint64_t x = g.x, y = g.y;
+    return ((2 * x + 4) * (2 * y + 4) + (2 * x + 3) * (2 * y + 3)) * 16;
+  };
   auto up_bytes = [](Workgroup2D g) {
-    return std::max(((g.x + 10) * (g.y + 10) + g.x * (g.y + 10)) * 16, 4 * g.x * g.y * 16);
+    const uint64_t x = g.x, y = g.y;
+    return std::max(((x + 10) * (y + 10) + x * (y + 10)) * 16, 4 * x * y * 16);
   };
   check("down_workgroup", path.down_workgroup, down_bytes(path.down_workgroup));
   check("up_workgroup", path.up_workgroup, up_bytes(path.up_workgroup));

@@ -26,9 +26,12 @@ struct BloomPath {
   /// devices no), or forced either way (tests reach both forms on any device).
   enum class CopyOrder { device, on, off };
   CopyOrder copy_order_2x = CopyOrder::device;
-  /// Workgroup shapes of the kernels after the first stage, per kind: the downsamples
-  /// (bloom_down), the upsamples (bloom_up, bloom_up_2x) and the composite (bloom_composite,
-  /// bloom_composite_2x). {0, 0}: the bloom's own shape, which the first stage always runs in.
+  /// Workgroup shapes per kind of kernel: the downsamples (bloom_down, level0_height's steps
+  /// included), the upsamples (bloom_up, bloom_up_2x) and the composite (bloom_composite,
+  /// bloom_composite_2x; not bloom_composite_up, the fused path's). {0, 0}: the bloom's own shape,
+  /// which the bright-pass kernels, the gauss9 blur and the small-levels dispatch always take.
+  /// BloomAccess::set_path() refuses a shape the device cannot run (its invocations or the
+  /// kernels' shared memory).
   Workgroup2D down_workgroup{0, 0};
   Workgroup2D up_workgroup{0, 0};
   Workgroup2D composite_workgroup{0, 0};

@@ -195,6 +195,8 @@ LensFlare::LensFlare(const Context& context, VkFormat color_format, VkExtent2D e
   // instance twice as often; on the H200 16x8, 16x16, 64x4 and 8x16 were slower with and without
   // the split) and GLINT_FLARE_ONE_DISPATCH_GROUP_X/Y (the same) for the one-dispatch gather; the device's 2D
   // choice (8x8, or ContextOptions::workgroup_2d) on CPU devices.
+  static_assert(GLINT_FLARE_ONE_DISPATCH_GROUP_X * GLINT_FLARE_ONE_DISPATCH_GROUP_Y >= GLINT_FLARE_SPRITES &&
+                GLINT_FLARE_ONE_DISPATCH_GROUP_X * GLINT_FLARE_ONE_DISPATCH_GROUP_Y <= GLINT_FLARE_GATHER_MAX_THREADS);
   const bool cpu = context.info().type == VK_PHYSICAL_DEVICE_TYPE_CPU;
   const bool gpu_shapes = !cpu && context.info().max_workgroup_invocations >= 256 && context.info().subgroup_size >= 32;
   detail::Workgroup2D group = detail::choose_workgroup_2d(context), one_group = group;

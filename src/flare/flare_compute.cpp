@@ -265,12 +265,14 @@ void LensFlareAccess::set_gather_workgroup(LensFlare& flare, uint32_t x, uint32_
   LensFlare::Impl& m = *flare.impl_;
   const uint64_t threads = uint64_t(x) * y;
   if (x < 1 || y < 1 || threads < GLINT_FLARE_SPRITES || threads > GLINT_FLARE_GATHER_MAX_THREADS ||
-      threads > m.context->info().max_workgroup_invocations || rows > GLINT_FLARE_GATHER_ROWS) {
+      threads > m.context->info().max_workgroup_invocations || rows > GLINT_FLARE_GATHER_ROWS ||
+      (!one_dispatch && rows != 0)) {
     throw Error(ErrorCode::invalid_argument,
                 concat("LensFlareAccess::set_gather_workgroup: ", x, "x", y, " with ", rows,
                        " rows is out of range: accepted ", GLINT_FLARE_SPRITES, " to ",
                        std::min<uint32_t>(GLINT_FLARE_GATHER_MAX_THREADS, m.context->info().max_workgroup_invocations),
-                       " invocations and 0 (unchanged) to ", GLINT_FLARE_GATHER_ROWS, " rows"));
+                       " invocations and 0 (unchanged) to ", GLINT_FLARE_GATHER_ROWS,
+                       " rows (the one-dispatch gather only; 0 for the pre-pass gathers)"));
   }
   LensFlare::Impl::GatherTiles& one = m.tiles_one_dispatch;
   if (one_dispatch) {

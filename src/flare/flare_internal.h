@@ -55,8 +55,9 @@ struct LensFlareAccess {
   /// one-dispatch gather, run in workgroups of x by y (tiles x wide) from now on, each invocation
   /// shading as many rows as before, or (one-dispatch gather) `rows` if not 0: the benchmarks
   /// compare shapes per device. The one-dispatch limit follows its workgroup's size (GPUs). x * y
-  /// is 16 (one instance's sprites) to GLINT_FLARE_GATHER_MAX_THREADS, rows at most
-  /// GLINT_FLARE_GATHER_ROWS. Remakes pipelines and buffers, as set_pre_pass_tiles().
+  /// is GLINT_FLARE_SPRITES (one instance's sprites) to GLINT_FLARE_GATHER_MAX_THREADS; rows is 0
+  /// (unchanged), or 1 to GLINT_FLARE_GATHER_ROWS for the one-dispatch gather. Remakes pipelines
+  /// and buffers, as set_pre_pass_tiles().
   static void set_gather_workgroup(LensFlare& flare, uint32_t x, uint32_t y, bool one_dispatch = false,
                                    uint32_t rows = 0);
   /// Whether record_compute() splits crowded tiles in a pre-pass draw from an instances buffer of
