@@ -288,6 +288,21 @@ void LensFlareAccess::set_gather_workgroup(LensFlare& flare, uint32_t x, uint32_
   m.gather_beyond_split = {};
 }
 
+void LensFlareAccess::set_max_stored_instances(LensFlare& flare, uint32_t instances) {
+  LensFlare::Impl& m = *flare.impl_;
+  if (instances < 1) {
+    throw Error(ErrorCode::invalid_argument,
+                "LensFlareAccess::set_max_stored_instances: instances is 0; accepted 1 and more");
+  }
+  m.max_stored_instances = std::min(m.max_stored_instances, instances);
+  m.sprite_stores.clear();
+}
+
+uint32_t LensFlareAccess::sprite_store_capacity(const LensFlare& flare) {
+  const LensFlare::Impl& m = *flare.impl_;
+  return m.sprite_stores.empty() ? 0u : m.sprite_stores.back()->capacity;
+}
+
 void LensFlareAccess::set_split(LensFlare& flare, bool on, uint32_t min_sprites, uint32_t sprites_per_slice,
                                 uint32_t max_slices) {
   if (sprites_per_slice < 1 || max_slices < 1 || max_slices > 31) {

@@ -60,6 +60,15 @@ struct LensFlareAccess {
   /// and buffers, as set_pre_pass_tiles().
   static void set_gather_workgroup(LensFlare& flare, uint32_t x, uint32_t y, bool one_dispatch = false,
                                    uint32_t rows = 0);
+  /// Caps the instances whose sprites the pre-pass stores at `instances` (at least 1; at most what
+  /// one descriptor holds, LensFlare's own limit), dropping the stores made so far: the gather
+  /// evaluates the sprites of every instance beyond, as it does beyond maxStorageBufferRange, so
+  /// tests reach that path on every device. Call it only while no command buffer recorded with
+  /// `flare` is pending.
+  static void set_max_stored_instances(LensFlare& flare, uint32_t instances);
+  /// Instances whose sprites the last pre-pass draw stored at most (its store's capacity; 0 before
+  /// any).
+  static uint32_t sprite_store_capacity(const LensFlare& flare);
   /// Whether record_compute() splits crowded tiles in a pre-pass draw from an instances buffer of
   /// `instances` instances.
   static bool splits(const LensFlare& flare, uint64_t instances);
