@@ -808,14 +808,25 @@ TEST_F(FlareTest, CrowdedTilesSplitIntoSlicesMatchTheReference) {
     EXPECT_EQ(std::memcmp(c.rgba.data(), c2.rgba.data(), c.rgba.size() * 4), 0) << fmt << ": frames differ";
     EXPECT_THROW(detail::LensFlareAccess::set_split(flare, true, 1, 0, 8), Error);
     EXPECT_THROW(detail::LensFlareAccess::set_split(flare, true, 1, 1, 32), Error);
+
+    // The split gather in another workgroup (the benchmarks compare shapes): the counted tiles, the
+    // plan and the slots follow the gather's tiles.
+    detail::LensFlareAccess::set_split(flare, true, 200, 16, 8);
+    detail::LensFlareAccess::set_gather_workgroup(flare, 16, 16);
+    const detail::FlareGatherTile t16 = detail::LensFlareAccess::gather_tile(flare, false, lights.size());
+    EXPECT_EQ(t16.width, 16u) << fmt;
+    const size_t tiles16 = size_t((kW + t16.width - 1) / t16.width) * ((kH + t16.height - 1) / t16.height);
+    const CpuImage s16 = draw(flare, Path::compute, background, format, in, config);
+    const std::vector<uint32_t> w16 = read_words(detail::LensFlareAccess::split_words(flare));
+    ASSERT_EQ(w16.size(), 3 * tiles16 + GLINT_FLARE_SPLIT_SLOTS + 1) << fmt;
+    size_t split16 = 0;
+    for (size_t i = 0; i < tiles16; ++i) split16 += (w16[tiles16 + i] & 31u) > 1 ? 1 : 0;
+    EXPECT_GT(split16, 0u) << fmt << ": no 16x" << t16.height << " tile was split";
+    const FlareDeviation d16 = compare_flare(s16, ref, format);
+    EXPECT_EQ(d16.outside, 0u) << fmt << ", 16x16 workgroups, " << split16 << " tiles split: " << d16.first;
   }
 }
 
-// The sprite pre-pass stores 304 bytes per instance in one storage-buffer descriptor, fewer
-// instances than the 48-byte instances buffer may hold (maxStorageBufferRange / 304 against / 48):
-// the gather evaluates the sprites of the instances beyond the store itself. Lights at both ends of
-// such a buffer (the rest draw nothing), between draws from a small buffer with the same LensFlare
-// (its first store is kept for it, a second, larger one made): every draw matches the reference.
 // Draws `stored` + 6 instances with the sprite store holding `stored` (the device's limit, or a
 // smaller cap set through LensFlareAccess::set_max_stored_instances): the first 6 and last 6 are
 // lights, the rest zeros (size 0, nothing drawn), so the last 6 are evaluated by the gather
@@ -869,10 +880,13 @@ void check_beyond_store(LensFlare& flare, uint64_t stored, const reference::Flar
               static_cast<unsigned long long>(n), static_cast<unsigned long long>(stored), d.worst_ratio);
 }
 
-// The sprites of instances beyond the store (an instances buffer larger than one descriptor of
-// sprite blocks holds) are evaluated by the gather. At the device's own limit where those
-// instances fit in 64 MiB (lavapipe's 2^27-byte ranges), and on every device with the store capped
-// at 64 instances.
+// The sprite pre-pass stores 304 bytes per instance in one storage-buffer descriptor, fewer
+// instances than the 48-byte instances buffer may hold (maxStorageBufferRange / 304 against / 48):
+// the gather evaluates the sprites of the instances beyond the store itself. Lights at both ends of
+// such a buffer (the rest draw nothing), between draws from a small buffer with the same LensFlare
+// (its first store is kept for it, a second, larger one made): every draw matches the reference.
+// At the device's own limit where those instances fit in 64 MiB (lavapipe's 2^27-byte ranges), and
+// on every device with the store capped at 64 instances.
 TEST_F(FlareTest, ComputeDrawsInstancesBeyondItsSpriteStore) {
   VkPhysicalDeviceProperties props;
   vkGetPhysicalDeviceProperties(context().physical_device(), &props);
