@@ -573,14 +573,16 @@ TEST_F(FlareTest, OneDispatchDrawGivesTheBitsOfThePrePass) {
     detail::LensFlareAccess::set_split(flare, false);
     const reference::FlareAtlas atlas = read_flare_atlas(flare);
     const uint32_t most = flare.one_dispatch_instances();
-    // The gather's workgroup as flare.cpp picks it: 32x8 on GPUs with 256 invocations and 32-wide
-    // subgroups, else the device's 2D choice.
+    // The one-dispatch limit is one batch of its gather's workgroup (GLINT_FLARE_ONE_DISPATCH_GROUP_X/Y
+    // on GPUs with 256 invocations and 32-wide subgroups), none on CPU devices.
     const DeviceInfo& info = context().info();
-    detail::Workgroup2D wg = detail::choose_workgroup_2d(context());
+    const detail::FlareGatherTile one_tile = detail::LensFlareAccess::gather_tile(flare, true, 1);
     if (info.type != VK_PHYSICAL_DEVICE_TYPE_CPU && info.max_workgroup_invocations >= 256 && info.subgroup_size >= 32) {
-      wg = {32, 8};
+      EXPECT_EQ(one_tile.width, GLINT_FLARE_ONE_DISPATCH_GROUP_X) << fmt;
+      EXPECT_EQ(one_tile.row_step, GLINT_FLARE_ONE_DISPATCH_GROUP_Y) << fmt;
     }
-    const uint32_t expected = info.type == VK_PHYSICAL_DEVICE_TYPE_CPU ? 0 : wg.x * wg.y / GLINT_FLARE_SPRITES;
+    const uint32_t expected =
+        info.type == VK_PHYSICAL_DEVICE_TYPE_CPU ? 0 : one_tile.width * one_tile.row_step / GLINT_FLARE_SPRITES;
     EXPECT_EQ(most, expected) << fmt;
     const CpuImage background = as_stored(random_hdr(kW, kH, 81), format);
     auto lights = random_instances(300, 31);

@@ -41,22 +41,36 @@ constexpr VkAccessFlags2 kSampled = VK_ACCESS_2_SHADER_SAMPLED_READ_BIT;
 constexpr VkAccessFlags2 kStorageWrite = VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT;
 constexpr VkAccessFlags2 kStorageRead = VK_ACCESS_2_SHADER_STORAGE_READ_BIT;
 
-// Shared memory the tiled kernels declare for a workgroup (src/bloom/shaders/bloom_down_tiled.glsl,
-// bloom_up_tiled.glsl, bloom_composite_up.comp and src/bloom/shaders/bloom_prefilter_smooth.comp: vec4 windows of the
-// source; src/bloom/shaders/bloom_prefilter_boxes.comp: three floats per texel of a window for a 2 g.y row tile,
-// at an odd row stride with 4 texels of slack, and of its horizontal results; src/bloom/shaders/bloom_up_2x.glsl:
-// a vec3 per output of the workgroup's 2 g.x x 2 g.y tile, counted at 16 bytes).
-uint32_t bloom_shared_bytes(detail::Workgroup2D g) {
-  const uint32_t down = ((2 * g.x + 4) * (2 * g.y + 4) + (2 * g.x + 3) * (2 * g.y + 3)) * 16;
-  const uint32_t up = ((g.x + 10) * (g.y + 10) + g.x * (g.y + 10)) * 16;
+// Shared memory the tiled kernels declare for a workgroup g, per kind (64-bit: set_path() checks
+// shapes a caller chose). The downsamples (src/bloom/shaders/bloom_down_tiled.glsl: vec4 windows of
+// the source and of its box means).
+uint64_t down_shared_bytes(detail::Workgroup2D g) {
+  const uint64_t x = g.x, y = g.y;
+  return ((2 * x + 4) * (2 * y + 4) + (2 * x + 3) * (2 * y + 3)) * 16;
+}
+// The tiled upsample and composite (bloom_up_tiled.glsl: vec4 windows of the smaller level and of
+// the horizontal pass).
+uint64_t up_tiled_shared_bytes(detail::Workgroup2D g) {
+  const uint64_t x = g.x, y = g.y;
+  return ((x + 10) * (y + 10) + x * (y + 10)) * 16;
+}
+// The 2:1 upsample and composite (src/bloom/shaders/bloom_up_2x.glsl: a vec3 per output of the
+// workgroup's 2 g.x x 2 g.y tile, counted at 16 bytes).
+uint64_t two_to_one_shared_bytes(detail::Workgroup2D g) { return 4 * uint64_t(g.x) * g.y * 16; }
+
+// Shared memory of the kernels that run in the bloom's own workgroup: the above, and
+// bloom_composite_up.comp, src/bloom/shaders/bloom_prefilter_smooth.comp (vec4 windows of the
+// source) and src/bloom/shaders/bloom_prefilter_boxes.comp (three floats per texel of a window for a
+// 2 g.y row tile, at an odd row stride with 4 texels of slack, and of its horizontal results).
+uint64_t bloom_shared_bytes(detail::Workgroup2D g) {
+  const uint64_t x = g.x, y = g.y;
   // bloom_composite_up.comp: the up tiles plus the window of level 1.
-  const uint32_t composite_up = up + ((g.x + 9) / 2 + 12) * ((g.y + 9) / 2 + 12) * 16;
-  const uint32_t apron = 2 * GLINT_BLOOM_SMOOTH_RADIUS;
-  const uint32_t smooth = ((2 * g.x + 6 + apron) * (2 * g.y + 6 + apron) + (2 * g.y + 6 + apron) * (2 * g.x + 6)) * 16;
+  const uint64_t composite_up = up_tiled_shared_bytes(g) + ((x + 9) / 2 + 12) * ((y + 9) / 2 + 12) * 16;
+  const uint64_t apron = 2 * GLINT_BLOOM_SMOOTH_RADIUS;
+  const uint64_t smooth = ((2 * x + 6 + apron) * (2 * y + 6 + apron) + (2 * y + 6 + apron) * (2 * x + 6)) * 16;
   // The window's row stride is odd: 2 g.x + 4 + apron is even, so one more.
-  const uint32_t boxes = ((2 * g.x + 5 + apron + 2 * g.x + 3) * (4 * g.y + 4 + apron) + 4) * 12;
-  const uint32_t two_to_one = 4 * g.x * g.y * 16;
-  return std::max({down, composite_up, smooth, boxes, two_to_one});
+  const uint64_t boxes = ((2 * x + 5 + apron + 2 * x + 3) * (4 * y + 4 + apron) + 4) * 12;
+  return std::max({down_shared_bytes(g), composite_up, smooth, boxes, two_to_one_shared_bytes(g)});
 }
 
 // Whether src/bloom/shaders/bloom_prefilter_boxes.comp can serve this configuration: the
@@ -594,7 +608,7 @@ uint64_t Bloom::min_bytes_moved(VkFormat input_format, VkFormat output_format) c
 namespace detail {
 
 void BloomAccess::set_path(Bloom& bloom, const BloomPath& path) {
-  // The shared memory of each kind's kernels at its shape (bloom_shared_bytes() has the layouts):
+  // The shared memory of each kind's kernels at its shape (down_shared_bytes() and the others above):
   // bloom_down's tiles; bloom_up's (and bloom_composite's) tiles and the 2:1 kernels' output tile.
   const DeviceInfo& info = bloom.impl_->context->info();
   auto check = [&](const char* kind, Workgroup2D g, uint64_t bytes) {
@@ -607,15 +621,8 @@ void BloomAccess::set_path(Bloom& bloom, const BloomPath& path) {
                          info.max_workgroup_invocations, " and ", info.max_shared_memory_bytes));
     }
   };
-  auto down_bytes = [](Workgroup2D g) {
-    const uint64_t x = g.x, y = g.y;
-    return ((2 * x + 4) * (2 * y + 4) + (2 * x + 3) * (2 * y + 3)) * 16;
-  };
-  auto up_bytes = [](Workgroup2D g) {
-    const uint64_t x = g.x, y = g.y;
-    return std::max(((x + 10) * (y + 10) + x * (y + 10)) * 16, 4 * x * y * 16);
-  };
-  check("down_workgroup", path.down_workgroup, down_bytes(path.down_workgroup));
+  auto up_bytes = [](Workgroup2D g) { return std::max(up_tiled_shared_bytes(g), two_to_one_shared_bytes(g)); };
+  check("down_workgroup", path.down_workgroup, down_shared_bytes(path.down_workgroup));
   check("up_workgroup", path.up_workgroup, up_bytes(path.up_workgroup));
   check("composite_workgroup", path.composite_workgroup, up_bytes(path.composite_workgroup));
   bloom.impl_->path = path;
