@@ -23,6 +23,7 @@
 #include "core/resources.h"
 #include "reference/occlusion_reference.h"
 #include "support/transfer.h"
+#include "visibility/light_cull_internal.h"
 
 namespace glint::bench {
 namespace {
@@ -30,6 +31,7 @@ namespace {
 void BM_FlareEndToEnd(benchmark::State& state) {
   const auto lights = static_cast<uint32_t>(state.range(0));
   const bool compute = state.range(1) != 0;
+  const auto visibility = state.range(2);  // 0: as the pass chooses, 1: the pyramid, 2: the depth image
   const Context& ctx = context();
   const uint32_t w = 1920, h = 1080;
   const auto scene = reference::random_scene(w, h, lights, 2024, false, 128.0);
@@ -42,6 +44,8 @@ void BM_FlareEndToEnd(benchmark::State& state) {
   pc.draw = compute ? FlareDrawPath::compute : FlareDrawPath::raster;
   pc.clamp_capacity = true;
   LensFlarePass pass(ctx, pc);
+  if (visibility == 1) detail::LightCullAccess::select_path(pass.culler(), detail::LightCullPath::pyramid);
+  if (visibility == 2) detail::LightCullAccess::select_path(pass.culler(), detail::LightCullPath::depth);
 
   detail::OwnedImage color(ctx, {w, h}, VK_FORMAT_R16G16B16A16_SFLOAT,
                            detail::kToolImageUsage | VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT);
@@ -120,16 +124,29 @@ void BM_FlareEndToEnd(benchmark::State& state) {
   for (const auto& [key, us] : by_label) {
     if (key != "us_hiz" && key != "us_cull" && key != "us_draw") state.counters[key] = us;
   }
-  state.SetLabel(std::string(compute ? "compute" : "raster") + " rgba16f, hi-z levels " +
-                 std::to_string(pass.hiz().levels()) + " on " + ctx.info().name);
+  const bool pyramid = pass.culler().needs_pyramid(pass.hiz(), lights);
+  state.counters["reads_pyramid"] = pyramid ? 1 : 0;
+  state.SetLabel(std::string(compute ? "compute" : "raster") + " rgba16f, " +
+                 (pyramid ? "hi-z levels " + std::to_string(pass.hiz().levels()) : std::string("depth image")) +
+                 " on " + ctx.info().name);
 }
 
+// visibility: 0 as LensFlarePass chooses (the speed table's rows), 1 the Hi-Z pyramid, 2 the depth
+// image read by the cull (LightCuller::needs_pyramid; docs/OCCLUSION.md): where the choice turns.
 BENCHMARK(BM_FlareEndToEnd)
-    ->Args({10, 0})
-    ->Args({10, 1})
-    ->Args({1000, 0})
-    ->Args({1000, 1})
-    ->ArgNames({"lights", "compute"})
+    ->Args({10, 0, 0})
+    ->Args({10, 1, 0})
+    ->Args({1000, 0, 0})
+    ->Args({1000, 1, 0})
+    ->Args({10, 1, 1})
+    ->Args({10, 1, 2})
+    ->Args({31, 1, 1})
+    ->Args({31, 1, 2})
+    ->Args({64, 1, 1})
+    ->Args({64, 1, 2})
+    ->Args({128, 1, 1})
+    ->Args({128, 1, 2})
+    ->ArgNames({"lights", "compute", "visibility"})
     ->UseManualTime()
     ->Unit(benchmark::kMicrosecond);
 

@@ -19,6 +19,7 @@
 #include "core/half.h"
 #include "support/flare_scene.h"
 #include "support/gpu_test.h"
+#include "visibility/light_cull_internal.h"
 
 namespace glint::test {
 namespace {
@@ -273,6 +274,56 @@ TEST_F(FlareEndToEndTest, RasterAndComputeAgreeWithinTheDocumentedTolerance) {
   EXPECT_GT(changed, 1000u) << "the flares changed too few pixels for the comparison to mean anything";
   EXPECT_TRUE(all_finite(r.image));
   EXPECT_TRUE(all_finite(c.image));
+}
+
+// Few lights and a pyramid capped by max_size_px: the pass leaves the Hi-Z out and the cull reads
+// the depth image (LightCuller::needs_pyramid), and the frame is the one the pyramid gives, bit for
+// bit: image, statistics, arguments and per-light results, both draw paths, two frames on one
+// command buffer. Lights in the open, behind an occluder, straddling its edges, off screen and
+// behind the camera, at 1024x768 (cells of up to 8 px: level 3; the 12 lights' windows hold at
+// most 12 x 16 x 4^4 = 49152 of the image's 786432 pixels).
+TEST_F(FlareEndToEndTest, FewLightsReadTheDepthImageAndDrawTheFrameThePyramidGives) {
+  const uint32_t w = 1024, h = 768;
+  const Camera cam{w, h};
+  std::vector<float> depth(size_t(w) * h, 1.0f);
+  const auto box = float(cam.depth_at(5.0));
+  for (uint32_t y = 300; y < 500; ++y)
+    for (uint32_t x = 200; x < 600; ++x) depth[size_t(y) * w + x] = box;
+  std::vector<GlintFlareLight> list;
+  list.push_back(cam.light_at(400, 400, 20, 32));      // behind the box
+  list.push_back(cam.light_at(800, 200, 20, 32));      // in the open
+  list.push_back(cam.light_at(200, 400, 20, 31));      // straddles the box's left edge
+  list.push_back(cam.light_at(500, 500.5, 20, 17));    // straddles its bottom edge
+  list.push_back(cam.light_at(300, 350, 3, 24));       // before the box
+  list.push_back(cam.light_at(3.0 * w, 100, 20, 16));  // far off screen
+  list.push_back(cam.light_at(1023.5, 0.5, 20, 32));   // on the corner
+  for (int i = 0; i < 5; ++i) list.push_back(cam.light_at(150 + 170.3 * i, 280 + 41.7 * i, 10 + i, 5.0f + 6.0f * i));
+  const CpuImage background = random_hdr(w, h, 11);
+  const FlareConfig look = FlareConfig::preset(FlarePreset::cinematic);
+  for (FlareDrawPath path : {FlareDrawPath::compute, FlareDrawPath::raster}) {
+    FlarePassConfig pc = pass_config(path);
+    pc.extent = {w, h};
+    pc.max_size_px = 32.0f;  // cells of 8 px at N = 4: 3 levels
+    LensFlarePass direct(context(), pc);
+    LensFlarePass pyramid(context(), pc);
+    detail::LightCullAccess::select_path(pyramid.culler(), detail::LightCullPath::pyramid);
+    ASSERT_EQ(direct.hiz().levels(), 3u);
+    ASSERT_FALSE(direct.culler().needs_pyramid(direct.hiz(), uint32_t(list.size())));
+    ASSERT_TRUE(pyramid.culler().needs_pyramid(pyramid.hiz(), uint32_t(list.size())));
+    const FrameResult a = run_frame(direct, background, depth, list, cam.view_proj(), look, 2);
+    const FrameResult b = run_frame(pyramid, background, depth, list, cam.view_proj(), look, 2);
+    const char* what = path == FlareDrawPath::compute ? "compute" : "raster";
+    EXPECT_EQ(std::memcmp(&a.stats, &b.stats, sizeof a.stats), 0) << what;
+    EXPECT_EQ(std::memcmp(&a.indirect, &b.indirect, sizeof a.indirect), 0) << what;
+    ASSERT_EQ(a.results.size(), list.size());
+    EXPECT_EQ(std::memcmp(a.results.data(), b.results.data(), list.size() * sizeof a.results[0]), 0) << what;
+    EXPECT_TRUE(bit_equal(a.image, b.image)) << what;
+    EXPECT_EQ(a.stats.frustum_culled, 1u) << what;
+    EXPECT_GE(a.stats.occluded, 1u) << what;
+    uint32_t partial = 0;
+    for (const auto& r : a.results) partial += r.visible_fraction > 0.0f && r.visible_fraction < 1.0f;
+    EXPECT_GE(partial, 2u) << what << ": the edge lights did not straddle the box";
+  }
 }
 
 // Thousands of lights on one pixel, more visible than the capacity: the instance count is clamped

@@ -283,7 +283,8 @@ CullRun run_cull(const reference::DepthImage& depth, VkFormat format, bool rever
   frame.groups_per_instance = groups_per_instance;
   context().run_once([&](VkCommandBuffer cmd) {
     for (int f = 0; f < frames; ++f) {
-      hiz.record(cmd, img.state);
+      // The depth-image cull reads no pyramid: it is not built for it (so the cull cannot read it).
+      if (culler.needs_pyramid(hiz, n)) hiz.record(cmd, img.state);
       culler.record(cmd, hiz, img.state, lbuf.view, n, frame, out);
     }
     to_host(cmd, out.instances);
@@ -721,6 +722,98 @@ TEST_F(OcclusionTest, OneWorkgroupCullGivesTheBitsOfTheFourDispatches) {
       }
     }
   }
+}
+
+// The depth-image cull (a workgroup per sample reading its window's pixels, the last workgroup
+// culling) gives the bits of the cull that reads the pyramid: instances, results, arguments and
+// statistics, both Z conventions, multi-jittered and regular grids of 1 to 4, pyramids capped at
+// 2 to 5 levels and uncapped (8 levels: windows of up to 512x286 pixels at the image's edge), no
+// light, one, a few and more than one chunk of the last workgroup, capacity overflow, and two
+// frames on one command buffer (the count of finished workgroups resets). Lights of up to 90 px
+// in scenes with lights on the image's edges, off screen and behind the camera; the runs are
+// also checked against the float64 reference.
+TEST_F(OcclusionTest, DepthImageCullGivesTheBitsOfThePyramidCull) {
+  struct Case {
+    uint32_t grid;
+    uint32_t max_cell_px;  // 0: every level
+    OcclusionPattern pattern;
+  };
+  uint32_t stream = 901;
+  for (bool reversed : {false, true}) {
+    for (const Case c : {Case{4, 32, OcclusionPattern::multi_jittered}, Case{3, 8, OcclusionPattern::multi_jittered},
+                         Case{2, 0, OcclusionPattern::multi_jittered}, Case{1, 4, OcclusionPattern::multi_jittered},
+                         Case{4, 16, OcclusionPattern::regular}}) {
+      const auto scene = reference::random_scene(257, 143, 150, stream++, reversed, 90);
+      LightCullConfig config;
+      config.grid = c.grid;
+      config.pattern = c.pattern;
+      float vp[16];
+      for (int i = 0; i < 16; ++i) vp[i] = static_cast<float>(scene.view_proj[i]);
+      const VkFormat format = reversed ? VK_FORMAT_R32_SFLOAT : VK_FORMAT_D32_SFLOAT;
+      const uint32_t levels = c.max_cell_px == 0 ? 8u : static_cast<uint32_t>(std::ceil(std::log2(c.max_cell_px)));
+      const uint32_t w = LightCuller(context(), config).one_group_lights();
+      for (uint32_t m : {0u, 1u, 9u, std::min(150u, w + 3)}) {
+        const std::vector<GlintFlareLight> few(scene.lights.begin(), scene.lights.begin() + m);
+        reference::Scene first = scene;
+        first.lights = few;
+        for (uint32_t capacity : {150u, std::max(1u, m / 4)}) {
+          config.capacity = capacity;
+          const std::string what = std::string(reversed ? "reversed" : "standard") + ", grid " +
+                                   std::to_string(c.grid) + (c.pattern == OcclusionPattern::regular ? " regular" : "") +
+                                   ", max_cell_px " + std::to_string(c.max_cell_px) + ", " + std::to_string(m) +
+                                   " lights, capacity " + std::to_string(capacity);
+          const auto a = run_cull(scene.depth, format, reversed, few, vp, config, c.max_cell_px, 1, 3,
+                                  detail::LightCullPath::pyramid);
+          const auto b = run_cull(scene.depth, format, reversed, few, vp, config, c.max_cell_px, 2, 3,
+                                  detail::LightCullPath::depth);
+          EXPECT_EQ(std::memcmp(&a.indirect, &b.indirect, sizeof a.indirect), 0) << what;
+          EXPECT_EQ(std::memcmp(&a.stats, &b.stats, sizeof a.stats), 0) << what;
+          ASSERT_EQ(a.results.size(), b.results.size()) << what;
+          if (m > 0) {
+            EXPECT_EQ(std::memcmp(a.results.data(), b.results.data(), a.results.size() * sizeof a.results[0]), 0)
+                << what;
+          }
+          ASSERT_EQ(a.instances.size(), b.instances.size()) << what;
+          if (!a.instances.empty()) {
+            EXPECT_EQ(std::memcmp(a.instances.data(), b.instances.data(), a.instances.size() * sizeof a.instances[0]),
+                      0)
+                << what;
+          }
+          EXPECT_TRUE(b.canary_intact) << what;
+          EXPECT_EQ(b.stats.total, m) << what;
+          if (m > 0) expect_cull_matches(b, first, config, reversed, levels, what);
+          if (m == 150u && capacity < 150u) {
+            EXPECT_GT(b.stats.overflow, 0u) << what << ": no overflow";
+          }
+        }
+      }
+    }
+  }
+}
+
+// LightCuller::needs_pyramid: the depth image is read where the samples' windows (count x N^2 x
+// 4^(levels + 1) pixels at most) hold no more pixels than the image, for counts the one-workgroup
+// cull takes; the pyramid otherwise, and on the forced paths as they say.
+TEST_F(OcclusionTest, CullReadsTheDepthImageOnlyWhereItsWindowsAreSmallerThanTheImage) {
+  LightCullConfig config;  // N = 4
+  LightCuller culler(context(), config);
+  HiZConfig hc;
+  hc.extent = {1920, 1080};
+  hc.max_cell_px = 32;  // 5 levels, as LensFlarePass makes for lights of up to 128 px
+  HiZPyramid capped(context(), hc);
+  ASSERT_EQ(capped.levels(), 5u);
+  // 31 x 16 x 4^6 = 2031616 <= 1920 x 1080 = 2073600 < 32 x 16 x 4^6.
+  EXPECT_FALSE(culler.needs_pyramid(capped, 0));
+  EXPECT_FALSE(culler.needs_pyramid(capped, 10));
+  EXPECT_EQ(culler.needs_pyramid(capped, 31), 31u > culler.one_group_lights());
+  EXPECT_TRUE(culler.needs_pyramid(capped, 32));
+  hc.max_cell_px = 0;  // 10 levels: any window may cover more than the image
+  HiZPyramid full(context(), hc);
+  EXPECT_TRUE(culler.needs_pyramid(full, 1));
+  detail::LightCullAccess::select_path(culler, detail::LightCullPath::pyramid);
+  EXPECT_TRUE(culler.needs_pyramid(capped, 10));
+  detail::LightCullAccess::select_path(culler, detail::LightCullPath::depth);
+  EXPECT_FALSE(culler.needs_pyramid(full, 1000));
 }
 
 // The README's maximum: a million lights, all visible, with more workgroups in their dispatch

@@ -65,6 +65,10 @@ class LensFlarePass {
   ~LensFlarePass();
 
   /// Records the Hi-Z build from `depth`, the cull of `count` lights and the draw into `color`.
+  /// The Hi-Z build is left out where the cull reads the depth image itself
+  /// (culler().needs_pyramid(hiz(), count) is false: few lights and a pyramid capped by
+  /// max_size_px); hiz() then holds an earlier frame's pyramid, or none. Build it with
+  /// hiz().record() when something else reads it.
   /// `color`: config's format and extent (COLOR_ATTACHMENT usage for raster, STORAGE for compute);
   /// left as LensFlare::record_raster / record_compute leave it (unchanged and untouched when
   /// `look` is disabled or has intensity 0; the cull still runs and the statistics are written).

@@ -158,12 +158,15 @@ class LightCuller {
   ~LightCuller();
 
   /// Records the cull of `count` lights from `lights` (GlintFlareLight[count], STORAGE usage)
-  /// against `hiz` (built from `depth` earlier on this command buffer or before) into `outputs`.
+  /// against `hiz` (built from `depth` earlier on this command buffer or before, unless
+  /// needs_pyramid() says the cull does not read it) into `outputs`.
   /// Up to one_group_lights() lights, one dispatch: one workgroup culls, tests and compacts
-  /// them. More lights, four dispatches: the cull and grid test in workgroups of 64 lights; the
+  /// them; when needs_pyramid() is false, the samples' windows are read from `depth` itself by a
+  /// workgroup each and the last of them culls and compacts. More lights, four dispatches: the
+  /// cull and grid test in workgroups of 64 lights; the
   /// two-level scan (the second, one workgroup, gives every workgroup its first instance slot,
   /// writes the indirect arguments and statistics and resets the counters); the scatter of the
-  /// visible lights into their slots. Both give the same outputs (bit for bit on every device
+  /// visible lights into their slots. All give the same outputs (bit for bit on every device
   /// tested), the same bits on every run.
   /// A light with enabled == 0 or a non-finite float field is GLINT_FLARE_DISABLED.
   /// count == 0 is allowed (zero instances). Afterwards the
@@ -177,6 +180,14 @@ class LightCuller {
               const LightCullFrame& frame, LightCullOutputs& outputs, Profiler* profiler = nullptr);
 
   const LightCullConfig& config() const;
+
+  /// Whether record() of `count` lights against a pyramid made as `hiz` reads the pyramid. False
+  /// when the lights are few and the pyramid shallow enough that their samples' windows hold fewer
+  /// depth pixels than the image (count x N^2 x 4^(levels + 1) <= width x height, count <=
+  /// one_group_lights()): record() then reads the same pixels from the depth image, with the
+  /// pyramid's answers (docs/OCCLUSION.md, "Few lights from the depth image"), and the caller may
+  /// skip HiZPyramid::record() for this cull. A fact of the configs, the device and `count`.
+  bool needs_pyramid(const HiZPyramid& hiz, uint32_t count) const;
 
   /// The largest LightCullFrame::groups_per_instance this culler's capacity allows on this device:
   /// capacity x groups_per_instance workgroups must fit maxComputeWorkGroupCount[0] x [1] (the

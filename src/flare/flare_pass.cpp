@@ -3,7 +3,8 @@
 // vertices_per_instance() and groups_per_instance() (docs/FLARE.md, "Interface with the visibility
 // stage"), and each part writes its own barriers from the buffers' state fields, so the frame is
 // Hi-Z -> cull (one dispatch for few lights, else cull, scan, scatter) -> draw on one command
-// buffer with no readback.
+// buffer with no readback; no Hi-Z where the cull reads the depth image itself (few lights, a
+// shallow pyramid: LightCuller::needs_pyramid).
 #include <glint/flare_pass.h>
 #include <glint/gpu/flare_types.h>
 
@@ -188,7 +189,9 @@ void LensFlarePass::record(VkCommandBuffer cmd, Image& color, Image& depth, Buff
   frame.groups_per_instance = m.flare.groups_per_instance();
   LightCullOutputs out{m.instances.view, m.indirect.view, m.stats.view,
                        m.config.per_light_results ? m.results.view : Buffer{}};
-  m.hiz.record(cmd, depth, profiler);
+  // Few lights read their samples' windows from the depth image itself (the same answers):
+  // building the pyramid would cost more than the cull reads (LightCuller::needs_pyramid).
+  if (m.culler.needs_pyramid(m.hiz, count)) m.hiz.record(cmd, depth, profiler);
   m.culler.record(cmd, m.hiz, depth, lights, count, frame, out, profiler);
   m.instances.view = out.instances;
   m.indirect.view = out.indirect;

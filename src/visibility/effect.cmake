@@ -10,6 +10,7 @@ set(GLINT_EFFECT_KERNELS
   "shaders/compact_scan_tiles|main|"
   "shaders/light_cull|main|"
   "shaders/light_cull|one_group|GLINT_CULL_ONE_GROUP=1"
+  "shaders/light_cull|from_depth|GLINT_CULL_ONE_GROUP=1+GLINT_CULL_FROM_DEPTH=1"
   "shaders/light_cull_scan|main|"
   "shaders/light_cull_scatter|main|"
   "shaders/object_cull|main|"

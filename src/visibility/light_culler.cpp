@@ -65,6 +65,9 @@ constexpr uint32_t kMaxGroupsX = 65535;  // guaranteed maxComputeWorkGroupCount[
 // 1000 lights with N = 8 and 16 (65.7 against 61.9 us, 231.7 against 185.9), where one
 // multiprocessor's fetch rate holds it; fewer samples only shorten its work.
 constexpr uint32_t kOneGroupSamples = 16384;
+// Samples (lights x N^2) the depth-image cull holds words for: a workgroup each, within the
+// guaranteed maxComputeWorkGroupCount[0]. The device's choice stays under kOneGroupSamples.
+constexpr uint32_t kDepthSamples = 65535;
 
 }  // namespace
 
@@ -98,6 +101,17 @@ struct LightCuller::Impl {
   // The same kernel with one invocation per light (specialization constant kShareSamples = 0), for
   // more than half as many lights as invocations (where each light would get one) and on CPU devices.
   detail::ComputePipeline one_group_per_light;
+  // light_cull.comp built with GLINT_CULL_FROM_DEPTH too: a workgroup of one_group_size per sample
+  // reads its window from the depth image, the last to finish runs the one-workgroup cull
+  // (needs_pyramid() == false). Its words (one per sample) and its count of finished workgroups,
+  // which the kernel resets after each cull (cleared once, by the first record() that uses it).
+  detail::ComputePipeline from_depth;
+  detail::OwnedBuffer sample_words;
+  Buffer sample_words_state;
+  detail::OwnedBuffer finished;
+  Buffer finished_state;
+  bool finished_cleared = false;
+  uint32_t depth_samples = 0;  // words in sample_words
   uint32_t one_group_size = 64;
   uint32_t one_group_lights = 64;
   // Whether up to half as many lights as invocations share their samples (GPUs). CPU devices run a
@@ -147,7 +161,18 @@ LightCuller::LightCuller(const Context& context, const LightCullConfig& config) 
   m.one_group = detail::ComputePipeline(context, d);
   d.specialization = {0};
   m.one_group_per_light = detail::ComputePipeline(context, d);
+  d.kernel_id = "light_cull_from_depth";
+  d.bindings = {S, S, B, B, B, B, B, B, B};
+  m.from_depth = detail::ComputePipeline(context, d);
   d.specialization = {};
+  m.depth_samples =
+      uint32_t(std::min<uint64_t>(uint64_t(config.max_lights) * config.grid * config.grid, kDepthSamples));
+  m.sample_words =
+      detail::OwnedBuffer(context, VkDeviceSize(m.depth_samples) * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, false);
+  m.sample_words_state = view_of(m.sample_words, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  const VkBufferUsageFlags counter_usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+  m.finished = detail::OwnedBuffer(context, 16, counter_usage, false);
+  m.finished_state = view_of(m.finished, counter_usage);
   detail::Compaction::Desc cd;
   cd.max_items = config.max_lights;
   cd.scan_kernel = "light_cull_scan_main";  // writes the indirect arguments and statistics
@@ -180,6 +205,21 @@ uint32_t LightCuller::max_groups_per_instance() const {
 }
 
 uint32_t LightCuller::one_group_lights() const { return impl_->one_group_lights; }
+
+bool LightCuller::needs_pyramid(const HiZPyramid& hiz, uint32_t count) const {
+  const Impl& m = *impl_;
+  if (m.path == detail::LightCullPath::depth) return false;
+  if (m.path != detail::LightCullPath::device || count > m.one_group_lights) return true;
+  // The pixels the samples' windows can cover (at most 2 texels of level `levels` per axis, each at
+  // most 2^(levels + 1) - 1 pixels wide at the edge, so under 4^(levels + 1) pixels) against the
+  // pixels the pyramid's build reads. Beyond level 12 the bound exceeds the largest image.
+  const uint32_t levels = hiz.levels();
+  if (levels > 12) return true;
+  const uint64_t n2 = uint64_t(m.config.grid) * m.config.grid;
+  const uint64_t window = uint64_t(1) << (2 * (levels + 1));
+  const VkExtent2D e = hiz.config().extent;
+  return uint64_t(count) * n2 * window > uint64_t(e.width) * e.height;
+}
 
 void LightCuller::record(VkCommandBuffer cmd, HiZPyramid& hiz, Image& depth, Buffer& lights, uint32_t count,
                          const LightCullFrame& frame, LightCullOutputs& out, Profiler* profiler) {
@@ -241,17 +281,58 @@ void LightCuller::record(VkCommandBuffer cmd, HiZPyramid& hiz, Image& depth, Buf
                (m.config.pattern == OcclusionPattern::regular ? GLINT_CULL_REGULAR_GRID : 0u);
   push.margin_ndc = m.config.margin_ndc;
   push.depth_bias = m.config.depth_bias;
+  const bool from_depth = !needs_pyramid(hiz, count);
+  const uint64_t depth_groups = std::max<uint64_t>(1, uint64_t(count) * m.config.grid * m.config.grid);
+  if (from_depth && depth_groups > m.depth_samples) {  // only where the path is forced (tests)
+    throw Error(ErrorCode::invalid_argument,
+                concat(where, ": count = ", count, " is out of range for the depth-image cull: accepted 0 to ",
+                       m.depth_samples / (m.config.grid * m.config.grid), " (", m.depth_samples,
+                       " samples of N^2 = ", m.config.grid * m.config.grid, ")"));
+  }
   detail::Barriers b;
   const bool one_group = m.path == detail::LightCullPath::one_group ||
                          m.path == detail::LightCullPath::one_group_shared_samples ||
-                         (m.path == detail::LightCullPath::device && count <= m.one_group_lights);
-  // Both paths' first dispatch reads the depth, the pyramid and the lights (bindings 0 to 2).
+                         ((m.path == detail::LightCullPath::device || m.path == detail::LightCullPath::pyramid) &&
+                          count <= m.one_group_lights);
+  // Every path's first dispatch reads the depth, the pyramid (the depth-image path binds the depth
+  // in its place) and the lights (bindings 0 to 2).
   b.use(depth, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, kCompute, kSampled);
-  b.use(hiz.image(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, kCompute, kSampled, std::max(1u, hiz.levels()));
+  if (!from_depth) {
+    b.use(hiz.image(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, kCompute, kSampled, std::max(1u, hiz.levels()));
+  }
   b.use(lights, kCompute, kStorageRead);
-  const detail::Bindings inputs{{depth.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL},
-                                {hiz.image().view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL},
-                                lights};
+  const detail::Binding depth_binding{depth.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+  const detail::Bindings inputs{
+      depth_binding,
+      from_depth ? depth_binding : detail::Binding{hiz.image().view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL}, lights};
+  if (from_depth) {
+    // A workgroup per sample, the last one culls: slots, instances, results, arguments, statistics.
+    if (!m.finished_cleared) {  // once per object: the kernel resets the count after each cull
+      b.use(m.finished_state, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);
+      b.flush(cmd);
+      vkCmdFillBuffer(cmd, m.finished.buffer(), 0, VK_WHOLE_SIZE, 0);
+      m.finished_cleared = true;
+    }
+    b.use(out.instances, kCompute, kStorageWrite);
+    b.use(results, kCompute, kStorageWrite);
+    b.use(out.indirect, kCompute, kStorageWrite);
+    b.use(out.stats, kCompute, kStorageWrite);
+    b.use(m.sample_words_state, kCompute, kStorageRead | kStorageWrite);
+    b.use(m.finished_state, kCompute, kStorageRead | kStorageWrite);
+    b.flush(cmd);
+    push.capacity = m.config.capacity;
+    push.vertex_count = frame.vertex_count;
+    push.groups_per_instance = frame.groups_per_instance;
+    push.max_group_count_x = m.max_groups_x;
+    detail::Bindings set = inputs;
+    for (const Buffer* o :
+         {&out.instances, &results, &out.indirect, &out.stats, &m.sample_words_state, &m.finished_state}) {
+      set.push_back(*o);
+    }
+    m.from_depth.dispatch(cmd, set, push, uint32_t(depth_groups) * m.one_group_size, 1);
+    if (profiler) profiler->mark(cmd, "light cull");
+    return;
+  }
   if (one_group) {
     // One workgroup: cull, grid test, slots, instances, results, arguments and statistics.
     b.use(out.instances, kCompute, kStorageWrite);

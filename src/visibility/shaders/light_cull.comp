@@ -51,6 +51,13 @@ layout(std430, binding = 5) writeonly buffer Indirect { GlintFlareIndirect indir
 layout(std430, binding = 6) writeonly buffer Stats { GlintFlareStats stats; };
 // The visible lights of the current chunk, one bit per light of the chunk (at most 1024).
 shared uint chunk_mask[32];
+#ifdef GLINT_CULL_FROM_DEPTH
+// The depth-image build (GLINT_CULL_FROM_DEPTH, main() at the end): whether sample t of light i sees
+// it, at word i * N^2 + t, and the count of finished workgroups. Binding 1 holds the depth image
+// again: this build reads no pyramid.
+layout(std430, binding = 7) coherent buffer SampleSeen { uint sample_words[]; };
+layout(std430, binding = 8) coherent buffer Finished { uint finished_groups; };
+#endif
 #define GLINT_CULL_STORES_INSTANCES
 #define GLINT_CULL_STORES_ARGUMENTS
 #include "light_cull_outputs.glsl"
@@ -233,6 +240,17 @@ uint cull_project(uint i, out vec4 words[3], out vec2 center, out float ndc_z, o
   return GLINT_FLARE_VISIBLE;
 }
 
+#ifdef GLINT_CULL_FROM_DEPTH
+// The samples of light i that see it, as the depth-image workgroups found them (coherent loads:
+// they were written by other workgroups of this dispatch).
+float samples_fraction(uint i) {
+  const uint n2 = pc.grid * pc.grid;
+  uint seen = 0u;
+  for (uint t = 0u; t < n2; ++t) seen += sample_words[i * n2 + t];
+  return float(seen) / float(n2);
+}
+#endif
+
 // Cull and grid test of light i: its state (GLINT_FLARE_VISIBLE, _OCCLUDED, _FRUSTUM or _DISABLED),
 // and for a light that reaches the grid test its pixel centre, visible fraction and NDC depth.
 uint cull_light(uint i, out vec4 words[3], out vec2 center, out float fraction, out float ndc_z) {
@@ -240,7 +258,11 @@ uint cull_light(uint i, out vec4 words[3], out vec2 center, out float fraction, 
   fraction = 0.0;
   const uint state = cull_project(i, words, center, ndc_z, size);
   if (state != GLINT_FLARE_VISIBLE) return state;
+#ifdef GLINT_CULL_FROM_DEPTH
+  fraction = samples_fraction(i);
+#else
   fraction = grid_test(center, size, ndc_z);
+#endif
   return fraction > 0.0 ? GLINT_FLARE_VISIBLE : GLINT_FLARE_OCCLUDED;
 }
 
@@ -311,13 +333,18 @@ const uint kHidden = 0x80000000u;
 // sharing code and light_seen fold away.
 layout(constant_id = 2) const uint kShareSamples = 1u;
 
-void main() {
+void cull_in_one_group() {
   const uint lid = gl_LocalInvocationIndex;
   const uint size = gl_WorkGroupSize.x * gl_WorkGroupSize.y;  // at most 1024: 32 mask words
   const uint n2 = pc.grid * pc.grid;
   // Invocations per light: one per sample and one for the early out when the workgroup holds them
   // for every light (the same in every invocation: pc.count is uniform).
-  const uint lanes = kShareSamples != 0u ? clamp(size / max(pc.count, 1u), 1u, pc.grid > 1u ? n2 + 1u : 1u) : 1u;
+#ifdef GLINT_CULL_FROM_DEPTH
+  const bool share = false;  // the samples are read already
+#else
+  const bool share = kShareSamples != 0u;
+#endif
+  const uint lanes = share ? clamp(size / max(pc.count, 1u), 1u, pc.grid > 1u ? n2 + 1u : 1u) : 1u;
   const uint per_chunk = size / lanes;  // lights per chunk
   const uint words_used = (per_chunk + 31u) / 32u;
   const uint l = lid / lanes, lane = lid % lanes;
@@ -394,4 +421,82 @@ void main() {
   cull_store_arguments(pc.count, before, group_frustum, group_occluded, group_disabled, pc.capacity, pc.vertex_count,
                        pc.groups_per_instance, pc.max_group_count_x);
 }
+
+#ifndef GLINT_CULL_FROM_DEPTH
+void main() { cull_in_one_group(); }
+#else
+// Few lights without a pyramid (light_culler.cpp picks this build when its reads are fewer than
+// the pyramid's: docs/OCCLUSION.md, "Few lights from the depth image"). Workgroup w tests sample
+// t = w % N^2 of light w / N^2: it finds the sample's window at level k as sample_seen() does and
+// reads the depth pixels those level-k texels cover, [c 2^k, (c + 1) 2^k) per texel c, the last
+// texel of a level to the image's edge (the fold rule, hiz_read.glsl). A texel holds the farthest
+// depth of exactly those pixels, so "some texel is not nearer than the light" is "some pixel is not
+// nearer": the same answer as the pyramid's, without building it. A window of more than
+// GLINT_CULL_MAX_WINDOW_TEXELS texels counts as seen without reading, as there. The workgroup stores
+// its answer, makes it visible (memoryBarrierBuffer) and counts itself finished; the last one
+// (Kirk and Hwu's threadFenceReduction pattern, AMD FidelityFX SPD's global counter) resets the
+// count for the next cull and runs the one-workgroup cull above, each light's fraction from its
+// samples' words: instances in light order, results, arguments and statistics. At least one
+// workgroup runs (count 0: the last one writes the empty frame's outputs).
+shared uint group_seen;
+shared bool group_last;
+
+void main() {
+  const uint lid = gl_LocalInvocationIndex;
+  const uint size = gl_WorkGroupSize.x * gl_WorkGroupSize.y;
+  const uint n2 = pc.grid * pc.grid;
+  const uint w = gl_WorkGroupID.x;
+  const uint i = w / n2, t = w % n2;
+  if (lid == 0u) group_seen = 0u;
+  barrier();
+  if (i < pc.count) {  // uniform in the workgroup: every invocation projects the same light
+    vec4 words[3];
+    vec2 center;
+    float ndc_z, light_size;
+    if (cull_project(i, words, center, ndc_z, light_size) == GLINT_FLARE_VISIBLE) {
+      const GridTest g = grid_setup(center, light_size, ndc_z);
+      const int si = int(t % pc.grid), sj = int(t / pc.grid);
+      const ivec2 sx = sample_span(si, sj, g.n, g.regular), sy = sample_span(sj, si, g.n, g.regular);
+      const ivec2 tx = texel_range(g.origin.x + float(sx.x) * g.unit, g.origin.x + float(sx.y) * g.unit, g.k, pc.width,
+                                   g.lsize.x);
+      const ivec2 ty = texel_range(g.origin.y + float(sy.x) * g.unit, g.origin.y + float(sy.y) * g.unit, g.k, pc.height,
+                                   g.lsize.y);
+      if ((tx.y - tx.x + 1) * (ty.y - ty.x + 1) > GLINT_CULL_MAX_WINDOW_TEXELS) {
+        if (lid == 0u) group_seen = 1u;
+      } else {
+        // The pixels of texels [t0, t1] of level k.
+        const ivec2 pixels = ivec2(pc.width, pc.height);
+        const ivec2 t0 = ivec2(tx.x, ty.x), t1 = ivec2(tx.y, ty.y);
+        const ivec2 p0 = t0 << g.k;
+        const ivec2 p1 = mix((t1 + 1) << g.k, pixels, equal(t1, g.lsize - 1));  // exclusive
+        const uint span_x = uint(p1.x - p0.x);
+        const uint pixel_count = span_x * uint(p1.y - p0.y);
+        bool seen = false;
+        // Four fetches in flight per invocation and round; past the end an invocation reads the
+        // window's last pixel again (a repeated pixel changes no answer).
+        for (uint base = lid; base < pixel_count && !seen; base += 4u * size) {
+          float d[4];
+          for (uint r = 0u; r < 4u; ++r) {
+            const uint q = min(base + r * size, pixel_count - 1u);
+            d[r] = texelFetch(depth_tex, p0 + ivec2(q % span_x, q / span_x), 0).r;
+          }
+          for (uint r = 0u; r < 4u; ++r) seen = seen || (g.reversed ? d[r] <= g.zt : d[r] >= g.zt);
+        }
+        if (seen) atomicOr(group_seen, 1u);
+      }
+    }
+  }
+  barrier();
+  if (lid == 0u) {
+    sample_words[w] = group_seen;
+    memoryBarrierBuffer();
+    group_last = atomicAdd(finished_groups, 1u) == max(pc.count * n2, 1u) - 1u;
+  }
+  barrier();
+  if (!group_last) return;
+  if (lid == 0u) finished_groups = 0u;
+  memoryBarrierBuffer();
+  cull_in_one_group();
+}
+#endif
 #endif
