@@ -45,7 +45,15 @@ void BM_FlareEndToEnd(benchmark::State& state) {
   pc.clamp_capacity = true;
   LensFlarePass pass(ctx, pc);
   if (visibility == 1) detail::LightCullAccess::select_path(pass.culler(), detail::LightCullPath::pyramid);
-  if (visibility == 2) detail::LightCullAccess::select_path(pass.culler(), detail::LightCullPath::depth);
+  if (visibility >= 2) detail::LightCullAccess::select_path(pass.culler(), detail::LightCullPath::depth);
+  if (visibility == 3) {
+    try {
+      detail::LightCullAccess::set_depth_workgroup(pass.culler(), 256);
+    } catch (const Error& e) {  // CPU devices: the one-workgroup cull has 64 invocations
+      state.SkipWithError(e.what());
+      return;
+    }
+  }
 
   detail::OwnedImage color(ctx, {w, h}, VK_FORMAT_R16G16B16A16_SFLOAT,
                            detail::kToolImageUsage | VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT);
@@ -132,7 +140,8 @@ void BM_FlareEndToEnd(benchmark::State& state) {
 }
 
 // visibility: 0 as LensFlarePass chooses (the speed table's rows), 1 the Hi-Z pyramid, 2 the depth
-// image read by the cull (LightCuller::needs_pyramid; docs/OCCLUSION.md): where the choice turns.
+// image read by the cull (LightCuller::needs_pyramid; docs/OCCLUSION.md): where the choice turns;
+// 3 the depth image in workgroups of 256 (the default is the one-workgroup cull's size).
 BENCHMARK(BM_FlareEndToEnd)
     ->Args({10, 0, 0})
     ->Args({10, 1, 0})
@@ -140,6 +149,8 @@ BENCHMARK(BM_FlareEndToEnd)
     ->Args({1000, 1, 0})
     ->Args({10, 1, 1})
     ->Args({10, 1, 2})
+    ->Args({10, 1, 3})
+    ->Args({10, 0, 1})
     ->Args({31, 1, 1})
     ->Args({31, 1, 2})
     ->Args({64, 1, 1})

@@ -65,6 +65,20 @@ constexpr uint32_t kMaxGroupsX = 65535;  // guaranteed maxComputeWorkGroupCount[
 // 1000 lights with N = 8 and 16 (65.7 against 61.9 us, 231.7 against 185.9), where one
 // multiprocessor's fetch rate holds it; fewer samples only shorten its work.
 constexpr uint32_t kOneGroupSamples = 16384;
+
+// The depth-image cull's pipeline in workgroups of `size` invocations (kShareSamples = 0: its last
+// workgroup culls one light per invocation).
+detail::PipelineDesc from_depth_desc(uint32_t size) {
+  const auto S = VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE;
+  const auto B = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+  detail::PipelineDesc d;
+  d.kernel_id = "light_cull_from_depth";
+  d.bindings = {S, S, B, B, B, B, B, B, B};
+  d.push_constant_bytes = sizeof(GlintCullPush);
+  d.workgroup = {size, 1};
+  d.specialization = {0};
+  return d;
+}
 // Samples (lights x N^2) the depth-image cull holds words for: a workgroup each, within the
 // guaranteed maxComputeWorkGroupCount[0]. The device's choice stays under kOneGroupSamples.
 constexpr uint32_t kDepthSamples = 65535;
@@ -106,6 +120,7 @@ struct LightCuller::Impl {
   // (needs_pyramid() == false). Its words (one per sample) and its count of finished workgroups,
   // which the kernel resets after each cull (cleared once, by the first record() that uses it).
   detail::ComputePipeline from_depth;
+  uint32_t depth_group_size = 64;  // its workgroup (one_group_size; detail::LightCullAccess may change it)
   detail::OwnedBuffer sample_words;
   Buffer sample_words_state;
   detail::OwnedBuffer finished;
@@ -161,9 +176,8 @@ LightCuller::LightCuller(const Context& context, const LightCullConfig& config) 
   m.one_group = detail::ComputePipeline(context, d);
   d.specialization = {0};
   m.one_group_per_light = detail::ComputePipeline(context, d);
-  d.kernel_id = "light_cull_from_depth";
-  d.bindings = {S, S, B, B, B, B, B, B, B};
-  m.from_depth = detail::ComputePipeline(context, d);
+  m.depth_group_size = m.one_group_size;
+  m.from_depth = detail::ComputePipeline(context, from_depth_desc(m.depth_group_size));
   d.specialization = {};
   m.depth_samples =
       uint32_t(std::min<uint64_t>(uint64_t(config.max_lights) * config.grid * config.grid, kDepthSamples));
@@ -329,7 +343,7 @@ void LightCuller::record(VkCommandBuffer cmd, HiZPyramid& hiz, Image& depth, Buf
          {&out.instances, &results, &out.indirect, &out.stats, &m.sample_words_state, &m.finished_state}) {
       set.push_back(*o);
     }
-    m.from_depth.dispatch(cmd, set, push, uint32_t(depth_groups) * m.one_group_size, 1);
+    m.from_depth.dispatch(cmd, set, push, uint32_t(depth_groups) * m.depth_group_size, 1);
     if (profiler) profiler->mark(cmd, "light cull");
     return;
   }
@@ -389,6 +403,18 @@ void LightCuller::record(VkCommandBuffer cmd, HiZPyramid& hiz, Image& depth, Buf
 namespace detail {
 
 void LightCullAccess::select_path(LightCuller& culler, LightCullPath path) { culler.impl_->path = path; }
+
+void LightCullAccess::set_depth_workgroup(LightCuller& culler, uint32_t size) {
+  LightCuller::Impl& m = *culler.impl_;
+  if (size < 32 || size > m.one_group_size || size % 32 != 0) {
+    throw Error(ErrorCode::invalid_argument,
+                concat("LightCullAccess::set_depth_workgroup: size = ", size,
+                       " is out of range: accepted multiples of 32 from 32 to ", m.one_group_size));
+  }
+  if (size == m.depth_group_size) return;
+  m.from_depth = detail::ComputePipeline(*m.context, from_depth_desc(size));
+  m.depth_group_size = size;
+}
 
 }  // namespace detail
 

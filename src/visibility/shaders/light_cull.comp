@@ -51,6 +51,8 @@ layout(std430, binding = 5) writeonly buffer Indirect { GlintFlareIndirect indir
 layout(std430, binding = 6) writeonly buffer Stats { GlintFlareStats stats; };
 // The visible lights of the current chunk, one bit per light of the chunk (at most 1024).
 shared uint chunk_mask[32];
+// Per light of the chunk: samples that see it; bit 31: the early out (main() below).
+shared uint light_seen[1024];
 #ifdef GLINT_CULL_FROM_DEPTH
 // The depth-image build (GLINT_CULL_FROM_DEPTH, main() at the end): whether sample t of light i sees
 // it, at word i * N^2 + t, and the count of finished workgroups. Binding 1 holds the depth image
@@ -241,13 +243,10 @@ uint cull_project(uint i, out vec4 words[3], out vec2 center, out float ndc_z, o
 }
 
 #ifdef GLINT_CULL_FROM_DEPTH
-// The samples of light i that see it, as the depth-image workgroups found them (coherent loads:
-// they were written by other workgroups of this dispatch).
+// The samples of light i that see it, as the depth-image workgroups found them: light_seen holds
+// them per light of the chunk (cull_in_one_group(); chunks are whole workgroups of lights here).
 float samples_fraction(uint i) {
-  const uint n2 = pc.grid * pc.grid;
-  uint seen = 0u;
-  for (uint t = 0u; t < n2; ++t) seen += sample_words[i * n2 + t];
-  return float(seen) / float(n2);
+  return float(light_seen[i % (gl_WorkGroupSize.x * gl_WorkGroupSize.y)]) / float(pc.grid * pc.grid);
 }
 #endif
 
@@ -326,7 +325,6 @@ void main() {
 // the chunk's mask, so instances are in light order, as the compaction of the multi-workgroup path
 // puts them. Then the indirect arguments and statistics, as light_cull_scan.comp writes them. No
 // group buffer, no other dispatch.
-shared uint light_seen[1024];  // per light of the chunk: samples that see it; bit 31: the early out
 const uint kHidden = 0x80000000u;
 // 0: one invocation per light whatever the count (light_culler.cpp picks this build on CPU devices
 // and for more than half as many lights as invocations): lanes is then the constant 1, so the
@@ -358,6 +356,16 @@ void cull_in_one_group() {
   for (uint c0 = 0u; c0 < pc.count; c0 += per_chunk) {
     if (lid < words_used) chunk_mask[lid] = 0u;
     if (lanes > 1u && lid < per_chunk) light_seen[lid] = 0u;
+#ifdef GLINT_CULL_FROM_DEPTH
+    // The chunk's sample words, one per invocation and round (all loads in flight together; coherent:
+    // other workgroups of this dispatch wrote them), counted per light.
+    light_seen[lid] = 0u;  // per_chunk == size: one invocation per light
+    barrier();
+    const uint chunk_samples = min(per_chunk, pc.count - c0) * n2;
+    for (uint j = lid; j < chunk_samples; j += size) {
+      if (sample_words[c0 * n2 + j] != 0u) atomicAdd(light_seen[j / n2], 1u);
+    }
+#endif
     barrier();
     const uint i = c0 + l;
     const bool in_range = l < per_chunk && i < pc.count;
