@@ -46,9 +46,10 @@ void BM_FlareEndToEnd(benchmark::State& state) {
   LensFlarePass pass(ctx, pc);
   if (visibility == 1) detail::LightCullAccess::select_path(pass.culler(), detail::LightCullPath::pyramid);
   if (visibility >= 2) detail::LightCullAccess::select_path(pass.culler(), detail::LightCullPath::depth);
-  if (visibility == 3) {
+  if (visibility >= 3) {
     try {
-      detail::LightCullAccess::set_depth_workgroup(pass.culler(), 256);
+      constexpr uint32_t kSizes[] = {64, 128, 512, 1024};
+      detail::LightCullAccess::set_depth_workgroup(pass.culler(), kSizes[std::min<int64_t>(visibility - 3, 3)]);
     } catch (const Error& e) {  // CPU devices: the one-workgroup cull has 64 invocations
       state.SkipWithError(e.what());
       return;
@@ -141,7 +142,7 @@ void BM_FlareEndToEnd(benchmark::State& state) {
 
 // visibility: 0 as LensFlarePass chooses (the speed table's rows), 1 the Hi-Z pyramid, 2 the depth
 // image read by the cull (LightCuller::needs_pyramid; docs/OCCLUSION.md): where the choice turns;
-// 3 the depth image in workgroups of 256 (the default is the one-workgroup cull's size).
+// 3 to 6 the depth image in workgroups of 64, 128, 512 and 1024 (the default is 256 on GPUs).
 BENCHMARK(BM_FlareEndToEnd)
     ->Args({10, 0, 0})
     ->Args({10, 1, 0})
@@ -150,6 +151,9 @@ BENCHMARK(BM_FlareEndToEnd)
     ->Args({10, 1, 1})
     ->Args({10, 1, 2})
     ->Args({10, 1, 3})
+    ->Args({10, 1, 4})
+    ->Args({10, 1, 5})
+    ->Args({10, 1, 6})
     ->Args({10, 0, 1})
     ->Args({31, 1, 1})
     ->Args({31, 1, 2})

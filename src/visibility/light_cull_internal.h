@@ -37,7 +37,8 @@ struct LightCullAccess {
   /// Selects the path `culler` records from now on.
   static void select_path(LightCuller& culler, LightCullPath path);
   /// The depth-image cull's workgroup (32 to the one-workgroup size, a multiple of 32; the default is
-  /// that size): each sample's workgroup and the last one, which culls chunks of that many lights.
+  /// 256 or that size if smaller): each sample's workgroup and the last one, which culls chunks of
+  /// that many lights.
   static void set_depth_workgroup(LightCuller& culler, uint32_t size);
 };
 
