@@ -807,8 +807,8 @@ TEST_F(OcclusionTest, DepthImageCullGivesTheBitsOfThePyramidCull) {
 }
 
 // LightCuller::needs_pyramid: the depth image is read where the samples' windows (count x N^2 x
-// 4^(levels + 1) pixels at most) hold no more pixels than the image, for counts the one-workgroup
-// cull takes; the pyramid otherwise, and on the forced paths as they say.
+// 4^(levels + 1) pixels at most) hold no more than twice the image's pixels, for counts the
+// one-workgroup cull takes; the pyramid otherwise, and on the forced paths as they say.
 TEST_F(OcclusionTest, CullReadsTheDepthImageOnlyWhereItsWindowsAreSmallerThanTheImage) {
   LightCullConfig config;  // N = 4
   LightCuller culler(context(), config);
@@ -817,11 +817,11 @@ TEST_F(OcclusionTest, CullReadsTheDepthImageOnlyWhereItsWindowsAreSmallerThanThe
   hc.max_cell_px = 32;  // 5 levels, as LensFlarePass makes for lights of up to 128 px
   HiZPyramid capped(context(), hc);
   ASSERT_EQ(capped.levels(), 5u);
-  // 31 x 16 x 4^6 = 2031616 <= 1920 x 1080 = 2073600 < 32 x 16 x 4^6.
+  // 63 x 16 x 4^6 = 4128768 <= 2 x 1920 x 1080 = 4147200 < 64 x 16 x 4^6.
   EXPECT_FALSE(culler.needs_pyramid(capped, 0));
   EXPECT_FALSE(culler.needs_pyramid(capped, 10));
-  EXPECT_EQ(culler.needs_pyramid(capped, 31), 31u > culler.one_group_lights());
-  EXPECT_TRUE(culler.needs_pyramid(capped, 32));
+  EXPECT_EQ(culler.needs_pyramid(capped, 63), 63u > culler.one_group_lights());
+  EXPECT_TRUE(culler.needs_pyramid(capped, 64));
   hc.max_cell_px = 0;  // 10 levels: any window may cover more than the image
   HiZPyramid full(context(), hc);
   EXPECT_TRUE(culler.needs_pyramid(full, 1));

@@ -182,9 +182,9 @@ class LightCuller {
   const LightCullConfig& config() const;
 
   /// Whether record() of `count` lights against a pyramid made as `hiz` reads the pyramid. False
-  /// when the lights are few and the pyramid shallow enough that their samples' windows hold fewer
-  /// depth pixels than the image (count x N^2 x 4^(levels + 1) <= width x height, count <=
-  /// one_group_lights()): record() then reads the same pixels from the depth image, with the
+  /// when the lights are few and the pyramid shallow enough that their samples' windows hold at
+  /// most twice the depth image's pixels (count x N^2 x 4^(levels + 1) <= 2 x width x height,
+  /// count <= one_group_lights()): record() then reads the same pixels from the depth image, with the
   /// pyramid's answers (docs/OCCLUSION.md, "Few lights from the depth image"), and the caller may
   /// skip HiZPyramid::record() for this cull. A fact of the configs, the device and `count`.
   bool needs_pyramid(const HiZPyramid& hiz, uint32_t count) const;
