@@ -728,7 +728,7 @@ TEST_F(OcclusionTest, OneWorkgroupCullGivesTheBitsOfTheFourDispatches) {
 // The depth-image cull (a workgroup per sample reading its window's pixels, the last workgroup
 // culling) gives the bits of the cull that reads the pyramid: instances, results, arguments and
 // statistics, both Z conventions, multi-jittered and regular grids of 1 to 4, pyramids capped at
-// 2 to 5 levels and uncapped (8 levels: windows of up to 512x286 pixels at the image's edge), no
+// 2 to 5 levels and uncapped (8 levels: a window may cover the whole 257x143 image), no
 // light, one, a few and more than one chunk of the last workgroup (150 lights also in workgroups
 // of 32, on every device), capacity overflow, and two
 // frames on one command buffer (the count of finished workgroups resets). Lights of up to 90 px
@@ -806,9 +806,10 @@ TEST_F(OcclusionTest, DepthImageCullGivesTheBitsOfThePyramidCull) {
   }
 }
 
-// LightCuller::needs_pyramid: the depth image is read where the samples' windows (count x N^2 x
-// 4^(levels + 1) pixels at most) hold no more than twice the image's pixels, for counts the
-// one-workgroup cull takes; the pyramid otherwise, and on the forced paths as they say.
+// LightCuller::needs_pyramid: the depth image is read where the pyramid has at most 5 levels and
+// the samples' windows (estimated as count x N^2 x 4^(levels + 1) pixels) hold no more than twice
+// the image's pixels, for counts the one-workgroup cull takes; the pyramid otherwise (any count over
+// a deeper pyramid, even none or one light at N = 1), and on the forced paths as they say.
 TEST_F(OcclusionTest, CullReadsTheDepthImageOnlyWhereItsWindowsAreSmallerThanTheImage) {
   LightCullConfig config;  // N = 4
   LightCuller culler(context(), config);
@@ -822,9 +823,22 @@ TEST_F(OcclusionTest, CullReadsTheDepthImageOnlyWhereItsWindowsAreSmallerThanThe
   EXPECT_FALSE(culler.needs_pyramid(capped, 10));
   EXPECT_EQ(culler.needs_pyramid(capped, 63), 63u > culler.one_group_lights());
   EXPECT_TRUE(culler.needs_pyramid(capped, 64));
-  hc.max_cell_px = 0;  // 10 levels: any window may cover more than the image
+  hc.max_cell_px = 64;  // 6 levels: deeper than the depth-image cull takes
+  HiZPyramid six(context(), hc);
+  ASSERT_EQ(six.levels(), 6u);
+  EXPECT_TRUE(culler.needs_pyramid(six, 0));
+  EXPECT_TRUE(culler.needs_pyramid(six, 1));
+  hc.max_cell_px = 0;  // 10 levels
   HiZPyramid full(context(), hc);
+  EXPECT_TRUE(culler.needs_pyramid(full, 0));
   EXPECT_TRUE(culler.needs_pyramid(full, 1));
+  LightCullConfig one_sample;  // N = 1 over a near-square image: 1 x 1 x 4^10 <= 2 x 1000 x 1000
+  one_sample.grid = 1;
+  LightCuller single(context(), one_sample);
+  hc.extent = {1000, 1000};
+  HiZPyramid square(context(), hc);
+  ASSERT_EQ(square.levels(), 9u);
+  EXPECT_TRUE(single.needs_pyramid(square, 1)) << "a few workgroups would read most of the image";
   detail::LightCullAccess::select_path(culler, detail::LightCullPath::pyramid);
   EXPECT_TRUE(culler.needs_pyramid(capped, 10));
   detail::LightCullAccess::select_path(culler, detail::LightCullPath::depth);

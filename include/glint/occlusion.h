@@ -119,7 +119,9 @@ struct LightCullConfig {
       0.0f;  //!< NDC depth tolerance: a light up to this much behind a surface
              //!< still counts as visible there (0 to 0.1; 0.01 hides depth-precision noise on coplanar lights)
   uint32_t max_lights = 1u << 20;  //!< most lights per record() (1 to 4194240 = 65535 x 64); the
-                                   //!< culler keeps 16 bytes per light (and 16 per 64) for it
+                                   //!< culler keeps 16 bytes per light (and 16 per 64) for it, and
+                                   //!< 4 per sample up to 65535 samples (max_lights x N^2) for the
+                                   //!< depth-image cull
   OcclusionPattern pattern = OcclusionPattern::multi_jittered;  //!< where the N x N samples read
 
   void validate() const;
@@ -173,7 +175,9 @@ class LightCuller {
   /// outputs were last written by the compute shader stage: a draw needs a barrier to
   /// DRAW_INDIRECT / INDIRECT_COMMAND_READ for `indirect` and to VERTEX_SHADER (or COMPUTE) /
   /// SHADER_STORAGE_READ for `instances`. The first four-dispatch record() clears the internal
-  /// counters once.
+  /// counters once, and so does the first record() that reads the depth image; submit the command
+  /// buffers they were recorded into (a culler whose first such record() was never submitted is
+  /// left with uncleared counters: make a new one).
   /// Throws Error before recording if a buffer is null, too small or lacks a usage, if `depth`
   /// does not match `hiz`, or if count or `frame` is out of range.
   void record(VkCommandBuffer cmd, HiZPyramid& hiz, Image& depth, Buffer& lights, uint32_t count,
@@ -182,11 +186,14 @@ class LightCuller {
   const LightCullConfig& config() const;
 
   /// Whether record() of `count` lights against a pyramid made as `hiz` reads the pyramid. False
-  /// when the lights are few and the pyramid shallow enough that their samples' windows hold at
-  /// most twice the depth image's pixels (count x N^2 x 4^(levels + 1) <= 2 x width x height,
-  /// count <= one_group_lights()): record() then reads the same pixels from the depth image, with the
-  /// pyramid's answers (docs/OCCLUSION.md, "Few lights from the depth image"), and the caller may
-  /// skip HiZPyramid::record() for this cull. A fact of the configs, the device and `count`.
+  /// when the lights are few (count <= one_group_lights()), the pyramid has at most 5 levels (a
+  /// HiZConfig::max_cell_px of at most 32, as LensFlarePass sets for lights of up to 128 px at
+  /// N = 4) and the samples' windows, estimated as 2x2 texels of the last level each, hold at most
+  /// twice the depth image's pixels (count x N^2 x 4^(levels + 1) <= 2 x width x height; so also
+  /// for no light): record() then reads the pixels under the windows' texels from the depth image
+  /// itself, with the pyramid's answers (docs/OCCLUSION.md, "Few lights from the depth image"), and
+  /// the caller may skip HiZPyramid::record() for this cull. A fact of the configs, the device and
+  /// `count`.
   bool needs_pyramid(const HiZPyramid& hiz, uint32_t count) const;
 
   /// The largest LightCullFrame::groups_per_instance this culler's capacity allows on this device:

@@ -182,6 +182,7 @@ void LensFlare::record_compute(VkCommandBuffer cmd, Image& color, Buffer& instan
     b.use(m.split_state, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);  // fill = "transfer"
     b.flush(cmd);
     vkCmdFillBuffer(cmd, m.split_state.buffer, 0, VK_WHOLE_SIZE, 0);
+    detail::count_recorded_command();
     m.split_cleared = true;
   }
   // 2. The sprite pre-pass: every sprite of every instance, once (with the split, each tile's

@@ -296,6 +296,7 @@ void HiZPyramid::record(VkCommandBuffer cmd, Image& depth, Profiler* profiler) {
     b.use(m.counter_state, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);  // fill = "transfer"
     b.flush(cmd);
     vkCmdFillBuffer(cmd, m.counters.buffer(), 0, VK_WHOLE_SIZE, 0);
+    detail::count_recorded_command();
     m.counters_cleared = true;
   }
   b.use(depth, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, kCompute, kSampled);

@@ -26,7 +26,8 @@ enum class LightCullPath : uint32_t {
   one_group_shared_samples,
   /// light_cull.comp built with GLINT_CULL_ONE_GROUP and GLINT_CULL_FROM_DEPTH: a workgroup per
   /// sample reads its window's pixels from the depth image, the last to finish culls every light
-  /// as `one_group` does (one invocation per light). Any count, on any device; the pyramid is not read.
+  /// as `one_group` does (one invocation per light). Up to 65535 / N^2 lights (record() refuses more),
+  /// on any device; the pyramid is not read.
   depth,
   /// As `device` without `depth`: `one_group` up to one_group_lights(), else `groups` (the choice
   /// before the depth path existed; for comparisons).

@@ -82,6 +82,9 @@ detail::PipelineDesc from_depth_desc(uint32_t size) {
 // The depth-image cull's workgroup: on an NVIDIA H200 the 10-light flare frame took 27.1 us with
 // 256 invocations against 30.1 with 1024 (docs/OCCLUSION.md, "Few lights from the depth image").
 constexpr uint32_t kDepthGroup = 256;
+// The deepest pyramid whose windows the depth-image cull reads instead (LightCuller::needs_pyramid):
+// the flare pass's for lights of up to 128 px at N = 4, where it was measured.
+constexpr uint32_t kDepthMaxLevels = 5;
 // Samples (lights x N^2) the depth-image cull holds words for: a workgroup each, within the
 // guaranteed maxComputeWorkGroupCount[0]. The device's choice stays under kOneGroupSamples.
 constexpr uint32_t kDepthSamples = 65535;
@@ -227,13 +230,16 @@ bool LightCuller::needs_pyramid(const HiZPyramid& hiz, uint32_t count) const {
   const Impl& m = *impl_;
   if (m.path == detail::LightCullPath::depth) return false;
   if (m.path != detail::LightCullPath::device || count > m.one_group_lights) return true;
-  // The pixels the samples' windows can cover (at most 2 texels of level `levels` per axis, each at
-  // most 2^(levels + 1) - 1 pixels wide at the edge, so under 4^(levels + 1) pixels) against twice
-  // the pixels the pyramid's build reads: on an NVIDIA H200 at 1920x1080 with 5 levels the depth
-  // image won the flare frame at 10, 31 and 64 lights (27.1 / 59.5 / 74.1 us against 33.4 / 64.7 /
-  // 78.5; the rule takes up to 63). Beyond level 12 the bound exceeds twice the largest image.
+  // A pyramid of at most kDepthMaxLevels levels, so that a sample's window is a few thousand pixels
+  // (at most 2x2 texels of 32x32 pixels inside the light, 3x3 on its border; a light larger than the
+  // pyramid's cap up to GLINT_CULL_MAX_WINDOW_TEXELS texels): one round of fetches for a workgroup
+  // of 256, where a deep pyramid's windows would have a few workgroups read most of the image.
+  // Then the windows' pixels, estimated as 2x2 texels of level `levels` per sample (4^(levels + 1)),
+  // against twice the pixels the pyramid's build reads: on an NVIDIA H200 at 1920x1080 with 5
+  // levels the depth image won the flare frame at 10, 31 and 64 lights (27.1 / 59.5 / 74.1 us
+  // against 33.4 / 64.7 / 78.5; the rule takes up to 63). No light: nothing to read.
   const uint32_t levels = hiz.levels();
-  if (levels > 12) return true;
+  if (levels > kDepthMaxLevels) return true;
   const uint64_t n2 = uint64_t(m.config.grid) * m.config.grid;
   const uint64_t window = uint64_t(1) << (2 * (levels + 1));
   const VkExtent2D e = hiz.config().extent;
@@ -324,40 +330,24 @@ void LightCuller::record(VkCommandBuffer cmd, HiZPyramid& hiz, Image& depth, Buf
   const detail::Bindings inputs{
       depth_binding,
       from_depth ? depth_binding : detail::Binding{hiz.image().view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL}, lights};
-  if (from_depth) {
-    // A workgroup per sample, the last one culls: slots, instances, results, arguments, statistics.
-    if (!m.finished_cleared) {  // once per object: the kernel resets the count after each cull
+  if (from_depth || one_group) {
+    // One dispatch writes the slots, instances, results, arguments and statistics: one workgroup,
+    // or from the depth image a workgroup per sample, the last of which culls.
+    if (from_depth && !m.finished_cleared) {  // once per object: the kernel resets the count after each cull
       b.use(m.finished_state, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);
       b.flush(cmd);
       vkCmdFillBuffer(cmd, m.finished.buffer(), 0, VK_WHOLE_SIZE, 0);
+      detail::count_recorded_command();
       m.finished_cleared = true;
     }
     b.use(out.instances, kCompute, kStorageWrite);
     b.use(results, kCompute, kStorageWrite);
     b.use(out.indirect, kCompute, kStorageWrite);
     b.use(out.stats, kCompute, kStorageWrite);
-    b.use(m.sample_words_state, kCompute, kStorageRead | kStorageWrite);
-    b.use(m.finished_state, kCompute, kStorageRead | kStorageWrite);
-    b.flush(cmd);
-    push.capacity = m.config.capacity;
-    push.vertex_count = frame.vertex_count;
-    push.groups_per_instance = frame.groups_per_instance;
-    push.max_group_count_x = m.max_groups_x;
-    detail::Bindings set = inputs;
-    for (const Buffer* o :
-         {&out.instances, &results, &out.indirect, &out.stats, &m.sample_words_state, &m.finished_state}) {
-      set.push_back(*o);
+    if (from_depth) {
+      b.use(m.sample_words_state, kCompute, kStorageRead | kStorageWrite);
+      b.use(m.finished_state, kCompute, kStorageRead | kStorageWrite);
     }
-    m.from_depth.dispatch(cmd, set, push, uint32_t(depth_groups) * m.depth_group_size, 1);
-    if (profiler) profiler->mark(cmd, "light cull");
-    return;
-  }
-  if (one_group) {
-    // One workgroup: cull, grid test, slots, instances, results, arguments and statistics.
-    b.use(out.instances, kCompute, kStorageWrite);
-    b.use(results, kCompute, kStorageWrite);
-    b.use(out.indirect, kCompute, kStorageWrite);
-    b.use(out.stats, kCompute, kStorageWrite);
     b.flush(cmd);
     push.capacity = m.config.capacity;
     push.vertex_count = frame.vertex_count;
@@ -365,11 +355,17 @@ void LightCuller::record(VkCommandBuffer cmd, HiZPyramid& hiz, Image& depth, Buf
     push.max_group_count_x = m.max_groups_x;
     detail::Bindings set = inputs;
     for (const Buffer* o : {&out.instances, &results, &out.indirect, &out.stats}) set.push_back(*o);
-    // At most half as many lights as invocations: on GPUs the lights share their samples over the
-    // workgroup (at least two invocations each).
-    const bool share = (m.share_samples || m.path == detail::LightCullPath::one_group_shared_samples) &&
-                       m.one_group_size / std::max(count, 1u) >= 2;
-    (share ? m.one_group : m.one_group_per_light).dispatch(cmd, set, push, m.one_group_size, 1);
+    if (from_depth) {
+      set.push_back(m.sample_words_state);
+      set.push_back(m.finished_state);
+      m.from_depth.dispatch(cmd, set, push, uint32_t(depth_groups) * m.depth_group_size, 1);
+    } else {
+      // At most half as many lights as invocations: on GPUs the lights share their samples over the
+      // workgroup (at least two invocations each).
+      const bool share = (m.share_samples || m.path == detail::LightCullPath::one_group_shared_samples) &&
+                         m.one_group_size / std::max(count, 1u) >= 2;
+      (share ? m.one_group : m.one_group_per_light).dispatch(cmd, set, push, m.one_group_size, 1);
+    }
     if (profiler) profiler->mark(cmd, "light cull");
     return;
   }
