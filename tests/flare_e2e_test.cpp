@@ -313,6 +313,9 @@ TEST_F(FlareEndToEndTest, FewLightsReadTheDepthImageAndDrawTheFrameThePyramidGiv
     const FrameResult a = run_frame(direct, background, depth, list, cam.view_proj(), look, 2);
     const FrameResult b = run_frame(pyramid, background, depth, list, cam.view_proj(), look, 2);
     const char* what = path == FlareDrawPath::compute ? "compute" : "raster";
+    // The pass built no pyramid (its image never left UNDEFINED); the other did.
+    EXPECT_EQ(direct.hiz().image().layout, VK_IMAGE_LAYOUT_UNDEFINED) << what;
+    EXPECT_NE(pyramid.hiz().image().layout, VK_IMAGE_LAYOUT_UNDEFINED) << what;
     EXPECT_EQ(std::memcmp(&a.stats, &b.stats, sizeof a.stats), 0) << what;
     EXPECT_EQ(std::memcmp(&a.indirect, &b.indirect, sizeof a.indirect), 0) << what;
     ASSERT_EQ(a.results.size(), list.size());
