@@ -4,7 +4,9 @@
 // Cull and occlusion grid test of the lens-flare lights (docs/OCCLUSION.md: a grid test on
 // the Hi-Z), the first of the four dispatches of the order-preserving compaction (the same
 // instance order on every run); built with GLINT_CULL_ONE_GROUP, the whole cull of few lights in
-// one workgroup (main() at the end). One invocation per light, GLINT_CULL_GROUP per workgroup
+// one workgroup (cull_in_one_group() at the end), and with GLINT_CULL_FROM_DEPTH too, the same
+// test read from the depth image by a workgroup per sample, the last of which runs that cull (the
+// last main()). One invocation per light, GLINT_CULL_GROUP per workgroup
 // (the one-workgroup variant: up to one invocation per sample, the lights chunk after chunk):
 // 1. reject disabled lights and lights with a non-finite float field (GLINT_FLARE_DISABLED), then
 //    project (Vulkan conventions) and reject w <= 0, non-finite clip coordinates, depth outside

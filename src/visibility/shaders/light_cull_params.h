@@ -1,6 +1,7 @@
 // Push constants and buffer layouts of the visibility stage of the lens flares: the Hi-Z build
 // (hiz_stream.comp, hiz_build.comp), the cull + occlusion grid test (light_cull.comp; for few
-// lights its one-workgroup variant compacts them itself), and the ordered compaction
+// lights its one-workgroup variant compacts them itself, and its depth-image variant reads the
+// samples' windows without a pyramid), and the ordered compaction
 // shared with the object cull (compact_params.h; the same order on every run): a two-level scan of
 // the cull's per-workgroup visibility masks (compact_scan_tiles.comp per tile, light_cull_scan.comp
 // over the tile totals, which also writes the indirect arguments and statistics), then the scatter
