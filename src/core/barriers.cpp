@@ -109,6 +109,13 @@ std::atomic<uint64_t> g_recorded_commands{0};
 uint64_t recorded_commands() { return g_recorded_commands.load(); }
 void count_recorded_command() { g_recorded_commands.fetch_add(1, std::memory_order_relaxed); }
 
+void record_zero_fill(VkCommandBuffer cmd, Barriers& b, Buffer& buffer, VkDeviceSize bytes) {
+  b.use(buffer, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);  // a fill is "transfer"
+  b.flush(cmd);
+  vkCmdFillBuffer(cmd, buffer.buffer, buffer.offset, bytes, 0);
+  count_recorded_command();
+}
+
 void Barriers::flush(VkCommandBuffer cmd) {
   if (pending_.empty() && pending_buffers_.empty()) return;
   count_recorded_command();

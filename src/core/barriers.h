@@ -69,6 +69,13 @@ class Barriers {
 uint64_t recorded_commands();
 void count_recorded_command();
 
+/// Records zeros over `bytes` bytes of `buffer` from its offset (VK_WHOLE_SIZE: to the end of the
+/// VkBuffer) with vkCmdFillBuffer, after the barrier from its last use (its state fields, flushed
+/// through `b`), and counts the command. The kernels' counters that reset themselves after each use
+/// are cleared so once per object (`if (!cleared) { record_zero_fill(...); cleared = true; }`): the
+/// command buffer that holds the first fill must be submitted.
+void record_zero_fill(VkCommandBuffer cmd, Barriers& b, Buffer& buffer, VkDeviceSize bytes = VK_WHOLE_SIZE);
+
 inline constexpr VkAccessFlags2 kWriteAccess = VK_ACCESS_2_SHADER_WRITE_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT |
                                                VK_ACCESS_2_TRANSFER_WRITE_BIT | VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT |
                                                VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT |

@@ -61,10 +61,7 @@ Compaction::Compaction(const Context& context, const Desc& desc) {
 
 void Compaction::record_clear_once(VkCommandBuffer cmd, Barriers& b) {
   if (counters_cleared_) return;
-  b.use(groups_state_, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);  // fill = "transfer"
-  b.flush(cmd);
-  vkCmdFillBuffer(cmd, groups_.buffer(), 0, GLINT_COMPACT_HEADER_WORDS * 4, 0);
-  count_recorded_command();
+  record_zero_fill(cmd, b, groups_state_, GLINT_COMPACT_HEADER_WORDS * 4);
   counters_cleared_ = true;
 }
 

@@ -179,10 +179,7 @@ void LensFlare::record_compute(VkCommandBuffer cmd, Image& color, Buffer& instan
   m.gather_args.dispatch(cmd, {indirect_words, m.gather_args_state}, ap, 1, 1);
   if (profiler) profiler->mark(cmd, "flare arguments");
   if (split && !m.split_cleared) {  // once per split buffer: after it, the plan zeroes the words it reads
-    b.use(m.split_state, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);  // fill = "transfer"
-    b.flush(cmd);
-    vkCmdFillBuffer(cmd, m.split_state.buffer, 0, VK_WHOLE_SIZE, 0);
-    detail::count_recorded_command();
+    detail::record_zero_fill(cmd, b, m.split_state);
     m.split_cleared = true;
   }
   // 2. The sprite pre-pass: every sprite of every instance, once (with the split, each tile's

@@ -293,10 +293,7 @@ void HiZPyramid::record(VkCommandBuffer cmd, Image& depth, Profiler* profiler) {
   detail::Barriers b;
   const bool tile_pass = m.levels > m.stream_levels;
   if (tile_pass && !m.counters_cleared) {  // once per object: the kernel resets the counter after each use
-    b.use(m.counter_state, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);  // fill = "transfer"
-    b.flush(cmd);
-    vkCmdFillBuffer(cmd, m.counters.buffer(), 0, VK_WHOLE_SIZE, 0);
-    detail::count_recorded_command();
+    detail::record_zero_fill(cmd, b, m.counter_state);
     m.counters_cleared = true;
   }
   b.use(depth, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, kCompute, kSampled);

@@ -121,7 +121,7 @@ struct LightCuller::Impl {
   // The same kernel with one invocation per light (specialization constant kShareSamples = 0), for
   // more than half as many lights as invocations (where each light would get one) and on CPU devices.
   detail::ComputePipeline one_group_per_light;
-  // light_cull.comp built with GLINT_CULL_FROM_DEPTH too: a workgroup of one_group_size per sample
+  // light_cull.comp built with GLINT_CULL_FROM_DEPTH too: a workgroup of depth_group_size per sample
   // reads its window from the depth image, the last to finish runs the one-workgroup cull
   // (needs_pyramid() == false). Its words (one per sample) and its count of finished workgroups,
   // which the kernel resets after each cull (cleared once, by the first record() that uses it).
@@ -334,10 +334,7 @@ void LightCuller::record(VkCommandBuffer cmd, HiZPyramid& hiz, Image& depth, Buf
     // One dispatch writes the slots, instances, results, arguments and statistics: one workgroup,
     // or from the depth image a workgroup per sample, the last of which culls.
     if (from_depth && !m.finished_cleared) {  // once per object: the kernel resets the count after each cull
-      b.use(m.finished_state, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);
-      b.flush(cmd);
-      vkCmdFillBuffer(cmd, m.finished.buffer(), 0, VK_WHOLE_SIZE, 0);
-      detail::count_recorded_command();
+      detail::record_zero_fill(cmd, b, m.finished_state);
       m.finished_cleared = true;
     }
     b.use(out.instances, kCompute, kStorageWrite);

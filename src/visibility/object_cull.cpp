@@ -460,10 +460,7 @@ void ObjectCuller::record_clear_history(VkCommandBuffer cmd, Buffer& visibility,
                VK_BUFFER_USAGE_TRANSFER_DST_BIT);
   if (count == 0) return;
   detail::Barriers b;
-  b.use(visibility, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);
-  b.flush(cmd);
-  vkCmdFillBuffer(cmd, visibility.buffer, visibility.offset, VkDeviceSize(count) * 4, 0);
-  detail::count_recorded_command();
+  detail::record_zero_fill(cmd, b, visibility, VkDeviceSize(count) * 4);
 }
 
 namespace detail {

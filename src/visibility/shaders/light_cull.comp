@@ -53,7 +53,7 @@ layout(std430, binding = 5) writeonly buffer Indirect { GlintFlareIndirect indir
 layout(std430, binding = 6) writeonly buffer Stats { GlintFlareStats stats; };
 // The visible lights of the current chunk, one bit per light of the chunk (at most 1024).
 shared uint chunk_mask[32];
-// Per light of the chunk: samples that see it; bit 31: the early out (main() below).
+// Per light of the chunk: samples that see it; bit 31: the early out (cull_in_one_group() below).
 shared uint light_seen[1024];
 #ifdef GLINT_CULL_FROM_DEPTH
 // The depth-image build (GLINT_CULL_FROM_DEPTH, main() at the end): whether sample t of light i sees
