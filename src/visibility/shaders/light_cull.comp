@@ -161,7 +161,8 @@ GridTest grid_setup(vec2 center, float size, float z) {
   g.lsize = max(ivec2(1), ivec2(pc.width, pc.height) >> g.k);
   g.reversed = (pc.flags & GLINT_CULL_REVERSED_Z) != 0u;
   g.zt = g.reversed ? z + pc.depth_bias : z - pc.depth_bias;
-  g.origin = center - 0.5 * size;
+  precise const vec2 origin = center - 0.5 * size;  // precise: as sample_window()
+  g.origin = origin;
   return g;
 }
 
@@ -170,15 +171,23 @@ bool grid_hidden(GridTest g) {
   return g.n > 1 && whole_light_hidden(g.origin, g.unit, g.n, g.regular, g.k, g.lsize, g.zt, g.reversed);
 }
 
+// The window of the sample of cell (i, j): the level-k texels [tx.x, tx.y] x [ty.x, ty.y] under its
+// footprint, clamped to the level. `precise`: the pyramid cull and the depth-image cull (two
+// pipelines) find the same window, whatever either compiler contracts into an FMA.
+void sample_window(GridTest g, int i, int j, out ivec2 tx, out ivec2 ty) {
+  const ivec2 sx = sample_span(i, j, g.n, g.regular), sy = sample_span(j, i, g.n, g.regular);
+  precise const vec2 x_edges = g.origin.x + vec2(sx) * g.unit;
+  precise const vec2 y_edges = g.origin.y + vec2(sy) * g.unit;
+  tx = texel_range(x_edges.x, x_edges.y, g.k, pc.width, g.lsize.x);
+  ty = texel_range(y_edges.x, y_edges.y, g.k, pc.height, g.lsize.y);
+}
+
 // Whether the sample of cell (i, j) sees the light: any depth texel under its footprint is not
 // nearer than the light (the loop stops at the first such texel; the answer does not depend on
 // the order of the reads).
 bool sample_seen(GridTest g, int i, int j) {
-  const ivec2 sx = sample_span(i, j, g.n, g.regular), sy = sample_span(j, i, g.n, g.regular);
-  const ivec2 tx = texel_range(g.origin.x + float(sx.x) * g.unit, g.origin.x + float(sx.y) * g.unit, g.k, pc.width,
-                               g.lsize.x);
-  const ivec2 ty = texel_range(g.origin.y + float(sy.x) * g.unit, g.origin.y + float(sy.y) * g.unit, g.k, pc.height,
-                               g.lsize.y);
+  ivec2 tx, ty;
+  sample_window(g, i, j, tx, ty);
   bool seen = (tx.y - tx.x + 1) * (ty.y - ty.x + 1) > GLINT_CULL_MAX_WINDOW_TEXELS;
   for (int y = ty.x; y <= ty.y && !seen; ++y) {
     for (int x = tx.x; x <= tx.y && !seen; ++x) {
@@ -228,17 +237,21 @@ uint cull_project(uint i, out vec4 words[3], out vec2 center, out float ndc_z, o
   if (light.enabled == 0u || !light_finite(light)) return GLINT_FLARE_DISABLED;
   const vec4 p = vec4(light.position_x, light.position_y, light.position_z, 1.0);
   const float m[16] = pc.view_proj;
-  const vec4 clip = vec4(m[0] * p.x + m[4] * p.y + m[8] * p.z + m[12], m[1] * p.x + m[5] * p.y + m[9] * p.z + m[13],
+  // precise, the projection and the pixel centre: the depth-image cull projects a light in each of
+  // its sample workgroups and again in the last one, and the pyramid cull in its own pipeline; each
+  // copy must find the same centre and state (SPIR-V leaves FMA contraction free otherwise).
+  precise const vec4 clip = vec4(m[0] * p.x + m[4] * p.y + m[8] * p.z + m[12], m[1] * p.x + m[5] * p.y + m[9] * p.z + m[13],
                          m[2] * p.x + m[6] * p.y + m[10] * p.z + m[14], m[3] * p.x + m[7] * p.y + m[11] * p.z + m[15]);
   // Overflowing clip coordinates (positions near the float range) are culled on the bits too.
   const bool clip_finite = cull_finite(clip.x) && cull_finite(clip.y) && cull_finite(clip.z) && cull_finite(clip.w);
   if (!clip_finite || !(clip.w > 0.0)) return GLINT_FLARE_FRUSTUM;
-  const vec3 ndc = clip.xyz / clip.w;
+  precise const vec3 ndc = clip.xyz / clip.w;
   if (!(cull_finite(ndc.x) && cull_finite(ndc.y) && cull_finite(ndc.z) && abs(ndc.x) <= pc.margin_ndc &&
         abs(ndc.y) <= pc.margin_ndc && ndc.z >= 0.0 && ndc.z <= 1.0)) {
     return GLINT_FLARE_FRUSTUM;
   }
-  center = (ndc.xy * 0.5 + 0.5) * vec2(pc.width, pc.height);
+  precise const vec2 pixel_centre = (ndc.xy * 0.5 + 0.5) * vec2(pc.width, pc.height);
+  center = pixel_centre;
   ndc_z = ndc.z;
   size = light.size_px >= 1.0 ? min(light.size_px, GLINT_CULL_MAX_SIZE_PX) : 1.0;
   return GLINT_FLARE_VISIBLE;
@@ -449,6 +462,7 @@ void main() { cull_in_one_group(); }
 // samples' words: instances in light order, results, arguments and statistics. At least one
 // workgroup runs (count 0: the last one writes the empty frame's outputs).
 shared uint group_seen;
+shared uint round_seen[3];
 shared bool group_last;
 
 void main() {
@@ -457,7 +471,10 @@ void main() {
   const uint n2 = pc.grid * pc.grid;
   const uint w = gl_WorkGroupID.x;
   const uint i = w / n2, t = w % n2;
-  if (lid == 0u) group_seen = 0u;
+  if (lid == 0u) {
+    group_seen = 0u;
+    round_seen[0] = 0u;
+  }
   barrier();
   if (i < pc.count) {  // uniform in the workgroup: every invocation projects the same light
     vec4 words[3];
@@ -465,12 +482,8 @@ void main() {
     float ndc_z, light_size;
     if (cull_project(i, words, center, ndc_z, light_size) == GLINT_FLARE_VISIBLE) {
       const GridTest g = grid_setup(center, light_size, ndc_z);
-      const int si = int(t % pc.grid), sj = int(t / pc.grid);
-      const ivec2 sx = sample_span(si, sj, g.n, g.regular), sy = sample_span(sj, si, g.n, g.regular);
-      const ivec2 tx = texel_range(g.origin.x + float(sx.x) * g.unit, g.origin.x + float(sx.y) * g.unit, g.k, pc.width,
-                                   g.lsize.x);
-      const ivec2 ty = texel_range(g.origin.y + float(sy.x) * g.unit, g.origin.y + float(sy.y) * g.unit, g.k, pc.height,
-                                   g.lsize.y);
+      ivec2 tx, ty;
+      sample_window(g, int(t % pc.grid), int(t / pc.grid), tx, ty);
       if ((tx.y - tx.x + 1) * (ty.y - ty.x + 1) > GLINT_CULL_MAX_WINDOW_TEXELS) {
         if (lid == 0u) group_seen = 1u;
       } else {
@@ -481,18 +494,29 @@ void main() {
         const ivec2 p1 = mix((t1 + 1) << g.k, pixels, equal(t1, g.lsize - 1));  // exclusive
         const uint span_x = uint(p1.x - p0.x);
         const uint pixel_count = span_x * uint(p1.y - p0.y);
-        bool seen = false;
-        // Four fetches in flight per invocation and round; past the end an invocation reads the
-        // window's last pixel again (a repeated pixel changes no answer).
-        for (uint base = lid; base < pixel_count && !seen; base += 4u * size) {
+        // Rounds of 4 * size pixels, four fetches in flight per invocation; past the end an
+        // invocation reads the window's last pixel again (a repeated pixel changes no answer). The
+        // whole workgroup stops after the first round in which any invocation found a pixel that
+        // sees the light: round r's finds go to round_seen[r % 3], read by all after the round's
+        // barrier (so the stop is uniform); the word of round r + 1 is cleared before that barrier,
+        // and the one it reuses, round r - 2's, was last read before round r - 1's barrier.
+        uint round = 0u;
+        for (uint base = 0u; base < pixel_count; base += 4u * size, ++round) {  // uniform bounds
           float d[4];
           for (uint r = 0u; r < 4u; ++r) {
-            const uint q = min(base + r * size, pixel_count - 1u);
+            const uint q = min(base + lid + r * size, pixel_count - 1u);
             d[r] = texelFetch(depth_tex, p0 + ivec2(q % span_x, q / span_x), 0).r;
           }
+          bool seen = false;
           for (uint r = 0u; r < 4u; ++r) seen = seen || (g.reversed ? d[r] <= g.zt : d[r] >= g.zt);
+          if (seen) atomicOr(round_seen[round % 3u], 1u);
+          if (lid == 0u) round_seen[(round + 1u) % 3u] = 0u;
+          barrier();
+          if (round_seen[round % 3u] != 0u) {  // the same in every invocation
+            if (lid == 0u) group_seen = 1u;
+            break;
+          }
         }
-        if (seen) atomicOr(group_seen, 1u);
       }
     }
   }
