@@ -110,10 +110,10 @@ ivec2 sample_span(int i, int j, int n, bool regular) {
 // (k = levels >= kc) the whole union, and every window, lies in at most 2x2 level-k texels.
 bool whole_light_hidden(vec2 origin, float unit, int n, bool regular, int k, ivec2 lsize, float zt, bool reversed) {
   const ivec2 ext = regular ? ivec2(0, 2 * n * n) : ivec2(2 - 2 * n, 2 * n * n + 2 * n - 2);
-  // The extreme samples' edges are origin + ext * unit, as the loop computes them, up to the
-  // compiler contracting either sum into an FMA or not (SPIR-V leaves it free): the two forms differ
-  // by a few units in the last place of the largest term, and the union is widened by 2^-18 of it
-  // (8 units in the last place and more).
+  // The extreme samples' edges are origin + ext * unit, as sample_window() computes them (precise:
+  // a product rounded, then a sum rounded); here the compiler may contract either sum into an FMA
+  // (SPIR-V leaves it free): the two forms differ by a few units in the last place of the largest
+  // term, and the union is widened by 2^-18 of it (8 units in the last place and more).
   const float a0 = float(ext.x) * unit, a1 = float(ext.y) * unit;
   const vec2 widen = ldexp(abs(origin) + max(abs(a0), abs(a1)), ivec2(-18));
   const ivec2 ux = texel_range(origin.x + a0 - widen.x, origin.x + a1 + widen.x, k, pc.width, lsize.x);
@@ -241,7 +241,7 @@ uint cull_project(uint i, out vec4 words[3], out vec2 center, out float ndc_z, o
   // its sample workgroups and again in the last one, and the pyramid cull in its own pipeline; each
   // copy must find the same centre and state (SPIR-V leaves FMA contraction free otherwise).
   precise const vec4 clip = vec4(m[0] * p.x + m[4] * p.y + m[8] * p.z + m[12], m[1] * p.x + m[5] * p.y + m[9] * p.z + m[13],
-                         m[2] * p.x + m[6] * p.y + m[10] * p.z + m[14], m[3] * p.x + m[7] * p.y + m[11] * p.z + m[15]);
+                                 m[2] * p.x + m[6] * p.y + m[10] * p.z + m[14], m[3] * p.x + m[7] * p.y + m[11] * p.z + m[15]);
   // Overflowing clip coordinates (positions near the float range) are culled on the bits too.
   const bool clip_finite = cull_finite(clip.x) && cull_finite(clip.y) && cull_finite(clip.z) && cull_finite(clip.w);
   if (!clip_finite || !(clip.w > 0.0)) return GLINT_FLARE_FRUSTUM;
@@ -462,7 +462,6 @@ void main() { cull_in_one_group(); }
 // samples' words: instances in light order, results, arguments and statistics. At least one
 // workgroup runs (count 0: the last one writes the empty frame's outputs).
 shared uint group_seen;
-shared uint round_seen[3];
 shared bool group_last;
 
 void main() {
@@ -471,10 +470,7 @@ void main() {
   const uint n2 = pc.grid * pc.grid;
   const uint w = gl_WorkGroupID.x;
   const uint i = w / n2, t = w % n2;
-  if (lid == 0u) {
-    group_seen = 0u;
-    round_seen[0] = 0u;
-  }
+  if (lid == 0u) group_seen = 0u;
   barrier();
   if (i < pc.count) {  // uniform in the workgroup: every invocation projects the same light
     vec4 words[3];
@@ -494,29 +490,20 @@ void main() {
         const ivec2 p1 = mix((t1 + 1) << g.k, pixels, equal(t1, g.lsize - 1));  // exclusive
         const uint span_x = uint(p1.x - p0.x);
         const uint pixel_count = span_x * uint(p1.y - p0.y);
-        // Rounds of 4 * size pixels, four fetches in flight per invocation; past the end an
-        // invocation reads the window's last pixel again (a repeated pixel changes no answer). The
-        // whole workgroup stops after the first round in which any invocation found a pixel that
-        // sees the light: round r's finds go to round_seen[r % 3], read by all after the round's
-        // barrier (so the stop is uniform); the word of round r + 1 is cleared before that barrier,
-        // and the one it reuses, round r - 2's, was last read before round r - 1's barrier.
-        uint round = 0u;
-        for (uint base = 0u; base < pixel_count; base += 4u * size, ++round) {  // uniform bounds
+        bool seen = false;
+        // Four fetches in flight per invocation and round; past the end an invocation reads the
+        // window's last pixel again (a repeated pixel changes no answer). Each invocation stops at
+        // its first pixel that sees the light; a workgroup-wide stop (a shared flag and a barrier
+        // each round) was slower on the H200 (docs/OCCLUSION.md, "Few lights from the depth image").
+        for (uint base = lid; base < pixel_count && !seen; base += 4u * size) {
           float d[4];
           for (uint r = 0u; r < 4u; ++r) {
-            const uint q = min(base + lid + r * size, pixel_count - 1u);
+            const uint q = min(base + r * size, pixel_count - 1u);
             d[r] = texelFetch(depth_tex, p0 + ivec2(q % span_x, q / span_x), 0).r;
           }
-          bool seen = false;
           for (uint r = 0u; r < 4u; ++r) seen = seen || (g.reversed ? d[r] <= g.zt : d[r] >= g.zt);
-          if (seen) atomicOr(round_seen[round % 3u], 1u);
-          if (lid == 0u) round_seen[(round + 1u) % 3u] = 0u;
-          barrier();
-          if (round_seen[round % 3u] != 0u) {  // the same in every invocation
-            if (lid == 0u) group_seen = 1u;
-            break;
-          }
         }
+        if (seen) atomicOr(group_seen, 1u);
       }
     }
   }
