@@ -122,7 +122,19 @@ std::vector<ApiCase> api_cases() {
                      ErrorCode::unsupported_size,
                      {"Bloom::prepare", "accepted 1 to " + std::to_string(max_dim)},
                      [e](Fixture& fx, VkCommandBuffer, auto&, auto&) { fx.bloom.prepare(e); }});
+    cases.push_back(
+        {"Bloom::prepare(extent, format) " + std::to_string(e.width) + "x" + std::to_string(e.height),
+         ErrorCode::unsupported_size,
+         {"Bloom::prepare", "accepted 1 to " + std::to_string(max_dim)},
+         [e](Fixture& fx, VkCommandBuffer, auto&, auto&) { fx.bloom.prepare(e, VK_FORMAT_R16G16B16A16_SFLOAT); }});
   }
+  // An output format no kernel stores (not a float colour format), refused before anything is made.
+  cases.push_back({"Bloom::prepare(extent, format) R8G8B8A8_UNORM",
+                   ErrorCode::unsupported_format,
+                   {"Bloom::prepare: output format is VK_FORMAT_R8G8B8A8_UNORM", "accepted"},
+                   [](Fixture& fx, VkCommandBuffer, auto&, auto&) {
+                     fx.bloom.prepare({40, 24}, VK_FORMAT_R8G8B8A8_UNORM);
+                   }});
 
   // Bloom::record images. Each row edits copies of the fixture's image views.
   using Edit = std::function<void(Fixture&, Image & in, Image & out)>;
@@ -254,7 +266,18 @@ std::vector<ApiCase> api_cases() {
                      ErrorCode::unsupported_size,
                      {"GaussianBlur::prepare", range},
                      [e](Fixture& fx, VkCommandBuffer, auto&, auto&) { fx.gauss.prepare(e); }});
+    cases.push_back(
+        {"GaussianBlur::prepare(extent, format) " + size,
+         ErrorCode::unsupported_size,
+         {"GaussianBlur::prepare", range},
+         [e](Fixture& fx, VkCommandBuffer, auto&, auto&) { fx.gauss.prepare(e, VK_FORMAT_R16G16B16A16_SFLOAT); }});
   }
+  cases.push_back({"GaussianBlur::prepare(extent, format) R8G8B8A8_UNORM",
+                   ErrorCode::unsupported_format,
+                   {"GaussianBlur::prepare: output format is VK_FORMAT_R8G8B8A8_UNORM", "accepted"},
+                   [](Fixture& fx, VkCommandBuffer, auto&, auto&) {
+                     fx.gauss.prepare({40, 24}, VK_FORMAT_R8G8B8A8_UNORM);
+                   }});
   for (const ImageRow& row : image_rows) {
     const std::string what = row.what;
     if (what == "in place with two formats") continue;

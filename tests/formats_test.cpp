@@ -22,6 +22,7 @@
 #include "reference/bloom_reference.h"
 #include "reference/blur_reference.h"
 #include "reference/occlusion_reference.h"
+#include "support/environment.h"
 #include "support/gpu_test.h"
 
 namespace glint::test {
@@ -266,6 +267,72 @@ TEST_F(FormatsTest, GaussianBlurWritesB10G11R11) {
     reference::DoubleImage ref{wide.width, wide.height, std::vector<double>(wide.rgba.begin(), wide.rgba.end())};
     const Deviation d = compare(gpu, ref, kB10);
     EXPECT_EQ(d.outside, 0u) << blur_method_name(method) << ", first " << d.first;
+  }
+}
+
+// An engine's output format, prepared: prepare(extent, format) makes what recording into it needs,
+// so that the first record() creates no Vulkan object (an engine warms its effects up before the
+// first frame), and a bloom shape change makes it again. Every float colour format the device
+// stores. Pipelines are compiled once per context (src/core/pipeline.cpp), so each format runs on a
+// context of its own, where nothing was compiled before; and on another, with prepare(extent)
+// alone, the first record() into B10G11R11 does compile pipelines: what the overload exists for,
+// and what makes the checks able to fail.
+TEST_F(FormatsTest, PrepareWithAnOutputFormatMakesWhatRecordingIntoItNeeds) {
+  const CpuImage input = random_hdr(48, 30, 21);
+  const VkExtent2D e{input.width, input.height};
+  ContextOptions options;
+  options.validation = true;
+  options = tools::context_options_from_environment(options);
+  int prepared = 0;
+  for (VkFormat f :
+       {kB10, kF16, kF32, VK_FORMAT_R16G16B16_SFLOAT, VK_FORMAT_R32G32B32_SFLOAT, VK_FORMAT_E5B9G9R9_UFLOAT_PACK32}) {
+    const std::string name = detail::format_name(f);
+    if (!(usage_for(f) & VK_IMAGE_USAGE_STORAGE_BIT)) continue;  // the device cannot store it
+    bool stores = true;
+    try {
+      detail::check_color_write(context(), f, "test", "output");
+    } catch (const Error&) {
+      stores = false;  // STORAGE_IMAGE without a qualifier and without STORAGE_WRITE_WITHOUT_FORMAT
+    }
+    if (!stores) continue;
+    ++prepared;
+    Context ctx = Context::create(options);
+    detail::OwnedImage in(ctx, e, kF16, usage_for(kF16));
+    detail::upload(ctx, in.state, input);
+    detail::OwnedImage out(ctx, e, f, usage_for(f));
+    for (BloomFilter filter : {BloomFilter::cod13, BloomFilter::dual}) {
+      BloomConfig bc;
+      bc.filter = filter;
+      Bloom bloom(ctx, bc);
+      GaussianBlur blur(ctx);
+      bloom.prepare(e, f);
+      blur.prepare(e, f);
+      uint64_t objects = ctx.objects_created();
+      ctx.run_once([&](VkCommandBuffer cmd) {
+        bloom.record(cmd, in.state, out.state);
+        blur.record(cmd, in.state, out.state);
+      });
+      EXPECT_EQ(ctx.objects_created(), objects) << name << ": the first record() created Vulkan objects";
+      // A shape change makes the prepared output's pipelines again, with the others.
+      bc.filter = filter == BloomFilter::cod13 ? BloomFilter::gauss9 : BloomFilter::cod13;
+      bloom.set_config(bc);
+      objects = ctx.objects_created();
+      ctx.run_once([&](VkCommandBuffer cmd) { bloom.record(cmd, in.state, out.state); });
+      EXPECT_EQ(ctx.objects_created(), objects) << name << ": recording after a shape change created objects";
+    }
+    EXPECT_EQ(ctx.validation_messages(), 0u) << name;
+  }
+  EXPECT_GT(prepared, 1) << "every device stores RGBA16F and RGBA32F";
+  if (usage_for(kB10) & VK_IMAGE_USAGE_STORAGE_BIT) {
+    Context ctx = Context::create(options);
+    detail::OwnedImage in(ctx, e, kF16, usage_for(kF16));
+    detail::upload(ctx, in.state, input);
+    detail::OwnedImage out(ctx, e, kB10, usage_for(kB10));
+    Bloom bloom(ctx);
+    bloom.prepare(e);
+    const uint64_t objects = ctx.objects_created();
+    ctx.run_once([&](VkCommandBuffer cmd) { bloom.record(cmd, in.state, out.state); });
+    EXPECT_GT(ctx.objects_created(), objects) << "prepare(extent) alone made B10G11R11's pipelines";
   }
 }
 

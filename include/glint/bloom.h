@@ -81,7 +81,8 @@ std::vector<LevelSize> bloom_pre_levels(VkExtent2D input, uint32_t level0_height
 /// output may be the same image (in place).
 ///
 /// Per size and config shape, images and pipelines are made once: by prepare(), or by the first
-/// record() at that size. A record() at a prepared size creates no Vulkan object. Descriptors are
+/// record() at that size. A record() at a prepared size, into an output of a prepared format
+/// (RGBA16F and RGBA32F always; others by prepare(extent, format)), creates no Vulkan object. Descriptors are
 /// pushed with each dispatch (VK_KHR_push_descriptor) and nothing keeps the caller's views: a view
 /// may be destroyed once the command buffers it was recorded into are done, and a new view (even
 /// one with the old handle) needs nothing before the next record().
@@ -110,7 +111,18 @@ class Bloom {
 
   /// Makes everything a frame of this size needs, so record() allocates nothing. Optional.
   /// Throws Error(unsupported_size) for a zero extent or one above the device's maximum.
+  /// The pipelines that write an RGBA16F or RGBA32F output are made with the others; those of
+  /// another output format (B10G11R11_UFLOAT_PACK32, or a format written without a format
+  /// qualifier) are made by the overload below or by the first record() into it.
   void prepare(VkExtent2D extent);
+
+  /// prepare(extent), and the pipelines that write `output_format`, so that record() into an
+  /// output of that format at this size creates no Vulkan object. They are kept for the Bloom's
+  /// lifetime, and a set_config() that changes the shape makes them again for the new shape.
+  /// Throws, before making anything: Error(unsupported_size) as prepare(extent);
+  /// Error(unsupported_format) naming the format when it is not a float colour format the device
+  /// can store (the check record() makes of its output).
+  void prepare(VkExtent2D extent, VkFormat output_format);
 
   /// Records the bloom of `input` into `output` on `cmd` (which must be in the recording state,
   /// on a queue family with compute). Updates the state fields of both images. An extent not seen

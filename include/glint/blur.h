@@ -182,7 +182,8 @@ struct BlurChoice {
 /// (docs/FORMATS.md: RGBA16F, RGBA32F, B10G11R11_UFLOAT, ...) with STORAGE usage, same extent, a
 /// different image (or another layer of the same one), left in GENERAL; both last used by the
 /// compute stage. Per size and output format, everything is made once; record() at a prepared
-/// size creates no Vulkan object, and keeps no reference to the caller's views.
+/// size and output format (prepare(extent, format)) creates no Vulkan object, and keeps no
+/// reference to the caller's views.
 ///
 /// Several sizes: one blur may be recorded at different extents and output formats, in one
 /// command buffer or in consecutive frames; each (size, output format) keeps its own plan, images
@@ -202,9 +203,16 @@ class GaussianBlur {
   void set_config(const GaussianBlurConfig& config);
   const GaussianBlurConfig& config() const;
 
-  /// Plans the method for this size and makes its images and pipelines. Throws
-  /// Error(unsupported_size) for a zero extent or one above the device's maximum.
+  /// Plans the method for this size and makes its images and pipelines, for an output of the
+  /// format last prepared or recorded (RGBA16F before any). Throws Error(unsupported_size) for a
+  /// zero extent or one above the device's maximum.
   void prepare(VkExtent2D extent);
+
+  /// The same for an output of `output_format`, so that record() into an output of that format at
+  /// this size creates no Vulkan object. Throws, before making anything: Error(unsupported_size)
+  /// as prepare(extent); Error(unsupported_format) naming the format when it is not a float colour
+  /// format the device can store (the check record() makes of its output).
+  void prepare(VkExtent2D extent, VkFormat output_format);
 
   /// Records the blur. Throws before recording anything on a wrong format, usage or extent, when
   /// input and output are the same image, or (invalid_argument) if a new size is needed while

@@ -5,7 +5,9 @@
 #include <cmath>
 #include <cstddef>
 #include <map>
+#include <string>
 #include <utility>
+#include <vector>
 
 #include "bloom/bloom_internal.h"
 #include "bloom/shaders/bloom_params.h"
@@ -151,7 +153,8 @@ struct Bloom::Impl {
   // The small levels in one dispatch (path.fuse_small_levels); else empty.
   detail::ComputePipeline tail;
   // Composite and copy per output variant (core/formats.h, check_color_write()): rgba16f and
-  // rgba32f are made with the others, r11f_g11f_b10f and noformat on first use. The composite is
+  // rgba32f are made with the others, r11f_g11f_b10f and noformat by prepare(extent, format) or
+  // on first use, and made again by a shape change. The composite is
   // bloom_composite_up (path.fuse_last_up) or bloom_composite; composite_2x holds
   // bloom_composite_2x for the separable filters (cod13, gauss9), which record() runs where the
   // output is exactly twice level 0 on both axes.
@@ -229,10 +232,16 @@ struct Bloom::Impl {
     } else {
       tail = detail::ComputePipeline();
     }
+    // The output variants made so far (prepared or recorded) are made again for the new shape, so
+    // that a prepared output format stays prepared.
+    std::vector<std::string> variants = {"rgba16f", "rgba32f"};
+    for (const auto& [v, pipeline] : composite) {
+      if (std::find(variants.begin(), variants.end(), v) == variants.end()) variants.push_back(v);
+    }
     composite.clear();
     composite_2x.clear();
     copy.clear();
-    for (const char* v : {"rgba16f", "rgba32f"}) output_pipelines(v);
+    for (const std::string& v : variants) output_pipelines(v);
   }
 
   // The pipelines that write an output of kernel variant `v`: the composite, the 2:1 composite
@@ -569,13 +578,26 @@ void Bloom::set_config(const BloomConfig& config) {
 
 const BloomConfig& Bloom::config() const { return impl_->config; }
 
-void Bloom::prepare(VkExtent2D extent) {
-  const uint32_t max_dim = impl_->context->info().max_image_dimension_2d;
+namespace {
+void check_prepare_extent(const Context& context, VkExtent2D extent) {
+  const uint32_t max_dim = context.info().max_image_dimension_2d;
   if (extent.width == 0 || extent.height == 0 || extent.width > max_dim || extent.height > max_dim) {
     throw Error(ErrorCode::unsupported_size, concat("Bloom::prepare: extent ", extent.width, "x", extent.height,
                                                     " is out of range: accepted 1 to ", max_dim, " on each side"));
   }
+}
+}  // namespace
+
+void Bloom::prepare(VkExtent2D extent) {
+  check_prepare_extent(*impl_->context, extent);
   impl_->pyramid_for(extent, "Bloom::prepare");
+}
+
+void Bloom::prepare(VkExtent2D extent, VkFormat output_format) {
+  check_prepare_extent(*impl_->context, extent);
+  const char* variant = detail::check_color_write(*impl_->context, output_format, "Bloom::prepare", "output");
+  impl_->pyramid_for(extent, "Bloom::prepare");
+  impl_->output_pipelines(variant);
 }
 
 void Bloom::record(VkCommandBuffer cmd, Image& input, Image& output, Profiler* profiler) {

@@ -366,6 +366,12 @@ void GaussianBlur::prepare(VkExtent2D extent) {
   impl_->size_for(extent, out, "GaussianBlur::prepare");
 }
 
+void GaussianBlur::prepare(VkExtent2D extent, VkFormat output_format) {
+  check_extent(*impl_->context, extent, "GaussianBlur::prepare");
+  detail::check_color_write(*impl_->context, output_format, "GaussianBlur::prepare", "output");
+  impl_->size_for(extent, output_format, "GaussianBlur::prepare");
+}
+
 void GaussianBlur::record(VkCommandBuffer cmd, Image& input, Image& output, Profiler* profiler) {
   detail::check_command_buffer("GaussianBlur::record", cmd);
   detail::check_image_layout("GaussianBlur::record", "input", input);
