@@ -13,6 +13,8 @@
 #include <set>
 
 #include "core/barriers.h"
+#include "core/check.h"
+#include "core/formats.h"
 #include "reference/occlusion_reference.h"
 #include "support/flare_scene.h"
 #include "support/gpu_test.h"
@@ -784,6 +786,41 @@ TEST_F(OcclusionTest, DepthImageCullGivesTheBitsOfThePyramidCull) {
       }
     }
   }
+}
+
+// The depth-image cull on the depth formats an engine passes (D24S8 most often; a flare frame of few
+// lights takes this path by default): the depth aspect read straight from the caller's image, with
+// the pyramid cull's bits, UNORM depth quantized for the reference as CullReadsEveryDepthFormat does.
+TEST_F(OcclusionTest, DepthImageCullReadsEveryDepthFormat) {
+  uint32_t stream = 951;
+  int ran = 0;
+  for (VkFormat format : {VK_FORMAT_D16_UNORM, VK_FORMAT_X8_D24_UNORM_PACK32, VK_FORMAT_D24_UNORM_S8_UINT,
+                          VK_FORMAT_D32_SFLOAT_S8_UINT, VK_FORMAT_D32_SFLOAT}) {
+    if (!(detail::format_features(context(), format) & VK_FORMAT_FEATURE_2_SAMPLED_IMAGE_BIT)) continue;
+    ++ran;
+    const int bits = format == VK_FORMAT_D16_UNORM                                              ? 16
+                     : format == VK_FORMAT_D32_SFLOAT_S8_UINT || format == VK_FORMAT_D32_SFLOAT ? 0
+                                                                                                : 24;
+    auto scene = reference::random_scene(201, 117, 100, stream++, false, 70);
+    if (bits) {
+      const double q = std::ldexp(1.0, bits) - 1.0;
+      for (float& v : scene.depth.depth) v = static_cast<float>(std::nearbyint(double(v) * q) / q);
+    }
+    LightCullConfig config;
+    config.capacity = 100;
+    float vp[16];
+    for (int i = 0; i < 16; ++i) vp[i] = static_cast<float>(scene.view_proj[i]);
+    const std::string what = detail::format_name(format);
+    const auto a =
+        run_cull(scene.depth, format, false, scene.lights, vp, config, 32, 1, 3, detail::LightCullPath::pyramid);
+    const auto b =
+        run_cull(scene.depth, format, false, scene.lights, vp, config, 32, 1, 3, detail::LightCullPath::depth);
+    expect_same_bits(a, b, what);
+    expect_cull_matches(b, scene, config, false, 5, what);
+    EXPECT_GT(b.stats.occluded, 0u) << what;
+    EXPECT_GT(b.stats.visible, 0u) << what;
+  }
+  EXPECT_GE(ran, 2) << "D16_UNORM and D32_SFLOAT are sampled by every device (Vulkan's required formats)";
 }
 
 // LightCuller::needs_pyramid: the depth image is read where the pyramid has at most 5 levels and
