@@ -257,11 +257,16 @@ struct CullRun {
   bool canary_intact = true;  // bytes past the capacity untouched
 };
 
+// `depth_image`, when given, is the image the cull reads (holding `depth`, of `format`), else one is
+// made from `depth`.
 CullRun run_cull(const reference::DepthImage& depth, VkFormat format, bool reversed,
                  const std::vector<GlintFlareLight>& lights, const float view_proj[16], const LightCullConfig& config,
                  uint32_t max_cell_px = 0, int frames = 1, uint32_t groups_per_instance = 3,
-                 detail::LightCullPath path = detail::LightCullPath::device, uint32_t depth_workgroup = 0) {
-  auto img = make_depth(depth, format);
+                 detail::LightCullPath path = detail::LightCullPath::device, uint32_t depth_workgroup = 0,
+                 Image* depth_image = nullptr) {
+  detail::OwnedImage made;
+  if (!depth_image) made = make_depth(depth, format);
+  Image& img_state = depth_image ? *depth_image : made.state;
   HiZConfig hc;
   hc.extent = {depth.width, depth.height};
   hc.format = format;
@@ -287,8 +292,8 @@ CullRun run_cull(const reference::DepthImage& depth, VkFormat format, bool rever
   context().run_once([&](VkCommandBuffer cmd) {
     for (int f = 0; f < frames; ++f) {
       // The depth-image cull reads no pyramid: it is not built for it (so the cull cannot read it).
-      if (culler.needs_pyramid(hiz, n)) hiz.record(cmd, img.state);
-      culler.record(cmd, hiz, img.state, lbuf.view, n, frame, out);
+      if (culler.needs_pyramid(hiz, n)) hiz.record(cmd, img_state);
+      culler.record(cmd, hiz, img_state, lbuf.view, n, frame, out);
     }
     to_host(cmd, out.instances);
     to_host(cmd, out.indirect);
@@ -821,6 +826,55 @@ TEST_F(OcclusionTest, DepthImageCullReadsEveryDepthFormat) {
     EXPECT_GT(b.stats.visible, 0u) << what;
   }
   EXPECT_GE(ran, 2) << "D16_UNORM and D32_SFLOAT are sampled by every device (Vulkan's required formats)";
+}
+
+// Layer 1 of a two-layer depth image (a stereo engine's second eye): the Hi-Z, the pyramid cull and
+// the depth-image cull read that layer alone. Layer 0 holds depth 0, nearer than every light, so a
+// read of it would occlude every light; the Hi-Z of layer 1 (D32) is also compared with its reference.
+TEST_F(OcclusionTest, CullReadsOneLayerOfAnArrayDepthImage) {
+  uint32_t stream = 971;
+  int ran = 0;
+  for (VkFormat format : {VK_FORMAT_D32_SFLOAT, VK_FORMAT_D24_UNORM_S8_UINT}) {
+    if (!(detail::format_features(context(), format) & VK_FORMAT_FEATURE_2_SAMPLED_IMAGE_BIT)) continue;
+    ++ran;
+    auto scene = reference::random_scene(201, 117, 100, stream++, false, 70);
+    if (format == VK_FORMAT_D24_UNORM_S8_UINT) {
+      const double q = std::ldexp(1.0, 24) - 1.0;
+      for (float& v : scene.depth.depth) v = static_cast<float>(std::nearbyint(double(v) * q) / q);
+    }
+    const VkExtent2D e{scene.depth.width, scene.depth.height};
+    detail::OwnedImage img(
+        context(), e, format,
+        VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT, 1, 2);
+    Image layer0 = img.state, layer1 = img.state;
+    layer1.view = img.layer_view(1);
+    layer1.base_array_layer = 1;
+    detail::upload_r32(context(), layer0, std::vector<float>(scene.depth.depth.size(), 0.0f));
+    detail::upload_r32(context(), layer1, scene.depth.depth);
+    LightCullConfig config;
+    config.capacity = 100;
+    float vp[16];
+    for (int i = 0; i < 16; ++i) vp[i] = static_cast<float>(scene.view_proj[i]);
+    const std::string what = detail::format_name(format) + " layer 1";
+    const auto a = run_cull(scene.depth, format, false, scene.lights, vp, config, 32, 1, 3,
+                            detail::LightCullPath::pyramid, 0, &layer1);
+    const auto b = run_cull(scene.depth, format, false, scene.lights, vp, config, 32, 1, 3,
+                            detail::LightCullPath::depth, 0, &layer1);
+    expect_same_bits(a, b, what);
+    expect_cull_matches(b, scene, config, false, 5, what);
+    EXPECT_GT(b.stats.visible, 0u) << what << ": layer 0 was read";
+    if (format == VK_FORMAT_D32_SFLOAT) {  // bit for bit (UNORM reads may differ by an ulp: HiZDepthFormat)
+      HiZConfig hc;
+      hc.extent = e;
+      hc.format = format;
+      HiZPyramid hiz(context(), hc);
+      poison_pyramid(hiz);
+      context().run_once([&](VkCommandBuffer cmd) { hiz.record(cmd, layer1); });
+      expect_pyramid(read_pyramid(hiz), scene.depth, false, what);
+    }
+    EXPECT_EQ(layer0.layout, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL) << "layer 0's state was changed";
+  }
+  EXPECT_GE(ran, 1) << "D32_SFLOAT is sampled by every device";
 }
 
 // LightCuller::needs_pyramid: the depth image is read where the pyramid has at most 5 levels and
