@@ -119,9 +119,9 @@ class Bloom {
   /// prepare(extent), and the pipelines that write `output_format`, so that record() into an
   /// output of that format at this size creates no Vulkan object. They are kept for the Bloom's
   /// lifetime, and a set_config() that changes the shape makes them again for the new shape.
-  /// Throws, before making anything: Error(unsupported_size) as prepare(extent);
+  /// Checks both before making anything: Error(unsupported_size) as prepare(extent);
   /// Error(unsupported_format) naming the format when it is not a float colour format the device
-  /// can store (the check record() makes of its output).
+  /// can store (the check record() makes of its output). Otherwise throws as prepare(extent) does.
   void prepare(VkExtent2D extent, VkFormat output_format);
 
   /// Records the bloom of `input` into `output` on `cmd` (which must be in the recording state,

@@ -209,9 +209,11 @@ class GaussianBlur {
   void prepare(VkExtent2D extent);
 
   /// The same for an output of `output_format`, so that record() into an output of that format at
-  /// this size creates no Vulkan object. Throws, before making anything: Error(unsupported_size)
-  /// as prepare(extent); Error(unsupported_format) naming the format when it is not a float colour
-  /// format the device can store (the check record() makes of its output).
+  /// this size creates no Vulkan object. set_config() plans again the current (size, format)
+  /// alone; another one prepared before is planned again by its next prepare() or record(). Checks
+  /// both before making anything: Error(unsupported_size) as prepare(extent);
+  /// Error(unsupported_format) naming the format when it is not a float colour format the device
+  /// can store (the check record() makes of its output). Otherwise throws as prepare(extent) does.
   void prepare(VkExtent2D extent, VkFormat output_format);
 
   /// Records the blur. Throws before recording anything on a wrong format, usage or extent, when
