@@ -472,6 +472,18 @@ TEST_F(OcclusionTest, CullMatchesReferenceOnRandomScenes) {
   }
 }
 
+// The depth a UNORM depth format holds and reads back: round(d * (2^bits - 1)) / (2^bits - 1)
+// (Vulkan, "Fixed-Point Data Conversions"), computed in float64 and rounded once to float; float
+// formats keep the values as they are.
+void quantize_for_format(reference::DepthImage& depth, VkFormat format) {
+  const int bits = format == VK_FORMAT_D16_UNORM                                                      ? 16
+                   : format == VK_FORMAT_X8_D24_UNORM_PACK32 || format == VK_FORMAT_D24_UNORM_S8_UINT ? 24
+                                                                                                      : 0;
+  if (bits == 0) return;
+  const double q = std::ldexp(1.0, bits) - 1.0;
+  for (float& v : depth.depth) v = static_cast<float>(std::nearbyint(double(v) * q) / q);
+}
+
 // The cull on the other depth formats (depth-aspect views; barriers cover stencil where the format
 // has it). UNORM depth is quantized to round(d * (2^bits - 1)) / (2^bits - 1) for the reference,
 // as the GPU reads it. A format the device cannot sample is skipped by name (HiZPyramid refuses it).
@@ -485,12 +497,8 @@ TEST_F(OcclusionTest, CullReadsEveryDepthFormat) {
       std::printf("skipped %d: device cannot sample it\n", int(format));
       continue;
     }
-    const int bits = format == VK_FORMAT_D16_UNORM ? 16 : format == VK_FORMAT_D32_SFLOAT_S8_UINT ? 0 : 24;
     auto scene = reference::random_scene(161, 97, 300, stream++, false, 60);
-    if (bits) {
-      const double q = std::ldexp(1.0, bits) - 1.0;
-      for (float& v : scene.depth.depth) v = static_cast<float>(std::nearbyint(double(v) * q) / q);
-    }
+    quantize_for_format(scene.depth, format);
     LightCullConfig config;
     config.capacity = 300;
     float vp[16];
@@ -803,14 +811,8 @@ TEST_F(OcclusionTest, DepthImageCullReadsEveryDepthFormat) {
                           VK_FORMAT_D32_SFLOAT_S8_UINT, VK_FORMAT_D32_SFLOAT}) {
     if (!(detail::format_features(context(), format) & VK_FORMAT_FEATURE_2_SAMPLED_IMAGE_BIT)) continue;
     ++ran;
-    const int bits = format == VK_FORMAT_D16_UNORM                                              ? 16
-                     : format == VK_FORMAT_D32_SFLOAT_S8_UINT || format == VK_FORMAT_D32_SFLOAT ? 0
-                                                                                                : 24;
     auto scene = reference::random_scene(201, 117, 100, stream++, false, 70);
-    if (bits) {
-      const double q = std::ldexp(1.0, bits) - 1.0;
-      for (float& v : scene.depth.depth) v = static_cast<float>(std::nearbyint(double(v) * q) / q);
-    }
+    quantize_for_format(scene.depth, format);
     LightCullConfig config;
     config.capacity = 100;
     float vp[16];
@@ -838,10 +840,7 @@ TEST_F(OcclusionTest, CullReadsOneLayerOfAnArrayDepthImage) {
     if (!(detail::format_features(context(), format) & VK_FORMAT_FEATURE_2_SAMPLED_IMAGE_BIT)) continue;
     ++ran;
     auto scene = reference::random_scene(201, 117, 100, stream++, false, 70);
-    if (format == VK_FORMAT_D24_UNORM_S8_UINT) {
-      const double q = std::ldexp(1.0, 24) - 1.0;
-      for (float& v : scene.depth.depth) v = static_cast<float>(std::nearbyint(double(v) * q) / q);
-    }
+    quantize_for_format(scene.depth, format);
     const VkExtent2D e{scene.depth.width, scene.depth.height};
     detail::OwnedImage img(
         context(), e, format,

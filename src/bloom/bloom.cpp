@@ -344,18 +344,12 @@ struct Bloom::Impl {
 
   // Checks both images; returns the kernel variant that writes the output.
   const char* check_images(const Image& in, const Image& out) const {
-    const uint32_t max_dim = context->info().max_image_dimension_2d;
     auto check_one = [&](const Image& img, const char* role, VkImageUsageFlags need, const char* need_name) {
       if (!img.image || !img.view) {
         throw Error(ErrorCode::invalid_argument, concat("Bloom::record: ", role, " image and view must be non-null"));
       }
       detail::check_layers(img, "Bloom::record", role);
-      if (img.extent.width == 0 || img.extent.height == 0 || img.extent.width > max_dim ||
-          img.extent.height > max_dim) {
-        throw Error(ErrorCode::unsupported_size,
-                    concat("Bloom::record: ", role, " extent ", img.extent.width, "x", img.extent.height,
-                           " is out of range: accepted 1 to ", max_dim, " on each side"));
-      }
+      detail::check_extent(*context, img.extent, "Bloom::record", role);
       if ((img.usage & need) != need) {
         throw Error(ErrorCode::missing_usage, concat("Bloom::record: ", role, " image lacks ", need_name, " usage"));
       }
@@ -578,23 +572,13 @@ void Bloom::set_config(const BloomConfig& config) {
 
 const BloomConfig& Bloom::config() const { return impl_->config; }
 
-namespace {
-void check_prepare_extent(const Context& context, VkExtent2D extent) {
-  const uint32_t max_dim = context.info().max_image_dimension_2d;
-  if (extent.width == 0 || extent.height == 0 || extent.width > max_dim || extent.height > max_dim) {
-    throw Error(ErrorCode::unsupported_size, concat("Bloom::prepare: extent ", extent.width, "x", extent.height,
-                                                    " is out of range: accepted 1 to ", max_dim, " on each side"));
-  }
-}
-}  // namespace
-
 void Bloom::prepare(VkExtent2D extent) {
-  check_prepare_extent(*impl_->context, extent);
+  detail::check_extent(*impl_->context, extent, "Bloom::prepare");
   impl_->pyramid_for(extent, "Bloom::prepare");
 }
 
 void Bloom::prepare(VkExtent2D extent, VkFormat output_format) {
-  check_prepare_extent(*impl_->context, extent);
+  detail::check_extent(*impl_->context, extent, "Bloom::prepare");
   const char* variant = detail::check_color_write(*impl_->context, output_format, "Bloom::prepare", "output");
   impl_->pyramid_for(extent, "Bloom::prepare");
   impl_->output_pipelines(variant);

@@ -111,7 +111,7 @@ void BlurPyramid::set_config(const BlurPyramidConfig& config) {
 const BlurPyramidConfig& BlurPyramid::config() const { return impl_->config; }
 
 void BlurPyramid::prepare(VkExtent2D input_extent) {
-  check_extent(*impl_->context, input_extent, "BlurPyramid::prepare");
+  detail::check_extent(*impl_->context, input_extent, "BlurPyramid::prepare");
   impl_->size_for(input_extent, "BlurPyramid::prepare");
 }
 

@@ -42,17 +42,6 @@ uint32_t stream_shared_bytes(detail::Workgroup2D wg, uint32_t radius, bool half_
   return (half_shared ? 8 : 16) * (load_s * step + row_s * (step + 2 * radius)) + (half_shared ? 32 : 16);
 }
 
-// Throws Error(unsupported_size) "<where>: <role> extent WxH is out of range: accepted 1 to N on
-// each side" (role may be empty). The message is built only when it is thrown.
-void check_extent_named(const Context& context, VkExtent2D e, const char* where, const char* role) {
-  const uint32_t max_dim = context.info().max_image_dimension_2d;
-  if (e.width == 0 || e.height == 0 || e.width > max_dim || e.height > max_dim) {
-    throw Error(ErrorCode::unsupported_size,
-                concat(where, ": ", role, *role ? " " : "", "extent ", e.width, "x", e.height,
-                       " is out of range: accepted 1 to ", max_dim, " on each side"));
-  }
-}
-
 // The first shape of `gpu` (of `cpu` on CPU devices) whose invocations and shared memory
 // (`shared_bytes(shape)`) fit the device (CONTRIBUTING.md, "Device limits"): larger tiles first.
 // Throws Error(no_device) naming `what` and the smallest shape's need when none fits.
@@ -123,10 +112,6 @@ std::string store_variant(VkFormat format) {
   return q ? q : "noformat";
 }
 
-void check_extent(const Context& context, VkExtent2D e, const char* where) {
-  check_extent_named(context, e, where, "");
-}
-
 void check_image(const Context& context, const Image& img, const char* where, const char* role, VkImageUsageFlags need,
                  const char* need_name) {
   if (!img.image || !img.view)
@@ -137,7 +122,7 @@ void check_image(const Context& context, const Image& img, const char* where, co
   } else {
     detail::check_color_read(context, img.format, where, role);
   }
-  check_extent_named(context, img.extent, where, role);
+  detail::check_extent(context, img.extent, where, role);
   if ((img.usage & need) != need)
     throw Error(ErrorCode::missing_usage, concat(where, ": ", role, " image lacks ", need_name, " usage"));
 }

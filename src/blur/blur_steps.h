@@ -41,10 +41,6 @@ float max_value_for(VkFormat a, VkFormat b);
 // detail::check_color_write() accepted for the caller's output before any pipeline is made).
 std::string store_variant(VkFormat format);
 
-/// Throws Error(unsupported_size) "<where>: extent WxH is out of range: accepted 1 to N on each
-/// side" unless `e` fits the device's maxImageDimension2D.
-void check_extent(const Context& context, VkExtent2D e, const char* where);
-
 /// Checks a caller image before anything is recorded: non-null handles, one layer, a float colour
 /// format the device reads (or, when `need` has STORAGE, writes), its extent, and the usage `need`
 /// (named `need_name` in the message).

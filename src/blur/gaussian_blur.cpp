@@ -361,13 +361,13 @@ void GaussianBlur::set_config(const GaussianBlurConfig& config) {
 const GaussianBlurConfig& GaussianBlur::config() const { return impl_->config; }
 
 void GaussianBlur::prepare(VkExtent2D extent) {
-  check_extent(*impl_->context, extent, "GaussianBlur::prepare");
+  detail::check_extent(*impl_->context, extent, "GaussianBlur::prepare");
   const VkFormat out = impl_->cur ? impl_->cur->output_format : VK_FORMAT_R16G16B16A16_SFLOAT;
   impl_->size_for(extent, out, "GaussianBlur::prepare");
 }
 
 void GaussianBlur::prepare(VkExtent2D extent, VkFormat output_format) {
-  check_extent(*impl_->context, extent, "GaussianBlur::prepare");
+  detail::check_extent(*impl_->context, extent, "GaussianBlur::prepare");
   detail::check_color_write(*impl_->context, output_format, "GaussianBlur::prepare", "output");
   impl_->size_for(extent, output_format, "GaussianBlur::prepare");
 }

@@ -48,6 +48,15 @@ void check_buffer(const char* where, const char* role, const Buffer& b, VkDevice
   }
 }
 
+void check_extent(const Context& context, VkExtent2D e, const char* where, const char* role) {
+  const uint32_t max_dim = context.info().max_image_dimension_2d;
+  if (e.width == 0 || e.height == 0 || e.width > max_dim || e.height > max_dim) {
+    throw Error(ErrorCode::unsupported_size,
+                concat(where, ": ", role, *role ? " " : "", "extent ", e.width, "x", e.height,
+                       " is out of range: accepted 1 to ", max_dim, " on each side"));
+  }
+}
+
 void check_command_buffer(const char* where, VkCommandBuffer cmd) {
   if (cmd == VK_NULL_HANDLE) {
     throw Error(ErrorCode::invalid_argument, concat(where, ": the command buffer is null"));

@@ -56,6 +56,11 @@ std::string format_name(VkFormat format);
 void check_buffer(const char* where, const char* role, const Buffer& b, VkDeviceSize need, VkBufferUsageFlags usage,
                   VkDeviceSize offset_alignment = 4);
 
+/// Throws Error(unsupported_size) "<where>: <role> extent WxH is out of range: accepted 1 to N on
+/// each side" (role may be empty) unless `e` fits the device's maxImageDimension2D. The message is
+/// built only when it is thrown.
+void check_extent(const Context& context, VkExtent2D e, const char* where, const char* role = "");
+
 /// Throws Error(invalid_argument) for a null command buffer.
 void check_command_buffer(const char* where, VkCommandBuffer cmd);
 

@@ -172,11 +172,7 @@ LensFlare::LensFlare(const Context& context, VkFormat color_format, VkExtent2D e
                 concat("LensFlare: color format is ", detail::format_name(color_format),
                        "; accepted VK_FORMAT_R16G16B16A16_SFLOAT or VK_FORMAT_R32G32B32A32_SFLOAT"));
   }
-  const uint32_t max_dim = context.info().max_image_dimension_2d;
-  if (extent.width == 0 || extent.height == 0 || extent.width > max_dim || extent.height > max_dim) {
-    throw Error(ErrorCode::unsupported_size, concat("LensFlare: extent ", extent.width, "x", extent.height,
-                                                    " is out of range: accepted 1 to ", max_dim, " on each side"));
-  }
+  detail::check_extent(context, extent, "LensFlare");
   Impl& m = *impl_;
   m.context = &context;
   m.device = context.device();
