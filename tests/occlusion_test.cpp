@@ -472,18 +472,6 @@ TEST_F(OcclusionTest, CullMatchesReferenceOnRandomScenes) {
   }
 }
 
-// The depth a UNORM depth format holds and reads back: round(d * (2^bits - 1)) / (2^bits - 1)
-// (Vulkan, "Fixed-Point Data Conversions"), computed in float64 and rounded once to float; float
-// formats keep the values as they are.
-void quantize_for_format(reference::DepthImage& depth, VkFormat format) {
-  const int bits = format == VK_FORMAT_D16_UNORM                                                      ? 16
-                   : format == VK_FORMAT_X8_D24_UNORM_PACK32 || format == VK_FORMAT_D24_UNORM_S8_UINT ? 24
-                                                                                                      : 0;
-  if (bits == 0) return;
-  const double q = std::ldexp(1.0, bits) - 1.0;
-  for (float& v : depth.depth) v = static_cast<float>(std::nearbyint(double(v) * q) / q);
-}
-
 // The cull on the other depth formats (depth-aspect views; barriers cover stencil where the format
 // has it). UNORM depth is quantized to round(d * (2^bits - 1)) / (2^bits - 1) for the reference,
 // as the GPU reads it. A format the device cannot sample is skipped by name (HiZPyramid refuses it).

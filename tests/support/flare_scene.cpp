@@ -1,6 +1,7 @@
 #include "support/flare_scene.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 
 #include "support/gpu_test.h"
@@ -25,6 +26,16 @@ std::vector<uint8_t> HostBuffer::bytes(size_t n) const {
   owned.invalidate();
   const auto* p = static_cast<const uint8_t*>(owned.mapped());
   return std::vector<uint8_t>(p, p + n);
+}
+
+int quantize_for_format(reference::DepthImage& depth, VkFormat format) {
+  const int bits = format == VK_FORMAT_D16_UNORM                                                      ? 16
+                   : format == VK_FORMAT_X8_D24_UNORM_PACK32 || format == VK_FORMAT_D24_UNORM_S8_UINT ? 24
+                                                                                                      : 0;
+  if (bits == 0) return 0;
+  const double q = std::ldexp(1.0, bits) - 1.0;
+  for (float& v : depth.depth) v = static_cast<float>(std::nearbyint(double(v) * q) / q);
+  return bits;
 }
 
 detail::OwnedImage make_depth(const reference::DepthImage& d, VkFormat format) {

@@ -39,6 +39,11 @@ struct HostBuffer {
 /// A sampled depth image (D32_SFLOAT or R32_SFLOAT) holding `d`.
 detail::OwnedImage make_depth(const reference::DepthImage& d, VkFormat format);
 
+/// The depth a UNORM depth format holds and reads back, in place: round(d * (2^bits - 1)) /
+/// (2^bits - 1) (Vulkan, "Fixed-Point Data Conversions"), computed in float64 and rounded once to
+/// float. Float depth formats keep the values as they are. Returns the UNORM bits (0: float).
+int quantize_for_format(reference::DepthImage& depth, VkFormat format);
+
 /// A perspective camera at the origin looking down -z onto a width x height image (Vulkan depth
 /// [0, 1], standard Z, ndc.y = -1 on the first row, 1 radian vertical field of view, near 0.1,
 /// far 100), as an engine would hand it over.
