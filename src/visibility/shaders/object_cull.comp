@@ -35,15 +35,20 @@
 //    (docs/OCCLUSION.md, "Cost"): every workgroup then pays a device-scope barrier and an atomic
 //    before it retires.
 // 7. A workgroup is 128 objects (two groups of 64; 256 on CPU devices). When it holds both kinds, it sorts them
-//    through shared memory (spheres from the first slot, boxes from the last) before the test, so
-//    a subgroup runs one kind's code; the results go back to object order for the writes. A
-//    workgroup of one kind tests its objects where they are. 256-object workgroups were slower on
+//    before the test (spheres from the first slot, boxes from the last), so that a subgroup runs
+//    one kind's code: only the objects' local indices go through shared memory, and each
+//    invocation then loads the record of its slot's object (lines the workgroup has just read, so
+//    from cache); the results go back to object order for the writes. A workgroup of one kind
+//    tests its objects where they are. Exchanging the records themselves through shared memory
+//    held them in registers across the barrier: 56 registers against 32, and on the H200 1.5 us
+//    slower at 1 M objects and 21 us at 10 M (docs/OCCLUSION.md, "Cost"). 256-object workgroups were slower on
 //    the H100 (fewer invocations fit its registers), 64-object ones slower on mixed scenes (a
 //    subgroup more often holds both kinds): docs/OCCLUSION.md, "Cost".
 // GLINT_OBJECT_PHASE1 builds the phase-1 variant, which binds no image (the depth image may be a
 // render target while phase 1 runs).
 // Cost (docs/OCCLUSION.md, "Cost"): one wave of latency-bound invocations, so the kernel keeps
-// few live values and one copy of each expensive step: the record is two 16-byte loads; spheres
+// few live values and one copy of each expensive step: the record is two 16-byte loads (the kind's
+// word first, to sort, the whole record after the sort); spheres
 // and boxes only reduce their bound to an NDC rectangle and a nearest depth, and one Hi-Z test
 // after the branch serves both (a subgroup holding both kinds fetches once, not once per kind);
 // each slope pair takes two reciprocals instead of three divisions; a box's frustum test and depth
@@ -86,10 +91,9 @@ layout(push_constant) uniform Push { GlintObjectCullPush pc; };
 const uint kThreads = gl_WorkGroupSize.x;
 const uint kGroups = (kThreads + GLINT_OBJECT_GROUP - 1u) / GLINT_OBJECT_GROUP;  // kThreads is a multiple of 64
 const uint kNotTested = 0x80000000u;
-// The workgroup's objects sorted by kind for the test (main, step 1), the local index of the
-// object in each slot (kNotTested: beyond the count, or not tested in phase 1), and each object's
-// result by local index: state | invalid << 2.
-shared vec4 s_obj[2][kThreads];
+// The local index of the object in each slot once sorted by kind for the test (main, step 1;
+// kNotTested: beyond the count, or not tested in phase 1), and each object's result by local
+// index: state | invalid << 2.
 shared uint s_who[kThreads];
 shared uint s_state[kThreads];
 shared uint s_ends[2];  // slots taken: spheres from the front, boxes from the back
@@ -338,19 +342,16 @@ void main() {
   const uint group_count = (pc.count + GLINT_OBJECT_GROUP - 1u) / GLINT_OBJECT_GROUP;
   const uint i = wg * kThreads + lid;
   const uint mode = pc.flags & GLINT_OBJECT_MODE_MASK;
-  // 1. Load (coalesced: invocation t, object t) and place the object by kind: spheres (and the
-  //    objects not tested) from the first slot up, boxes from the last slot down.
+  // 1. Load the kind (coalesced: invocation t, object t) and place the object by kind: spheres (and
+  //    the objects not tested) from the first slot up, boxes from the last slot down.
   uint history = GLINT_OBJECT_STATE_NONE;
   bool tested = false;
   if (i < pc.count) {
     history = mode == GLINT_OBJECT_MODE_SINGLE ? GLINT_OBJECT_STATE_NONE : visibility[i];
     tested = mode != GLINT_OBJECT_MODE_PHASE1 || history == GLINT_OBJECT_STATE_VISIBLE;
   }
-  vec4 w0 = vec4(0.0), w1 = vec4(0.0);
-  if (tested) {
-    w0 = object_words[2u * i];
-    w1 = object_words[2u * i + 1u];
-  }
+  vec4 w1 = vec4(0.0);
+  if (tested) w1 = object_words[2u * i + 1u];
   const bool box = tested && floatBitsToUint(w1.w) == GLINT_OBJECT_BOX;
   // The slot of the object once sorted: a rank among the workgroup's objects of its kind.
 #ifdef GLINT_OBJECT_SUBGROUP
@@ -371,19 +372,21 @@ void main() {
   const uint slot = box ? kThreads - 1u - rank : rank;
   barrier();
   // A workgroup of one kind (a scene of spheres only, say) tests its objects where they are; a
-  // mixed one sorts them through shared memory first (uniform in the workgroup: the barriers
-  // below are reached by all or none).
+  // mixed one sorts their indices through shared memory first (uniform in the workgroup: the
+  // barriers below are reached by all or none). Then each invocation loads the record of its
+  // slot's object: the lines the kind loads above brought in, read again from cache.
   const bool mixed = s_ends[0] != 0u && s_ends[1] != 0u;
-  vec4 a0 = w0, a1 = w1;
   uint who = lid | (tested ? 0u : kNotTested);
   if (mixed) {
-    s_obj[0][slot] = w0;
-    s_obj[1][slot] = w1;
     s_who[slot] = who;
     barrier();
-    a0 = s_obj[0][lid];
-    a1 = s_obj[1][lid];
     who = s_who[lid];
+  }
+  vec4 a0 = vec4(0.0), a1 = vec4(0.0);
+  if ((who & kNotTested) == 0u) {
+    const uint j = wg * kThreads + who;
+    a0 = object_words[2u * j];
+    a1 = object_words[2u * j + 1u];
   }
   // 2. Test the object of slot `lid`: in a mixed workgroup, one subgroup at most holds both kinds.
   uint st = GLINT_OBJECT_STATE_NONE;
