@@ -14,6 +14,7 @@
 #include <limits>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/barriers.h"
@@ -441,7 +442,14 @@ TEST_F(ObjectCullTest, EveryTestKernelMatchesReference) {
 // frustum, phase 2 the newly visible ones; their union covers every brute-force visible object,
 // they never overlap, and the states written equal a single-phase cull's.
 TEST_F(ObjectCullTest, TwoPhaseMovingCameraMissesNothing) {
-  for (bool reversed : {false, true}) {
+  // Both builds of the test kernel's phases: subgroup counting, and shared atomics alone (devices
+  // without subgroup arithmetic).
+  using detail::ObjectCullKernel;
+  const std::pair<ObjectCullKernel, bool> runs[] = {{ObjectCullKernel::current, false},
+                                                    {ObjectCullKernel::current, true},
+                                                    {ObjectCullKernel::shared_atomics, false},
+                                                    {ObjectCullKernel::shared_atomics, true}};
+  for (const auto& [kernel, reversed] : runs) {
     SceneSpec s;
     s.reversed = reversed;
     s.objects = 1200;
@@ -450,6 +458,7 @@ TEST_F(ObjectCullTest, TwoPhaseMovingCameraMissesNothing) {
     const auto objs = make_objects(rng, cam, s);
     ObjectCullConfig cc = config_for(s.objects, reversed);
     ObjectCuller culler(context(), cc);
+    detail::object_cull_select_kernel(culler, kernel);
     Outputs early(cc.capacity, 0), late(cc.capacity, 0), single(cc.capacity, 0);
     auto depth = make_depth_image(rng, cam, s);
     GpuScene g(depth, reversed, objs);
@@ -485,7 +494,8 @@ TEST_F(ObjectCullTest, TwoPhaseMovingCameraMissesNothing) {
       });
       g.visibility.view = g.buffers.visibility;
       single_vis.view = single_buffers.visibility;
-      const std::string what = std::string(reversed ? "reversed" : "standard") + " frame " + std::to_string(f);
+      const std::string what = std::string(kernel == ObjectCullKernel::current ? "" : "shared atomics, ") +
+                               (reversed ? "reversed" : "standard") + " frame " + std::to_string(f);
       const auto states = g.states(objs.size());
       const auto* sv = single_vis.as<uint32_t>();
       EXPECT_EQ(states, std::vector<uint32_t>(sv, sv + objs.size()))

@@ -36,19 +36,20 @@
 //    before it retires.
 // 7. A workgroup is 128 objects (two groups of 64; 256 on CPU devices). When it holds both kinds, it sorts them
 //    before the test (spheres from the first slot, boxes from the last), so that a subgroup runs
-//    one kind's code: only the objects' local indices go through shared memory, and each
-//    invocation then loads the record of its slot's object (lines the workgroup has just read, so
-//    from cache); the results go back to object order for the writes. A workgroup of one kind
-//    tests its objects where they are. Exchanging the records themselves through shared memory
-//    held them in registers across the barrier: 56 registers against 32, and on the H200 1.5 us
-//    slower at 1 M objects and 21 us at 10 M (docs/OCCLUSION.md, "Cost"). 256-object workgroups were slower on
+//    one kind's code: only the objects' local indices go through shared memory. A workgroup of
+//    one kind tests its objects where they are. Every invocation, sorted or not, then loads the
+//    whole record of its slot's object (lines the workgroup has just read, so from cache); the
+//    results go back to object order for the writes. Exchanging the records themselves through
+//    shared memory held them in registers across the barrier: 56 registers against 32, and on the
+//    H200 1.4 us slower at 1 M objects and 21 us at 10 M; reloading only in mixed workgroups was
+//    0.1 to 0.2 us and 2.6 us slower than reloading in all (docs/OCCLUSION.md, "Cost"). 256-object workgroups were slower on
 //    the H100 (fewer invocations fit its registers), 64-object ones slower on mixed scenes (a
 //    subgroup more often holds both kinds): docs/OCCLUSION.md, "Cost".
 // GLINT_OBJECT_PHASE1 builds the phase-1 variant, which binds no image (the depth image may be a
 // render target while phase 1 runs).
 // Cost (docs/OCCLUSION.md, "Cost"): one wave of latency-bound invocations, so the kernel keeps
-// few live values and one copy of each expensive step: the record is two 16-byte loads (the kind's
-// word first, to sort, the whole record after the sort); spheres
+// few live values and one copy of each expensive step: the record is read as 16-byte loads (its
+// second half first, for the kind, then both halves after the sort); spheres
 // and boxes only reduce their bound to an NDC rectangle and a nearest depth, and one Hi-Z test
 // after the branch serves both (a subgroup holding both kinds fetches once, not once per kind);
 // each slope pair takes two reciprocals instead of three divisions; a box's frustum test and depth
@@ -373,8 +374,8 @@ void main() {
   barrier();
   // A workgroup of one kind (a scene of spheres only, say) tests its objects where they are; a
   // mixed one sorts their indices through shared memory first (uniform in the workgroup: the
-  // barriers below are reached by all or none). Then each invocation loads the record of its
-  // slot's object: the lines the kind loads above brought in, read again from cache.
+  // barriers below are reached by all or none). Then every invocation loads the record of its
+  // slot's object: the lines the kind's load above brought in, read again from cache.
   const bool mixed = s_ends[0] != 0u && s_ends[1] != 0u;
   uint who = lid | (tested ? 0u : kNotTested);
   if (mixed) {
