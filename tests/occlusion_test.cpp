@@ -257,6 +257,15 @@ struct CullRun {
   bool canary_intact = true;  // bytes past the capacity untouched
 };
 
+// A float64 view-projection in float, as a cull frame carries it; passes as `const float*`.
+struct FloatViewProj {
+  float m[16];
+  explicit FloatViewProj(const double (&d)[16]) {
+    for (int i = 0; i < 16; ++i) m[i] = static_cast<float>(d[i]);
+  }
+  operator const float*() const { return m; }
+};
+
 // `depth_image`, when given, is the image the cull reads (holding `depth`, of `format`), else one is
 // made from `depth`.
 CullRun run_cull(const reference::DepthImage& depth, VkFormat format, bool reversed,
@@ -448,8 +457,7 @@ TEST_F(OcclusionTest, CullMatchesReferenceOnRandomScenes) {
           config.grid = c.grid;
           config.capacity = c.lights;
           if (variant == 2) config.pattern = OcclusionPattern::regular;
-          float vp[16];
-          for (int i = 0; i < 16; ++i) vp[i] = static_cast<float>(scene.view_proj[i]);
+          const FloatViewProj vp(scene.view_proj);
           const VkFormat format = reversed ? VK_FORMAT_R32_SFLOAT : VK_FORMAT_D32_SFLOAT;
           const auto run = run_cull(scene.depth, format, reversed, scene.lights, vp, config, 0, 1, 3, path);
           const uint32_t levels = static_cast<uint32_t>(std::floor(std::log2(double(std::max(c.w, c.h)))));
@@ -479,18 +487,15 @@ TEST_F(OcclusionTest, CullReadsEveryDepthFormat) {
   uint32_t stream = 91;
   for (VkFormat format : {VK_FORMAT_D16_UNORM, VK_FORMAT_X8_D24_UNORM_PACK32, VK_FORMAT_D24_UNORM_S8_UINT,
                           VK_FORMAT_D32_SFLOAT_S8_UINT}) {
-    VkFormatProperties props;
-    vkGetPhysicalDeviceFormatProperties(context().physical_device(), format, &props);
-    if (!(props.optimalTilingFeatures & VK_FORMAT_FEATURE_SAMPLED_IMAGE_BIT)) {
-      std::printf("skipped %d: device cannot sample it\n", int(format));
+    if (!(detail::format_features(context(), format) & VK_FORMAT_FEATURE_2_SAMPLED_IMAGE_BIT)) {
+      std::printf("skipped %s: device cannot sample it\n", detail::format_name(format).c_str());
       continue;
     }
     auto scene = reference::random_scene(161, 97, 300, stream++, false, 60);
     quantize_for_format(scene.depth, format);
     LightCullConfig config;
     config.capacity = 300;
-    float vp[16];
-    for (int i = 0; i < 16; ++i) vp[i] = static_cast<float>(scene.view_proj[i]);
+    const FloatViewProj vp(scene.view_proj);
     const auto run = run_cull(scene.depth, format, false, scene.lights, vp, config);
     expect_cull_matches(run, scene, config, false, 7, "161x97 format " + std::to_string(int(format)));
     EXPECT_GT(run.stats.occluded, 0u);
@@ -547,8 +552,7 @@ TEST_F(OcclusionTest, CullSeesLightsThroughSinglePixelHoles) {
         LightCullConfig config;
         config.grid = grid;
         config.capacity = 600;
-        float vp[16];
-        for (int i = 0; i < 16; ++i) vp[i] = static_cast<float>(scene.view_proj[i]);
+        const FloatViewProj vp(scene.view_proj);
         const VkFormat format = reversed ? VK_FORMAT_R32_SFLOAT : VK_FORMAT_D32_SFLOAT;
         const auto run = run_cull(scene.depth, format, reversed, scene.lights, vp, config);
         const std::string what = "holes max size " + std::to_string(int(c.max_size)) + " N=" + std::to_string(grid) +
@@ -641,8 +645,7 @@ TEST_F(OcclusionTest, CullWithCappedPyramidAndBias) {
   config.capacity = 400;
   config.depth_bias = 0.02f;
   config.grid = 2;
-  float vp[16];
-  for (int i = 0; i < 16; ++i) vp[i] = static_cast<float>(scene.view_proj[i]);
+  const FloatViewProj vp(scene.view_proj);
   const auto run = run_cull(scene.depth, VK_FORMAT_D32_SFLOAT, false, scene.lights, vp, config, 4);
   expect_cull_matches(run, scene, config, false, 2, "capped + bias");
 }
@@ -655,8 +658,7 @@ TEST_F(OcclusionTest, CullOverflowAndRepeatedFrames) {
     for (uint32_t capacity : {1u, 13u}) {
       LightCullConfig config;
       config.capacity = capacity;
-      float vp[16];
-      for (int i = 0; i < 16; ++i) vp[i] = static_cast<float>(scene.view_proj[i]);
+      const FloatViewProj vp(scene.view_proj);
       const auto run = run_cull(scene.depth, VK_FORMAT_D32_SFLOAT, false, scene.lights, vp, config, 0, 2, 3, path);
       ASSERT_GT(run.stats.visible, capacity);
       EXPECT_EQ(run.indirect.instance_count, capacity);
@@ -680,8 +682,7 @@ TEST_F(OcclusionTest, OneWorkgroupCullGivesTheBitsOfTheFourDispatches) {
     // also those of later chunks.
     config.capacity = reversed ? 1500 : 200;
     config.grid = 3;
-    float vp[16];
-    for (int i = 0; i < 16; ++i) vp[i] = static_cast<float>(scene.view_proj[i]);
+    const FloatViewProj vp(scene.view_proj);
     const VkFormat format = reversed ? VK_FORMAT_R32_SFLOAT : VK_FORMAT_D32_SFLOAT;
     LightCuller probe(context(), config);
     const uint32_t most = probe.max_groups_per_instance();
@@ -753,8 +754,7 @@ TEST_F(OcclusionTest, DepthImageCullGivesTheBitsOfThePyramidCull) {
       LightCullConfig config;
       config.grid = c.grid;
       config.pattern = c.pattern;
-      float vp[16];
-      for (int i = 0; i < 16; ++i) vp[i] = static_cast<float>(scene.view_proj[i]);
+      const FloatViewProj vp(scene.view_proj);
       const VkFormat format = reversed ? VK_FORMAT_R32_SFLOAT : VK_FORMAT_D32_SFLOAT;
       const uint32_t levels = c.max_cell_px == 0 ? 8u : static_cast<uint32_t>(std::ceil(std::log2(c.max_cell_px)));
       for (uint32_t m : {0u, 1u, 9u, 150u}) {
@@ -803,8 +803,7 @@ TEST_F(OcclusionTest, DepthImageCullReadsEveryDepthFormat) {
     quantize_for_format(scene.depth, format);
     LightCullConfig config;
     config.capacity = 100;
-    float vp[16];
-    for (int i = 0; i < 16; ++i) vp[i] = static_cast<float>(scene.view_proj[i]);
+    const FloatViewProj vp(scene.view_proj);
     const std::string what = detail::format_name(format);
     const auto a =
         run_cull(scene.depth, format, false, scene.lights, vp, config, 32, 1, 3, detail::LightCullPath::pyramid);
@@ -840,8 +839,7 @@ TEST_F(OcclusionTest, CullReadsOneLayerOfAnArrayDepthImage) {
     detail::upload_r32(context(), layer1, scene.depth.depth);
     LightCullConfig config;
     config.capacity = 100;
-    float vp[16];
-    for (int i = 0; i < 16; ++i) vp[i] = static_cast<float>(scene.view_proj[i]);
+    const FloatViewProj vp(scene.view_proj);
     const std::string what = detail::format_name(format) + " layer 1";
     const auto a = run_cull(scene.depth, format, false, scene.lights, vp, config, 32, 1, 3,
                             detail::LightCullPath::pyramid, 0, &layer1);
@@ -962,8 +960,7 @@ TEST_F(OcclusionTest, TheLightCountChoosesOneWorkgroupUpToOneGroupLights) {
           ? 64u
           : std::min({1024u, props.limits.maxComputeWorkGroupInvocations, props.limits.maxComputeWorkGroupSize[0]});
   const auto scene = reference::random_scene(96, 64, 1100, 77, false, 30);
-  float vp[16];
-  for (int i = 0; i < 16; ++i) vp[i] = static_cast<float>(scene.view_proj[i]);
+  const FloatViewProj vp(scene.view_proj);
   auto img = make_depth(scene.depth, VK_FORMAT_D32_SFLOAT);
   HiZConfig hc;
   hc.extent = {scene.depth.width, scene.depth.height};
@@ -982,7 +979,7 @@ TEST_F(OcclusionTest, TheLightCountChoosesOneWorkgroupUpToOneGroupLights) {
         stats(sizeof(GlintFlareStats));
     LightCullOutputs out{inst.view, indirect.view, stats.view, {}};
     LightCullFrame frame;
-    std::copy(vp, vp + 16, frame.view_proj);
+    std::copy(vp.m, vp.m + 16, frame.view_proj);
     // Commands one record() makes (detail::recorded_commands(): barriers, dispatches, fills) with
     // `path`, measured on a culler's second record (the first clears the counters once).
     auto commands = [&](detail::LightCullPath path, uint32_t n) {
